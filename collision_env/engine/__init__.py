@@ -1,0 +1,38 @@
+"""A time-of-impact-correct 2D/1D ball collision engine modelled on PhET's Collision Lab.
+
+>>> from collision_env.engine import Scene, Simulator
+>>> sim = Simulator(Scene(bounds=None), [[-1, 0], [1, 0]], [[1, 0], [-0.5, 0]], [0.5, 1.5])
+>>> [round(i.time, 6) for i in sim.step(2.0)]
+[1.088256]
+
+See :class:`Simulator` (one scene) and :class:`BatchSimulator` (many scenes at once, one engine).
+"""
+
+from ._jit import BACKEND
+from .scene import (
+    BALL_DENSITY,
+    CONSTANT_RADIUS,
+    PLAY_AREA_1D,
+    PLAY_AREA_2D,
+    WALL_NAMES,
+    Scene,
+    radius_from_mass,
+)
+from .simulator import IMPACT_DTYPE, MODES, BatchSimulator, EventCapWarning, Impact, Simulator
+
+__all__ = [
+    "BACKEND",
+    "BALL_DENSITY",
+    "CONSTANT_RADIUS",
+    "IMPACT_DTYPE",
+    "MODES",
+    "PLAY_AREA_1D",
+    "PLAY_AREA_2D",
+    "WALL_NAMES",
+    "BatchSimulator",
+    "EventCapWarning",
+    "Impact",
+    "Scene",
+    "Simulator",
+    "radius_from_mass",
+]

@@ -1,0 +1,344 @@
+"""Exact mode: a-priori, event-driven stepping to machine precision at any dt.
+
+Per scene and step: predict every ball's wall time and every pair's time of impact, then repeat
+"advance everything to the earliest event, resolve it, re-predict only the balls it changed"
+until the step ends. Pair predictions live in an N x N table of step-local times with cached
+per-row minima, so finding the next event is O(N) and an event re-predicts O(N) pairs per ball
+it changed.
+
+Determinism: ties are broken by index (walls before pairs for the same ball, then the lowest
+ball index, then the lowest partner index). Simultaneous events are therefore resolved one after
+another, each seeing the velocities the previous one produced; an exact corner hit is an x-wall
+event followed by a y-wall event at the same instant, and a touching train (Newton's cradle) is a
+chain of zero-time events.
+
+Times are relative: the clock runs from 0 to the step length within each step, and absolute
+times are formed once, when an impact is recorded, as ``start + sign * local``.
+
+The cap on events per step (``max_events``) is never silent: a scene that reaches it stops at
+the instant of its last resolved event, in a valid state (no overlap, nothing outside the border),
+is flagged in ``capped``, and its clock shows how far it got.
+
+Reverse steps are run forward on negated velocities with restitution 1/e (the caller negates).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ._jit import njit
+from .motion import advance_all, body_kinematics, has_rotation
+from .response import ball_ball, ball_wall, merge_bodies, stop_body
+from .toi import INF, ca_pair, ca_wall, toi_pair, toi_wall
+
+# counters: 0 pair predictions, 1 wall predictions, 2 events, 3 rotating-cluster predictions
+PAIR_TESTS, WALL_TESTS, EVENTS, CLUSTER_TESTS = 0, 1, 2, 3
+
+#: Contact tolerance (relative to the length scale) when re-verifying a cluster event.
+_CONTACT_TOL = 1e-9
+
+
+@njit
+def record(imp, n_imp, scene, time, ball, other, wall, x, y, speed):
+    k = n_imp[0]
+    imp[k, 0] = scene
+    imp[k, 1] = time
+    imp[k, 2] = ball
+    imp[k, 3] = other
+    imp[k, 4] = wall
+    imp[k, 5] = x
+    imp[k, 6] = y
+    imp[k, 7] = speed
+    n_imp[0] = k + 1
+
+
+@njit
+def wall_point(i, wall, pos, radius, bounds):
+    if wall == 0:
+        return bounds[0], pos[i, 1]
+    if wall == 1:
+        return bounds[2], pos[i, 1]
+    if wall == 2:
+        return pos[i, 0], bounds[1]
+    return pos[i, 0], bounds[3]
+
+
+@njit
+def wall_gap(i, wall, pos, radius, bounds):
+    if wall == 0:
+        return pos[i, 0] - radius[i] - bounds[0]
+    if wall == 1:
+        return bounds[2] - radius[i] - pos[i, 0]
+    if wall == 2:
+        return pos[i, 1] - radius[i] - bounds[1]
+    return bounds[3] - radius[i] - pos[i, 1]
+
+
+@njit
+def snap_to_wall(i, wall, pos, radius, bounds):
+    """Put a ball exactly on the wall it touches (it is there up to round-off)."""
+    if wall == 0:
+        pos[i, 0] = bounds[0] + radius[i]
+    elif wall == 1:
+        pos[i, 0] = bounds[2] - radius[i]
+    elif wall == 2:
+        pos[i, 1] = bounds[1] + radius[i]
+    else:
+        pos[i, 1] = bounds[3] - radius[i]
+
+
+@njit
+def _predict_pair(i, k, now, horizon, pos, vel, mass, radius, body, omega, rot, ki, kj, counters):
+    if body[i] == body[k]:
+        return INF
+    sigma = radius[i] + radius[k]
+    if rot and (omega[body[i]] != 0.0 or omega[body[k]] != 0.0):
+        counters[CLUSTER_TESTS] += 1
+        a = body_kinematics(i, pos, vel, mass, body, omega)
+        c = body_kinematics(k, pos, vel, mass, body, omega)
+        for q in range(7):
+            ki[q] = a[q]
+            kj[q] = c[q]
+        return now + ca_pair(ki, kj, sigma, horizon)
+    counters[PAIR_TESTS] += 1
+    return now + toi_pair(
+        pos[k, 0] - pos[i, 0], pos[k, 1] - pos[i, 1], vel[k, 0] - vel[i, 0], vel[k, 1] - vel[i, 1], sigma
+    )
+
+
+@njit
+def _predict_wall(i, now, horizon, pos, vel, mass, radius, body, omega, rot, bounds, dim, ki, counters):
+    if rot and omega[body[i]] != 0.0:
+        counters[CLUSTER_TESTS] += 1
+        a = body_kinematics(i, pos, vel, mass, body, omega)
+        for q in range(7):
+            ki[q] = a[q]
+        tau, wall = ca_wall(ki, radius[i], bounds, dim, horizon)
+        return now + tau, wall
+    counters[WALL_TESTS] += 1
+    tau, wall = toi_wall(pos[i, 0], pos[i, 1], vel[i, 0], vel[i, 1], radius[i], bounds, dim)
+    return now + tau, wall
+
+
+@njit
+def _rescan(i, pt, rmin, rarg):
+    best = INF
+    arg = -1
+    for k in range(pt.shape[0]):
+        if pt[i, k] < best:
+            best = pt[i, k]
+            arg = k
+    rmin[i] = best
+    rarg[i] = arg
+
+
+@njit
+def _scene(
+    sc, pos, vel, mass, inv_mass, radius, body, omega, time, remaining, events, bounds, e, ratio, sign,
+    has_walls, pairs, dim, sticky, max_events, imp, n_imp, stalled, capped, counters,
+    pt, rmin, rarg, wt, wid, involved, flag, ki, kj,
+):
+    n = pos.shape[0]
+    horizon_end = remaining[sc]
+    t0 = time[sc]
+    now = 0.0
+    rot = sticky and has_rotation(body, omega)
+
+    for i in range(n):
+        wt[i] = INF
+        wid[i] = -1
+        rmin[i] = INF
+        rarg[i] = -1
+        flag[i] = False
+        for k in range(n):
+            pt[i, k] = INF
+    if has_walls:
+        for i in range(n):
+            wt[i], wid[i] = _predict_wall(
+                i, now, horizon_end, pos, vel, mass, radius, body, omega, rot, bounds, dim, ki, counters
+            )
+    if pairs:
+        for i in range(n):
+            for k in range(i + 1, n):
+                v = _predict_pair(i, k, now, horizon_end, pos, vel, mass, radius, body, omega, rot, ki, kj, counters)
+                pt[i, k] = v
+                pt[k, i] = v
+        for i in range(n):
+            _rescan(i, pt, rmin, rarg)
+
+    while True:
+        best = INF
+        bi = -1
+        bj = -1
+        for i in range(n):
+            if wt[i] < best:
+                best = wt[i]
+                bi = i
+                bj = -1
+            if rmin[i] < best:
+                best = rmin[i]
+                bi = i
+                bj = rarg[i]
+        if not best <= horizon_end:
+            break
+        if events[sc] >= max_events:
+            capped[sc] = True
+            break
+        if n_imp[0] >= imp.shape[0]:
+            stalled[sc] = True
+            break
+        if best > now:
+            advance_all(best - now, pos, vel, mass, body, omega, rot)
+            now = best
+        events[sc] += 1
+        counters[EVENTS] += 1
+        t_abs = t0 + sign * now
+
+        n_inv = 0
+        if bj < 0:  # ball bi meets wall wid[bi]
+            wall = wid[bi]
+            if sticky:
+                scale = radius[bi] + abs(pos[bi, 0]) + abs(pos[bi, 1])
+                axis = 0 if wall < 2 else 1
+                into = vel[bi, axis] < 0.0 if wall % 2 == 0 else vel[bi, axis] > 0.0
+                if wall_gap(bi, wall, pos, radius, bounds) <= _CONTACT_TOL * scale and into:
+                    if omega[body[bi]] == 0.0:
+                        snap_to_wall(bi, wall, pos, radius, bounds)
+                    x, y = wall_point(bi, wall, pos, radius, bounds)
+                    record(imp, n_imp, sc, t_abs, bi, -1, wall, x, y, abs(vel[bi, axis]))
+                    root = body[bi]
+                    for k in range(n):
+                        if body[k] == root:
+                            involved[n_inv] = k
+                            n_inv += 1
+                    stop_body(bi, vel, body, omega)
+                else:
+                    involved[0] = bi
+                    n_inv = 1
+            else:
+                snap_to_wall(bi, wall, pos, radius, bounds)
+                speed = ball_wall(bi, wall, vel, e, ratio)
+                if speed > 0.0:
+                    x, y = wall_point(bi, wall, pos, radius, bounds)
+                    record(imp, n_imp, sc, t_abs, bi, -1, wall, x, y, speed)
+                involved[0] = bi
+                n_inv = 1
+        else:  # balls bi and bj meet
+            dx = pos[bj, 0] - pos[bi, 0]
+            dy = pos[bj, 1] - pos[bi, 1]
+            dist = math.sqrt(dx * dx + dy * dy)
+            sigma = radius[bi] + radius[bj]
+            closing = (vel[bj, 0] - vel[bi, 0]) * dx + (vel[bj, 1] - vel[bi, 1]) * dy
+            if sticky:
+                scale = sigma + abs(pos[bi, 0]) + abs(pos[bi, 1])
+                if dist - sigma <= _CONTACT_TOL * scale and closing < 0.0:
+                    x = pos[bi, 0] + radius[bi] * dx / dist
+                    y = pos[bi, 1] + radius[bi] * dy / dist
+                    record(imp, n_imp, sc, t_abs, bi, bj, -1, x, y, -closing / dist)
+                    root = merge_bodies(bi, bj, pos, vel, mass, body, omega)
+                    for k in range(n):
+                        if body[k] == root:
+                            involved[n_inv] = k
+                            n_inv += 1
+                    rot = has_rotation(body, omega)
+                else:
+                    involved[0] = bi
+                    involved[1] = bj
+                    n_inv = 2
+            else:
+                speed = ball_ball(bi, bj, pos, vel, inv_mass, e, ratio)
+                if speed > 0.0:
+                    x = pos[bi, 0] + radius[bi] * dx / dist
+                    y = pos[bi, 1] + radius[bi] * dy / dist
+                    record(imp, n_imp, sc, t_abs, bi, bj, -1, x, y, speed)
+                involved[0] = bi
+                involved[1] = bj
+                n_inv = 2
+        if sticky:
+            rot = has_rotation(body, omega)
+
+        # Re-predict what the event changed.
+        for q in range(n_inv):
+            i = involved[q]
+            flag[i] = True
+            if has_walls:
+                wt[i], wid[i] = _predict_wall(
+                    i, now, horizon_end - now, pos, vel, mass, radius, body, omega, rot, bounds, dim, ki, counters
+                )
+        if pairs:
+            for q in range(n_inv):
+                i = involved[q]
+                for k in range(n):
+                    if k != i and not (flag[k] and k < i):
+                        v = _predict_pair(
+                            i, k, now, horizon_end - now, pos, vel, mass, radius, body, omega, rot, ki, kj, counters
+                        )
+                        pt[i, k] = v
+                        pt[k, i] = v
+            for q in range(n_inv):
+                _rescan(involved[q], pt, rmin, rarg)
+            for k in range(n):
+                if flag[k]:
+                    continue
+                stale = False
+                for q in range(n_inv):
+                    i = involved[q]
+                    v = pt[k, i]
+                    if v < rmin[k]:
+                        rmin[k] = v
+                        rarg[k] = i
+                    elif rarg[k] == i and v > rmin[k]:
+                        stale = True
+                if stale:
+                    _rescan(k, pt, rmin, rarg)
+        for q in range(n_inv):
+            flag[involved[q]] = False
+
+    if not (capped[sc] or stalled[sc]) and now < horizon_end:
+        advance_all(horizon_end - now, pos, vel, mass, body, omega, rot)
+        now = horizon_end
+    if now == horizon_end:
+        time[sc] = t0 + sign * horizon_end
+        remaining[sc] = 0.0
+    else:
+        time[sc] = t0 + sign * now
+        remaining[sc] = horizon_end - now
+
+
+@njit
+def step_exact(
+    pos, vel, mass, inv_mass, radius, body, omega, time, remaining, events, active,
+    fparams, iparams, imp, n_imp, stalled, capped, counters,
+):
+    """Advance every active scene of the batch by its ``remaining`` time (see module doc).
+
+    ``fparams`` = (xmin, ymin, xmax, ymax, e, collapse_ratio, sign);
+    ``iparams`` = (has_walls, pairs, dim, sticky, max_events).
+    Impacts go to ``imp`` rows (scene, time, ball, other, wall, x, y, speed), ``n_imp[0]`` rows so
+    far; a scene that finds the buffer full stops where it is and is flagged in ``stalled``, so
+    the caller can empty the buffer and call again for those scenes.
+    """
+    n_scenes = pos.shape[0]
+    n = pos.shape[1]
+    bounds = fparams[0:4]
+    pt = np.empty((n, n))
+    rmin = np.empty(n)
+    rarg = np.empty(n, dtype=np.int64)
+    wt = np.empty(n)
+    wid = np.empty(n, dtype=np.int64)
+    involved = np.empty(n, dtype=np.int64)
+    flag = np.zeros(n, dtype=np.bool_)
+    ki = np.empty(7)
+    kj = np.empty(7)
+    for sc in range(n_scenes):
+        if not active[sc]:
+            continue
+        stalled[sc] = False
+        _scene(
+            sc, pos[sc], vel[sc], mass[sc], inv_mass[sc], radius[sc], body[sc], omega[sc], time, remaining, events,
+            bounds, fparams[4], fparams[5], fparams[6], iparams[0] != 0, iparams[1] != 0, iparams[2],
+            iparams[3] != 0, iparams[4], imp, n_imp, stalled, capped, counters,
+            pt, rmin, rarg, wt, wid, involved, flag, ki, kj,
+        )

@@ -1,0 +1,87 @@
+"""What a scene contains: the play area, the restitution, the dimension and the collision model.
+
+A :class:`Scene` is shared by every ball and, in a batch, by every scene of the batch. Ball
+properties (positions, velocities, masses, radii) belong to the simulator.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+#: PhET Collision Lab's 2D play area, (xmin, ymin, xmax, ymax) in metres.
+PLAY_AREA_2D = (-2.0, -1.0, 2.0, 1.0)
+#: PhET's 1D play area: 4 m by 1.1 m; balls stay on y = 0.
+PLAY_AREA_1D = (-2.0, -0.55, 2.0, 0.55)
+#: Density of PhET's balls (kg/m^3): the radius of a ball is that of a sphere of this density.
+BALL_DENSITY = 35.0
+#: PhET's radius with "Constant Size" checked (m).
+CONSTANT_RADIUS = 0.15
+
+WALL_NAMES = ("left", "right", "bottom", "top")
+
+
+def radius_from_mass(mass):
+    """PhET's mass-to-radius rule, ``r = (3 m / (4 pi rho))^(1/3)`` with rho = 35 kg/m^3."""
+    return np.cbrt(3.0 * np.asarray(mass, dtype=np.float64) / (4.0 * math.pi * BALL_DENSITY))
+
+
+@dataclass(frozen=True)
+class Scene:
+    """The static description of a scene.
+
+    Parameters
+    ----------
+    bounds:
+        ``(xmin, ymin, xmax, ymax)`` of the reflecting border in metres, or ``None`` for no border
+        (balls leave the area and fly on).
+    elasticity:
+        Coefficient of restitution ``e`` in [0, 1], for ball-ball and ball-wall collisions alike.
+    dimension:
+        2, or 1 for motion along x only (y and vy stay 0).
+    inelastic:
+        ``"slip"`` or ``"stick"``. Only meaningful at elasticity 0: with ``"stick"``, colliding
+        balls join a rigid cluster that rotates about its centre of mass, and a ball or cluster
+        that touches a wall stops dead (PhET's Inelastic screen).
+    ball_collisions:
+        ``False`` lets balls pass through each other (no pair work at all).
+    """
+
+    bounds: tuple[float, float, float, float] | None = PLAY_AREA_2D
+    elasticity: float = 1.0
+    dimension: int = 2
+    inelastic: str = "slip"
+    ball_collisions: bool = True
+
+    def __post_init__(self):
+        if self.bounds is not None:
+            try:
+                b = tuple(float(v) for v in self.bounds)
+            except (TypeError, ValueError):
+                raise ValueError(f"scene bounds: expected (xmin, ymin, xmax, ymax), got {self.bounds!r}") from None
+            if len(b) != 4 or not all(math.isfinite(v) for v in b):
+                raise ValueError(f"scene bounds: expected four finite numbers, got {self.bounds!r}")
+            if not (b[0] < b[2] and b[1] < b[3]):
+                raise ValueError(f"scene bounds: need xmin < xmax and ymin < ymax, got {b}")
+            if self.dimension == 1 and not (b[1] < 0.0 < b[3]):
+                raise ValueError(f"scene bounds: a 1D scene needs ymin < 0 < ymax (balls move on y = 0), got {b}")
+            object.__setattr__(self, "bounds", b)
+        try:
+            e = float(self.elasticity)
+        except (TypeError, ValueError):
+            raise ValueError(f"scene elasticity: expected a number in [0, 1], got {self.elasticity!r}") from None
+        if not (0.0 <= e <= 1.0):
+            raise ValueError(f"scene elasticity: must lie in [0, 1], got {self.elasticity!r}")
+        object.__setattr__(self, "elasticity", e)
+        if self.dimension not in (1, 2):
+            raise ValueError(f"scene dimension: must be 1 or 2, got {self.dimension!r}")
+        if self.inelastic not in ("slip", "stick"):
+            raise ValueError(f"scene inelastic: must be 'slip' or 'stick', got {self.inelastic!r}")
+        object.__setattr__(self, "ball_collisions", bool(self.ball_collisions))
+
+    @property
+    def sticky(self) -> bool:
+        """True when colliding balls form rigid clusters (stick flavour at elasticity 0)."""
+        return self.inelastic == "stick" and self.elasticity == 0.0 and self.ball_collisions

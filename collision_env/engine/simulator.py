@@ -1,0 +1,607 @@
+"""The public engine: :class:`BatchSimulator` steps many independent scenes at once; a
+:class:`Simulator` is a batch of one with per-ball conveniences.
+
+Both call the same kernels (``exact.step_exact`` and ``substep.step_substeps``), so there is one
+copy of the physics for the single env and the vector env alike.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._jit import BACKEND, njit
+from .exact import CLUSTER_TESTS, EVENTS, PAIR_TESTS, WALL_TESTS, step_exact
+from .scene import CONSTANT_RADIUS, WALL_NAMES, Scene, radius_from_mass
+from .substep import NAIVE, POSTERIORI, step_substeps, worst_case_impacts
+
+MODES = ("naive", "posteriori", "exact")
+
+#: One row per impact, as :meth:`BatchSimulator.step` returns them.
+IMPACT_DTYPE = np.dtype(
+    [
+        ("scene", np.int64),
+        ("time", np.float64),
+        ("ball", np.int64),
+        ("other", np.int64),  # -1: a wall
+        ("wall", np.int64),  # index into WALL_NAMES, -1: another ball
+        ("x", np.float64),
+        ("y", np.float64),
+        ("speed", np.float64),  # normal closing speed just before the impact
+    ]
+)
+
+#: Relative tolerance for "touching" in the start-state checks (exact contact is allowed).
+_CONTACT_RTOL = 1e-12
+
+
+class EventCapWarning(RuntimeWarning):
+    """A scene reached the cap on events per step and stopped early (in a valid state)."""
+
+
+@dataclass(frozen=True)
+class Impact:
+    """One collision inside a step."""
+
+    time: float  #: absolute simulation time (s)
+    ball: int  #: index of the ball
+    other: int | None  #: index of the other ball, or None for a wall
+    wall: str | None  #: "left" | "right" | "bottom" | "top", or None for a ball-ball impact
+    point: tuple[float, float]  #: contact point (m)
+    speed: float  #: normal closing speed just before the impact (m/s)
+
+
+@njit
+def _apply_impulses(pos, vel, mass, body, omega, dv):
+    """Add ``dv`` to every ball's velocity as an impulse ``m dv`` at its centre.
+
+    A free ball's velocity just changes by ``dv``; an impulse on a member of a stuck cluster
+    changes the cluster's linear and angular velocity, and so every member's velocity.
+    """
+    n_scenes, n = pos.shape[0], pos.shape[1]
+    for sc in range(n_scenes):
+        for i in range(n):
+            if dv[sc, i, 0] == 0.0 and dv[sc, i, 1] == 0.0:
+                continue
+            root = body[sc, i]
+            if body[sc, i] == i and omega[sc, i] == 0.0:
+                alone = True
+                for k in range(n):
+                    if k != i and body[sc, k] == i:
+                        alone = False
+                        break
+                if alone:
+                    vel[sc, i, 0] += dv[sc, i, 0]
+                    vel[sc, i, 1] += dv[sc, i, 1]
+                    continue
+            m_tot = 0.0
+            cx = 0.0
+            cy = 0.0
+            vx = 0.0
+            vy = 0.0
+            for k in range(n):
+                if body[sc, k] == root:
+                    m = mass[sc, k]
+                    m_tot += m
+                    cx += m * pos[sc, k, 0]
+                    cy += m * pos[sc, k, 1]
+                    vx += m * vel[sc, k, 0]
+                    vy += m * vel[sc, k, 1]
+            cx /= m_tot
+            cy /= m_tot
+            jx = mass[sc, i] * dv[sc, i, 0]
+            jy = mass[sc, i] * dv[sc, i, 1]
+            vx = (vx + jx) / m_tot
+            vy = (vy + jy) / m_tot
+            inertia = 0.0
+            for k in range(n):
+                if body[sc, k] == root:
+                    inertia += mass[sc, k] * ((pos[sc, k, 0] - cx) ** 2 + (pos[sc, k, 1] - cy) ** 2)
+            w = omega[sc, root]
+            if inertia > 0.0:
+                w += ((pos[sc, i, 0] - cx) * jy - (pos[sc, i, 1] - cy) * jx) / inertia
+            omega[sc, root] = w
+            for k in range(n):
+                if body[sc, k] == root:
+                    vel[sc, k, 0] = vx - w * (pos[sc, k, 1] - cy)
+                    vel[sc, k, 1] = vy + w * (pos[sc, k, 0] - cx)
+
+
+def _as_array(value, shape, field, label):
+    try:
+        arr = np.array(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{label}{field}: expected numbers of shape {shape}, got {value!r}") from None
+    if arr.shape != shape:
+        raise ValueError(f"{label}{field}: expected shape {shape}, got {arr.shape}")
+    return arr
+
+
+class BatchSimulator:
+    """Step ``B`` independent scenes of ``N`` balls each, sharing one :class:`Scene`.
+
+    Parameters
+    ----------
+    scene:
+        The :class:`Scene` every batch member shares.
+    positions, velocities:
+        ``(B, N, 2)`` arrays in m and m/s.
+    masses:
+        ``(B, N)`` or ``(N,)`` (the same for every scene), kg.
+    radii:
+        ``None`` for PhET's mass-to-radius rule, ``"constant"`` for PhET's constant size
+        (0.15 m), or explicit radii, ``(B, N)`` or ``(N,)``.
+    mode:
+        ``"exact"`` (event-driven, machine precision at any dt), ``"posteriori"`` (the seed's
+        overlap-time reconstruction) or ``"naive"`` (move, then reflect overlaps).
+    substeps:
+        Equal sub-steps per step for naive and posteriori (their speed/accuracy knob). Exact mode
+        is exact at any step, so it takes only 1.
+    max_events:
+        Cap on events per scene per step in exact mode. A scene that reaches it stops at its last
+        event, in a valid state; :attr:`cap_reached` flags it and an :class:`EventCapWarning` is
+        issued.
+    collapse_ratio:
+        The inelastic-collapse regulariser: a collision whose normal closing speed is at most this
+        fraction of the balls' speeds is elastic (see :mod:`collision_env.engine.response`).
+    """
+
+    def __init__(self, scene, positions, velocities, masses, radii=None, *, mode="exact", substeps=1,
+                 max_events=10_000, collapse_ratio=1e-9):
+        if not isinstance(scene, Scene):
+            raise ValueError(f"scene: expected a collision_env.engine.Scene, got {type(scene).__name__}")
+        if mode not in MODES:
+            raise ValueError(f"mode: must be one of {MODES}, got {mode!r}")
+        if isinstance(substeps, bool) or not isinstance(substeps, (int, np.integer)) or substeps < 1:
+            raise ValueError(f"substeps: must be a positive integer, got {substeps!r}")
+        if mode == "exact" and substeps != 1:
+            raise ValueError("substeps: exact mode resolves every event at its exact time; substeps must be 1")
+        if isinstance(max_events, bool) or not isinstance(max_events, (int, np.integer)) or max_events < 1:
+            raise ValueError(f"max_events: must be a positive integer, got {max_events!r}")
+        if not (isinstance(collapse_ratio, (int, float)) and 0.0 <= collapse_ratio < 1.0):
+            raise ValueError(f"collapse_ratio: must be a number in [0, 1), got {collapse_ratio!r}")
+        self.scene = scene
+        self.mode = mode
+        self.substeps = int(substeps)
+        self.max_events = int(max_events)
+        self.collapse_ratio = float(collapse_ratio)
+
+        pos = np.array(positions, dtype=np.float64) if not isinstance(positions, np.ndarray) else positions
+        if pos.ndim != 3 or pos.shape[-1] != 2:
+            raise ValueError(f"positions: expected shape (B, N, 2), got {np.shape(positions)}")
+        n_scenes, n = pos.shape[0], pos.shape[1]
+        if n_scenes < 1 or n < 1:
+            raise ValueError(f"positions: need at least one scene and one ball, got shape {pos.shape}")
+        self._n_scenes = n_scenes
+        self._n = n
+        pos, vel, mass, radius = self._checked_balls(np.arange(n_scenes), positions, velocities, masses, radii)
+        self._pos = pos
+        self._vel = vel
+        self._mass = mass
+        self._inv_mass = 1.0 / mass
+        self._radius = radius
+        self._body = np.tile(np.arange(n, dtype=np.int64), (n_scenes, 1))
+        self._omega = np.zeros((n_scenes, n))
+        self._time = np.zeros(n_scenes)
+        self._capped = np.zeros(n_scenes, dtype=np.bool_)
+        self._counters = np.zeros(4, dtype=np.int64)
+
+        bounds = scene.bounds if scene.bounds is not None else (0.0, 0.0, 0.0, 0.0)
+        self._fparams = np.array([*bounds, scene.elasticity, self.collapse_ratio, 1.0])
+        self._iparams = np.array(
+            [scene.bounds is not None, scene.ball_collisions and n > 1, scene.dimension, scene.sticky,
+             self.max_events],
+            dtype=np.int64,
+        )
+        self._alloc_work()
+
+    # ------------------------------------------------------------------ validation
+    def _label(self, sc, ball=None):
+        where = f"scene {sc}, " if self._n_scenes > 1 else ""
+        return f"{where}ball {ball}: " if ball is not None else (f"scene {sc}: " if self._n_scenes > 1 else "")
+
+    def _checked_balls(self, scenes, positions, velocities, masses, radii):
+        """Validate and return float64 copies of the balls of ``scenes`` (raises ValueError)."""
+        k, n = len(scenes), self._n
+        pos = _as_array(positions, (k, n, 2), "positions", "")
+        vel = _as_array(velocities, (k, n, 2), "velocities", "")
+        m = np.array(masses, dtype=np.float64) if masses is not None else None
+        if m is None or m.shape not in ((n,), (k, n)):
+            raise ValueError(f"masses: expected shape ({n},) or ({k}, {n}), got {None if m is None else m.shape}")
+        m = np.broadcast_to(m, (k, n)).copy()
+        if radii is None:
+            r = radius_from_mass(m)
+        elif isinstance(radii, str):
+            if radii != "constant":
+                raise ValueError(f"radii: expected None, 'constant' or an array, got {radii!r}")
+            r = np.full((k, n), CONSTANT_RADIUS)
+        else:
+            r = np.array(radii, dtype=np.float64)
+            if r.shape not in ((n,), (k, n)):
+                raise ValueError(f"radii: expected shape ({n},) or ({k}, {n}), got {r.shape}")
+            r = np.broadcast_to(r, (k, n)).copy()
+
+        def fail(mask, message):
+            bad = np.argwhere(mask)
+            if len(bad):
+                s, i = bad[0][0], bad[0][1]
+                raise ValueError(self._label(scenes[s], i) + message(s, i))
+
+        fail(~np.isfinite(pos).all(-1), lambda s, i: f"position must be finite, got {tuple(pos[s, i])}")
+        fail(~np.isfinite(vel).all(-1), lambda s, i: f"velocity must be finite, got {tuple(vel[s, i])}")
+        fail(~(np.isfinite(m) & (m > 0)), lambda s, i: f"mass must be positive and finite, got {m[s, i]}")
+        fail(~(np.isfinite(r) & (r > 0)), lambda s, i: f"radius must be positive and finite, got {r[s, i]}")
+        scene = self.scene
+        if scene.dimension == 1:
+            fail(pos[..., 1] != 0.0, lambda s, i: f"position y must be 0 in a 1D scene, got {pos[s, i, 1]}")
+            fail(vel[..., 1] != 0.0, lambda s, i: f"velocity y must be 0 in a 1D scene, got {vel[s, i, 1]}")
+        if scene.bounds is not None:
+            xmin, ymin, xmax, ymax = scene.bounds
+            tol = _CONTACT_RTOL * (np.abs(pos).max(-1) + r)
+            out = (pos[..., 0] - r < xmin - tol) | (pos[..., 0] + r > xmax + tol)
+            if scene.dimension == 2:
+                out |= (pos[..., 1] - r < ymin - tol) | (pos[..., 1] + r > ymax + tol)
+            fail(out, lambda s, i: f"position must keep the ball inside the reflecting border {scene.bounds}, "
+                                   f"got {tuple(pos[s, i])} with radius {r[s, i]:.6g}")
+        if scene.ball_collisions and n > 1:
+            d = pos[:, :, None, :] - pos[:, None, :, :]
+            dist = np.sqrt((d**2).sum(-1))
+            sigma = r[:, :, None] + r[:, None, :]
+            overlap = dist < sigma * (1.0 - _CONTACT_RTOL)
+            overlap &= ~np.eye(n, dtype=bool)
+            bad = np.argwhere(np.triu(overlap, 1))
+            if len(bad):
+                s, i, j = bad[0]
+                raise ValueError(
+                    f"{self._label(scenes[s], i)}position overlaps ball {j} "
+                    f"(centres {dist[s, i, j]:.6g} m apart, radii sum to {sigma[s, i, j]:.6g} m)"
+                )
+        return pos, vel, m, r
+
+    # ------------------------------------------------------------------ stepping
+    def _alloc_work(self):
+        b = self._n_scenes
+        rows = max(4096, 2 * worst_case_impacts(self._n))
+        self._imp = np.empty((rows, 8))
+        self._n_imp = np.zeros(1, dtype=np.int64)
+        self._remaining = np.empty(b)
+        self._events = np.empty(b, dtype=np.int64)
+        self._active = np.empty(b, dtype=np.bool_)
+        self._stalled = np.zeros(b, dtype=np.bool_)
+        self._t_start = np.empty(b)
+        self._done = np.empty(b, dtype=np.int64)
+
+    def step(self, dt):
+        """Advance every scene by ``dt`` seconds (``dt < 0`` runs time backwards).
+
+        Returns the impacts inside the step as an array of :data:`IMPACT_DTYPE`, ordered by scene
+        and then by the order in which they happened.
+        """
+        try:
+            dt = float(dt)
+        except (TypeError, ValueError):
+            raise ValueError(f"dt: expected a number of seconds, got {dt!r}") from None
+        if not math.isfinite(dt):
+            raise ValueError(f"dt: must be finite, got {dt}")
+        e = self.scene.elasticity
+        if dt < 0.0 and e == 0.0:
+            raise ValueError("dt: cannot step backwards with elasticity 0 (a perfectly inelastic collision has no inverse)")
+        self._capped[:] = False
+        if dt == 0.0:
+            return np.zeros(0, dtype=IMPACT_DTYPE)
+        sign = 1.0 if dt > 0.0 else -1.0
+        fp = self._fparams
+        fp[4] = e if sign > 0 else 1.0 / e
+        fp[6] = sign
+        if sign < 0:
+            np.negative(self._vel, out=self._vel)
+            np.negative(self._omega, out=self._omega)
+        try:
+            chunks = self._run(abs(dt))
+        finally:
+            if sign < 0:
+                np.negative(self._vel, out=self._vel)
+                np.negative(self._omega, out=self._omega)
+        if self._capped.any():
+            warnings.warn(
+                f"event cap of {self.max_events} per step reached in scene(s) {np.flatnonzero(self._capped).tolist()}; "
+                "they stopped early at their last event (see cap_reached and time)",
+                EventCapWarning,
+                stacklevel=2,
+            )
+        return self._impacts(chunks, sign)
+
+    def _run(self, dt_abs):
+        active = self._active
+        active[:] = True
+        chunks = []
+        self._n_imp[0] = 0
+        if self.mode == "exact":
+            self._remaining[:] = dt_abs
+            self._events[:] = 0
+        else:
+            np.copyto(self._t_start, self._time)
+            self._done[:] = 0
+        while True:
+            if self.mode == "exact":
+                step_exact(self._pos, self._vel, self._mass, self._inv_mass, self._radius, self._body, self._omega,
+                           self._time, self._remaining, self._events, active, self._fparams, self._iparams,
+                           self._imp, self._n_imp, self._stalled, self._capped, self._counters)
+            else:
+                step_substeps(NAIVE if self.mode == "naive" else POSTERIORI, self._pos, self._vel, self._mass,
+                              self._inv_mass, self._radius, self._body, self._omega, self._time, self._t_start,
+                              self._done, active, self._fparams, self._iparams, dt_abs, self.substeps,
+                              self._imp, self._n_imp, self._stalled, self._counters)
+            if self._n_imp[0]:
+                chunks.append(self._imp[: self._n_imp[0]].copy())
+                self._n_imp[0] = 0
+            if not self._stalled.any():
+                return chunks
+            np.copyto(active, self._stalled)
+
+    @staticmethod
+    def _impacts(chunks, sign):
+        if not chunks:
+            return np.zeros(0, dtype=IMPACT_DTYPE)
+        rows = chunks[0] if len(chunks) == 1 else np.concatenate(chunks)
+        out = np.empty(len(rows), dtype=IMPACT_DTYPE)
+        for k, name in enumerate(IMPACT_DTYPE.names):
+            out[name] = rows[:, k]
+        order = np.lexsort((sign * out["time"], out["scene"]))
+        return out[order]
+
+    # ------------------------------------------------------------------ state access
+    @property
+    def num_scenes(self):
+        return self._n_scenes
+
+    @property
+    def num_balls(self):
+        return self._n
+
+    @property
+    def positions(self):
+        return self._pos.copy()
+
+    @property
+    def velocities(self):
+        return self._vel.copy()
+
+    @property
+    def masses(self):
+        return self._mass.copy()
+
+    @property
+    def radii(self):
+        return self._radius.copy()
+
+    @property
+    def time(self):
+        return self._time.copy()
+
+    @property
+    def clusters(self):
+        """``(B, N)``: the index of the ball rooting each ball's rigid cluster (itself if free)."""
+        return self._body.copy()
+
+    @property
+    def cap_reached(self):
+        """``(B,)`` bool: the event cap stopped that scene's last step early."""
+        return self._capped.copy()
+
+    @property
+    def models(self):
+        """What the engine computes for this scene, and nothing else."""
+        return {
+            "mode": self.mode,
+            "substeps": self.substeps,
+            "dimension": self.scene.dimension,
+            "walls": self.scene.bounds is not None,
+            "ball_pairs": bool(self._iparams[1]),
+            "clusters": self.scene.sticky,
+            "backend": BACKEND,
+        }
+
+    @property
+    def stats(self):
+        """Work done so far: pair and wall predictions (or overlap tests), cluster predictions, events."""
+        c = self._counters
+        return {
+            "pair_tests": int(c[PAIR_TESTS]),
+            "wall_tests": int(c[WALL_TESTS]),
+            "cluster_tests": int(c[CLUSTER_TESTS]),
+            "events": int(c[EVENTS]),
+        }
+
+    def kinetic_energy(self):
+        """``(B,)`` total kinetic energy, J."""
+        return 0.5 * (self._mass * (self._vel**2).sum(-1)).sum(-1)
+
+    def momentum(self):
+        """``(B, 2)`` total momentum, kg m/s."""
+        return (self._mass[..., None] * self._vel).sum(1)
+
+    # ------------------------------------------------------------------ changing the state
+    def nudge(self, dv):
+        """Change every ball's velocity by ``dv`` (``(B, N, 2)``), as an impulse ``m dv``.
+
+        A member of a stuck cluster passes the impulse to the whole cluster (linear and angular).
+        """
+        dv = _as_array(dv, (self._n_scenes, self._n, 2), "nudge", "")
+        bad = np.argwhere(~np.isfinite(dv).all(-1))
+        if len(bad):
+            s, i = bad[0]
+            raise ValueError(f"{self._label(s, i)}nudge must be finite, got {tuple(dv[s, i])}")
+        if self.scene.dimension == 1:
+            bad = np.argwhere(dv[..., 1] != 0.0)
+            if len(bad):
+                s, i = bad[0]
+                raise ValueError(f"{self._label(s, i)}nudge y must be 0 in a 1D scene, got {dv[s, i, 1]}")
+        if self.scene.sticky:
+            _apply_impulses(self._pos, self._vel, self._mass, self._body, self._omega, dv)
+        else:
+            self._vel += dv
+
+    def set_scenes(self, index, positions, velocities, masses=None, radii=None, time=0.0):
+        """Start the scenes picked by ``index`` (indices or a ``(B,)`` bool mask) afresh.
+
+        ``positions``/``velocities`` are ``(K, N, 2)`` for the K scenes picked; ``masses`` and
+        ``radii`` default to those the scenes had. Validated like the constructor; on error
+        nothing changes.
+        """
+        idx = np.arange(self._n_scenes)[index]
+        idx = np.atleast_1d(idx)
+        if masses is None:
+            masses = self._mass[idx]
+        if radii is None:
+            radii = self._radius[idx]
+        pos, vel, m, r = self._checked_balls(idx, positions, velocities, masses, radii)
+        self._pos[idx] = pos
+        self._vel[idx] = vel
+        self._mass[idx] = m
+        self._inv_mass[idx] = 1.0 / m
+        self._radius[idx] = r
+        self._body[idx] = np.arange(self._n)
+        self._omega[idx] = 0.0
+        self._time[idx] = time
+
+    def get_state(self):
+        """A dict of array copies that :meth:`set_state` restores exactly."""
+        return {
+            "positions": self._pos.copy(),
+            "velocities": self._vel.copy(),
+            "masses": self._mass.copy(),
+            "radii": self._radius.copy(),
+            "clusters": self._body.copy(),
+            "omega": self._omega.copy(),
+            "time": self._time.copy(),
+        }
+
+    def set_state(self, state):
+        """Restore a state from :meth:`get_state` (shapes are checked; values are trusted)."""
+        shapes = {"positions": self._pos.shape, "velocities": self._vel.shape, "masses": self._mass.shape,
+                  "radii": self._radius.shape, "clusters": self._body.shape, "omega": self._omega.shape,
+                  "time": self._time.shape}
+        arrays = {}
+        for key, shape in shapes.items():
+            if key not in state:
+                raise ValueError(f"state: missing {key!r}")
+            a = np.asarray(state[key])
+            if a.shape != shape:
+                raise ValueError(f"state {key}: expected shape {shape}, got {a.shape}")
+            arrays[key] = a
+        np.copyto(self._pos, arrays["positions"])
+        np.copyto(self._vel, arrays["velocities"])
+        np.copyto(self._mass, arrays["masses"])
+        np.copyto(self._inv_mass, 1.0 / arrays["masses"])
+        np.copyto(self._radius, arrays["radii"])
+        np.copyto(self._body, arrays["clusters"])
+        np.copyto(self._omega, arrays["omega"])
+        np.copyto(self._time, arrays["time"])
+
+    def copy(self):
+        """An independent copy (for planning: step it ahead without touching this one)."""
+        return copy.deepcopy(self)
+
+    def __getstate__(self):
+        state = self.__dict__.copy()
+        for key in ("_imp", "_n_imp", "_remaining", "_events", "_active", "_stalled", "_t_start", "_done"):
+            state.pop(key)
+        return state
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        self._alloc_work()
+
+    def __deepcopy__(self, memo):
+        new = object.__new__(type(self))
+        new.__setstate__(copy.deepcopy(self.__getstate__(), memo))
+        return new
+
+
+class Simulator:
+    """One scene: the public surface of BRIEF section 5.
+
+    ``Simulator(scene, positions (N,2), velocities (N,2), masses (N,), radii=None, mode="exact",
+    substeps=1)``; :meth:`step` returns a list of :class:`Impact` in time order. Everything is a
+    batch of one over :class:`BatchSimulator`; keyword arguments pass through to it.
+    """
+
+    def __init__(self, scene, positions, velocities, masses, radii=None, mode="exact", substeps=1, **options):
+        if np.ndim(positions) != 2:
+            raise ValueError(f"positions: expected shape (N, 2), got {np.shape(positions)}")
+        self._batch = BatchSimulator(scene, [positions], [velocities], masses, radii, mode=mode, substeps=substeps,
+                                     **options)
+
+    @property
+    def batch(self):
+        """The underlying batch of one."""
+        return self._batch
+
+    @property
+    def scene(self):
+        return self._batch.scene
+
+    @property
+    def mode(self):
+        return self._batch.mode
+
+    def step(self, dt):
+        """Advance by ``dt`` seconds (negative: backwards). Returns the step's impacts in time order."""
+        rows = self._batch.step(dt)
+        return [
+            Impact(
+                time=float(r["time"]),
+                ball=int(r["ball"]),
+                other=None if r["other"] < 0 else int(r["other"]),
+                wall=None if r["wall"] < 0 else WALL_NAMES[r["wall"]],
+                point=(float(r["x"]), float(r["y"])),
+                speed=float(r["speed"]),
+            )
+            for r in rows
+        ]
+
+    positions = property(lambda self: self._batch._pos[0].copy(), doc="(N, 2) centres, m (a copy).")
+    velocities = property(lambda self: self._batch._vel[0].copy(), doc="(N, 2) velocities, m/s (a copy).")
+    masses = property(lambda self: self._batch._mass[0].copy(), doc="(N,) masses, kg.")
+    radii = property(lambda self: self._batch._radius[0].copy(), doc="(N,) radii, m.")
+    time = property(lambda self: float(self._batch._time[0]), doc="Simulation time, s.")
+    clusters = property(lambda self: self._batch._body[0].copy(), doc="(N,) root ball of each ball's cluster.")
+    cap_reached = property(lambda self: bool(self._batch._capped[0]), doc="The last step stopped at the event cap.")
+    models = property(lambda self: self._batch.models)
+    stats = property(lambda self: self._batch.stats)
+
+    def kinetic_energy(self):
+        return float(self._batch.kinetic_energy()[0])
+
+    def momentum(self):
+        return self._batch.momentum()[0]
+
+    def nudge(self, dv):
+        """Change each ball's velocity by ``dv`` (``(N, 2)``), as an impulse (clusters included)."""
+        self._batch.nudge([dv])
+
+    def set_balls(self, positions=None, velocities=None):
+        """Replace positions and/or velocities (validated; on error nothing changes). Time is kept."""
+        b = self._batch
+        b.set_scenes(
+            [0],
+            b._pos if positions is None else np.asarray(positions, dtype=np.float64)[None],
+            b._vel if velocities is None else np.asarray(velocities, dtype=np.float64)[None],
+            time=b._time[0],
+        )
+
+    def get_state(self):
+        return self._batch.get_state()
+
+    def set_state(self, state):
+        self._batch.set_state(state)
+
+    def copy(self):
+        new = object.__new__(Simulator)
+        new._batch = self._batch.copy()
+        return new

@@ -1,0 +1,62 @@
+"""The fixed-step driver shared by naive and posteriori modes: k equal sub-steps per step."""
+
+from __future__ import annotations
+
+from ._jit import njit
+from .motion import advance_all, has_rotation
+from .naive import resolve_naive
+from .posteriori import resolve_posteriori
+
+NAIVE, POSTERIORI = 0, 1
+
+
+def worst_case_impacts(n):
+    """Most impacts one sub-step can record for one scene (pairs, border, containment)."""
+    return n * (n - 1) // 2 + 4 * n
+
+
+@njit
+def step_substeps(
+    mode, pos, vel, mass, inv_mass, radius, body, omega, time, t_start, done, active,
+    fparams, iparams, dt_abs, k_total, imp, n_imp, stalled, counters,
+):
+    """Run the remaining sub-steps of every active scene (``done[sc]`` of ``k_total`` are done).
+
+    Parameters as :func:`exact.step_exact`; a scene stops between sub-steps when the impact
+    buffer could not hold another sub-step's worst case, and is flagged in ``stalled``.
+    """
+    n = pos.shape[1]
+    worst = n * (n - 1) // 2 + 4 * n
+    bounds = fparams[0:4]
+    e = fparams[4]
+    ratio = fparams[5]
+    sign = fparams[6]
+    has_walls = iparams[0] != 0
+    pairs = iparams[1] != 0
+    dim = iparams[2]
+    sticky = iparams[3] != 0
+    h = dt_abs / k_total
+    for sc in range(pos.shape[0]):
+        if not active[sc]:
+            continue
+        stalled[sc] = False
+        p = pos[sc]
+        v = vel[sc]
+        m = mass[sc]
+        b = body[sc]
+        w = omega[sc]
+        while done[sc] < k_total:
+            if imp.shape[0] - n_imp[0] < worst:
+                stalled[sc] = True
+                break
+            k = done[sc] + 1
+            t_end = t_start[sc] + sign * (dt_abs if k == k_total else h * k)
+            advance_all(h, p, v, m, b, w, sticky and has_rotation(b, w))
+            if mode == NAIVE:
+                resolve_naive(sc, t_end, p, v, m, inv_mass[sc], radius[sc], b, w, bounds, dim, e, ratio,
+                              has_walls, pairs, sticky, imp, n_imp, counters)
+            else:
+                resolve_posteriori(sc, t_end, sign, h, p, v, m, inv_mass[sc], radius[sc], b, w, bounds, dim, e, ratio,
+                                   has_walls, pairs, sticky, imp, n_imp, counters)
+            done[sc] = k
+            time[sc] = t_end
