@@ -30,14 +30,17 @@ import numpy as np
 
 from ._jit import njit
 from .motion import advance_all, body_kinematics, has_rotation
-from .response import ball_ball, ball_wall, merge_bodies, stop_body
+from .response import ball_ball, ball_wall, elastic_threshold, merge_bodies, stop_body
 from .toi import INF, ca_pair, ca_wall, toi_pair, toi_wall
 
 # counters: 0 pair predictions, 1 wall predictions, 2 events, 3 rotating-cluster predictions
 PAIR_TESTS, WALL_TESTS, EVENTS, CLUSTER_TESTS = 0, 1, 2, 3
 
-#: Contact tolerance (relative to the length scale) when re-verifying a cluster event.
+#: Contact tolerance (relative to the length scale): re-verifying a cluster event, and which
+#: balls touch in a contact group.
 _CONTACT_TOL = 1e-9
+#: Cap on sweeps over a contact group in one instant (the regulariser ends cascades long before).
+_MAX_SWEEPS = 100_000
 
 
 @njit
@@ -135,16 +138,109 @@ def _rescan(i, pt, rmin, rarg):
 
 
 @njit
+def _gap_pair(a, k, pos, radius):
+    dx = pos[k, 0] - pos[a, 0]
+    dy = pos[k, 1] - pos[a, 1]
+    return math.sqrt(dx * dx + dy * dy) - radius[a] - radius[k]
+
+
+@njit
+def _resolve_contact_group(
+    sc, t_abs, i0, j0, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, u_min, imp, n_imp, counters,
+    group, in_group, c_a, c_b, c_hit,
+):
+    """Resolve, at one instant, every contact of the group of touching balls an impact started.
+
+    At e < 1 an impact inside a touching group (a train pressed against a wall, a crowd) starts a
+    cascade of ever smaller impulses at the same instant: sequential impulses converge to the
+    limit geometrically. Running that cascade here, over the group's contact list in a fixed
+    order, gives the same sequence of pairwise impulses as the event loop would, without
+    re-predicting every ball after each impulse; the collapse regulariser ends it. Contacts are
+    gaps within ``_CONTACT_TOL`` of zero. Every contact that takes an impulse is reported once.
+    Returns the group size (its balls are in ``group``).
+    """
+    n = pos.shape[0]
+    for k in range(n):
+        in_group[k] = False
+    size = 0
+    for start in (i0, j0):
+        if start >= 0 and not in_group[start]:
+            group[size] = start
+            in_group[start] = True
+            size += 1
+    n_contacts = 0
+    q = 0
+    while q < size:
+        a = group[q]
+        q += 1
+        scale = _CONTACT_TOL * (2.0 * radius[a] + abs(pos[a, 0]) + abs(pos[a, 1]))
+        if pairs:
+            for k in range(n):
+                if k == a:
+                    continue
+                if _gap_pair(a, k, pos, radius) <= scale + _CONTACT_TOL * (radius[k] + abs(pos[k, 0]) + abs(pos[k, 1])):
+                    if not in_group[k]:
+                        group[size] = k
+                        in_group[k] = True
+                        size += 1
+                        c_a[n_contacts] = a
+                        c_b[n_contacts] = k
+                        c_hit[n_contacts] = False
+                        n_contacts += 1
+                    elif k > a or not in_group[k]:
+                        c_a[n_contacts] = min(a, k)
+                        c_b[n_contacts] = max(a, k)
+                        c_hit[n_contacts] = False
+                        n_contacts += 1
+        if has_walls:
+            for wall in range(4 if dim == 2 else 2):
+                if wall_gap(a, wall, pos, radius, bounds) <= scale:
+                    c_a[n_contacts] = a
+                    c_b[n_contacts] = -1 - wall
+                    c_hit[n_contacts] = False
+                    n_contacts += 1
+    # the list may hold a pair twice (found from both ends): harmless, the second sees it receding
+    for _ in range(_MAX_SWEEPS):
+        changed = False
+        for c in range(n_contacts):
+            a = c_a[c]
+            b = c_b[c]
+            if b >= 0:
+                speed = ball_ball(a, b, pos, vel, inv_mass, e, u_min)
+            else:
+                speed = ball_wall(a, -1 - b, vel, e, u_min)
+            if speed > 0.0:
+                changed = True
+                counters[EVENTS] += 1
+                if not c_hit[c] and n_imp[0] < imp.shape[0]:
+                    c_hit[c] = True
+                    if b >= 0:
+                        dx = pos[b, 0] - pos[a, 0]
+                        dy = pos[b, 1] - pos[a, 1]
+                        d = math.sqrt(dx * dx + dy * dy)
+                        record(imp, n_imp, sc, t_abs, a, b, -1, pos[a, 0] + radius[a] * dx / d,
+                               pos[a, 1] + radius[a] * dy / d, speed)
+                    else:
+                        x, y = wall_point(a, -1 - b, pos, radius, bounds)
+                        record(imp, n_imp, sc, t_abs, a, -1, -1 - b, x, y, speed)
+        if not changed:
+            break
+    return size
+
+
+@njit
 def _scene(
-    sc, pos, vel, mass, inv_mass, radius, body, omega, time, remaining, events, bounds, e, ratio, sign,
+    sc, pos, vel, mass, inv_mass, radius, body, omega, time, remaining, events, bounds, e, ratio, floor, sign,
     has_walls, pairs, dim, sticky, max_events, imp, n_imp, stalled, capped, counters,
-    pt, rmin, rarg, wt, wid, involved, flag, ki, kj,
+    pt, rmin, rarg, wt, wid, involved, flag, ki, kj, in_group, c_a, c_b, c_hit,
 ):
     n = pos.shape[0]
+    cascades = e < 1.0  # forward inelastic: resolve touching groups at one instant
     horizon_end = remaining[sc]
     t0 = time[sc]
     now = 0.0
     rot = sticky and has_rotation(body, omega)
+    u_min = elastic_threshold(vel, ratio, floor)
 
     for i in range(n):
         wt[i] = INF
@@ -219,12 +315,17 @@ def _scene(
                     n_inv = 1
             else:
                 snap_to_wall(bi, wall, pos, radius, bounds)
-                speed = ball_wall(bi, wall, vel, e, ratio)
+                speed = ball_wall(bi, wall, vel, e, u_min)
                 if speed > 0.0:
                     x, y = wall_point(bi, wall, pos, radius, bounds)
                     record(imp, n_imp, sc, t_abs, bi, -1, wall, x, y, speed)
                 involved[0] = bi
                 n_inv = 1
+                if cascades and speed > 0.0:
+                    n_inv = _resolve_contact_group(
+                        sc, t_abs, bi, -1, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, u_min,
+                        imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit,
+                    )
         else:  # balls bi and bj meet
             dx = pos[bj, 0] - pos[bi, 0]
             dy = pos[bj, 1] - pos[bi, 1]
@@ -248,7 +349,7 @@ def _scene(
                     involved[1] = bj
                     n_inv = 2
             else:
-                speed = ball_ball(bi, bj, pos, vel, inv_mass, e, ratio)
+                speed = ball_ball(bi, bj, pos, vel, inv_mass, e, u_min)
                 if speed > 0.0:
                     x = pos[bi, 0] + radius[bi] * dx / dist
                     y = pos[bi, 1] + radius[bi] * dy / dist
@@ -256,6 +357,11 @@ def _scene(
                 involved[0] = bi
                 involved[1] = bj
                 n_inv = 2
+                if cascades and speed > 0.0:
+                    n_inv = _resolve_contact_group(
+                        sc, t_abs, bi, bj, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, u_min,
+                        imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit,
+                    )
         if sticky:
             rot = has_rotation(body, omega)
 
@@ -314,7 +420,7 @@ def step_exact(
 ):
     """Advance every active scene of the batch by its ``remaining`` time (see module doc).
 
-    ``fparams`` = (xmin, ymin, xmax, ymax, e, collapse_ratio, sign);
+    ``fparams`` = (xmin, ymin, xmax, ymax, e, collapse_ratio, sign, collapse_floor);
     ``iparams`` = (has_walls, pairs, dim, sticky, max_events).
     Impacts go to ``imp`` rows (scene, time, ball, other, wall, x, y, speed), ``n_imp[0]`` rows so
     far; a scene that finds the buffer full stops where it is and is flagged in ``stalled``, so
@@ -332,13 +438,18 @@ def step_exact(
     flag = np.zeros(n, dtype=np.bool_)
     ki = np.empty(7)
     kj = np.empty(7)
+    in_group = np.zeros(n, dtype=np.bool_)
+    n_contacts = n * (n - 1) + 4 * n
+    c_a = np.empty(n_contacts, dtype=np.int64)
+    c_b = np.empty(n_contacts, dtype=np.int64)
+    c_hit = np.empty(n_contacts, dtype=np.bool_)
     for sc in range(n_scenes):
         if not active[sc]:
             continue
         stalled[sc] = False
         _scene(
             sc, pos[sc], vel[sc], mass[sc], inv_mass[sc], radius[sc], body[sc], omega[sc], time, remaining, events,
-            bounds, fparams[4], fparams[5], fparams[6], iparams[0] != 0, iparams[1] != 0, iparams[2],
+            bounds, fparams[4], fparams[5], fparams[7], fparams[6], iparams[0] != 0, iparams[1] != 0, iparams[2],
             iparams[3] != 0, iparams[4], imp, n_imp, stalled, capped, counters,
-            pt, rmin, rarg, wt, wid, involved, flag, ki, kj,
+            pt, rmin, rarg, wt, wid, involved, flag, ki, kj, in_group, c_a, c_b, c_hit,
         )

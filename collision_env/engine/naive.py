@@ -42,7 +42,7 @@ def shift_body(i, dx, dy, pos, body):
 
 
 @njit
-def contain(sc, t_abs, pos, vel, radius, body, omega, bounds, dim, e, ratio, sticky, imp, n_imp, counters):
+def contain(sc, t_abs, pos, vel, radius, body, omega, bounds, dim, e, u_min, sticky, imp, n_imp, counters):
     """Put every ball that ended up past a wall back on it; reflect it if it still moves outward."""
     n = pos.shape[0]
     n_axes = 2 if dim == 2 else 1
@@ -70,14 +70,14 @@ def contain(sc, t_abs, pos, vel, radius, body, omega, bounds, dim, e, ratio, sti
                     stop_body(i, vel, body, omega)
                     speed = abs(v)
                 else:
-                    speed = ball_wall(i, wall, vel, e, ratio)
+                    speed = ball_wall(i, wall, vel, e, u_min)
                 cx, cy = wall_point(i, wall, pos, radius, bounds)
                 record(imp, n_imp, sc, t_abs, i, -1, wall, cx, cy, speed)
                 counters[EVENTS] += 1
 
 
 @njit
-def resolve_naive(sc, t_abs, pos, vel, mass, inv_mass, radius, body, omega, bounds, dim, e, ratio,
+def resolve_naive(sc, t_abs, pos, vel, mass, inv_mass, radius, body, omega, bounds, dim, e, u_min,
                   has_walls, pairs, sticky, imp, n_imp, counters):
     n = pos.shape[0]
     if pairs:
@@ -111,8 +111,8 @@ def resolve_naive(sc, t_abs, pos, vel, mass, inv_mass, radius, body, omega, boun
                         merge_bodies(i, j, pos, vel, mass, body, omega)
                         speed = -closing
                     else:
-                        speed = ball_ball(i, j, pos, vel, inv_mass, e, ratio)
+                        speed = ball_ball(i, j, pos, vel, inv_mass, e, u_min)
                     record(imp, n_imp, sc, t_abs, i, j, -1, x, y, speed)
                     counters[EVENTS] += 1
     if has_walls:
-        contain(sc, t_abs, pos, vel, radius, body, omega, bounds, dim, e, ratio, sticky, imp, n_imp, counters)
+        contain(sc, t_abs, pos, vel, radius, body, omega, bounds, dim, e, u_min, sticky, imp, n_imp, counters)

@@ -69,7 +69,7 @@ def overlap_time_border(x, y, vx, vy, r, bounds, dim):
 
 
 @njit
-def resolve_posteriori(sc, t_end, sign, h, pos, vel, mass, inv_mass, radius, body, omega, bounds, dim, e, ratio,
+def resolve_posteriori(sc, t_end, sign, h, pos, vel, mass, inv_mass, radius, body, omega, bounds, dim, e, u_min,
                        has_walls, pairs, sticky, imp, n_imp, counters):
     n = pos.shape[0]
     if pairs:
@@ -98,7 +98,7 @@ def resolve_posteriori(sc, t_end, sign, h, pos, vel, mass, inv_mass, radius, bod
                         merge_bodies(i, j, pos, vel, mass, body, omega)
                         speed = -closing / dist
                     else:
-                        speed = ball_ball(i, j, pos, vel, inv_mass, e, ratio)
+                        speed = ball_ball(i, j, pos, vel, inv_mass, e, u_min)
                     record(imp, n_imp, sc, t_end - sign * t, i, j, -1, x, y, speed)
                     counters[EVENTS] += 1
                 _move(i, t, pos, vel, mass, body, omega)
@@ -125,10 +125,10 @@ def resolve_posteriori(sc, t_end, sign, h, pos, vel, mass, inv_mass, radius, bod
                     stop_body(i, vel, body, omega)
                     speed = abs(v)
                 else:
-                    speed = ball_wall(i, wall, vel, e, ratio)
+                    speed = ball_wall(i, wall, vel, e, u_min)
                 if speed > 0.0:
                     x, y = wall_point(i, wall, pos, radius, bounds)
                     record(imp, n_imp, sc, t_abs, i, -1, wall, x, y, speed)
                     counters[EVENTS] += 1
             shift_body(i, t * vel[i, 0], t * vel[i, 1], pos, body)
-        contain(sc, t_end, pos, vel, radius, body, omega, bounds, dim, e, ratio, sticky, imp, n_imp, counters)
+        contain(sc, t_end, pos, vel, radius, body, omega, bounds, dim, e, u_min, sticky, imp, n_imp, counters)

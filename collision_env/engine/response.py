@@ -9,14 +9,25 @@ with inverse masses ``w = 1/m`` so that mass ratios up to 1e12 and beyond stay w
 Ball-wall: ``v_n' = -e v_n``.
 
 **Collapse regulariser.** With e < 1, hard disks can collide infinitely often in finite time
-(inelastic collapse; McNamara & Young 1992), and a touching train at e = 0 is resolved by an
-infinite cascade of ever smaller impulses at one instant. A collision whose normal closing speed
-is at most ``collapse_ratio`` times the larger speed of the balls involved is treated as elastic
-(restitution 1). Such a collision carries a relative speed at the level of the round-off of the
-velocities (with the default ratio 1e-9), so the rule changes no measurable result while it ends
-every cascade after a bounded number of events (about log(1/ratio)/log(1/e) per contact chain)
-and turns the round-off residue of a plastic impact into a receding, not a re-colliding, pair.
-Energy never grows under it. Elastic scenes (e = 1) are unaffected.
+(inelastic collapse; McNamara & Young 1992), and a touching train pressed against a wall at e = 0
+is resolved by an infinite cascade of ever smaller impulses at one instant. Per scene and step
+the engine sets a tiny speed
+
+    u_min = max(collapse_ratio * (largest ball speed at the start of the step), collapse_floor)
+
+(defaults 1e-9 and 1e-15 m/s, far below anything measurable and far above the round-off of the
+velocities) and
+
+- makes a collision whose normal closing speed is at most ``u_min`` leave the pair (or the ball
+  and the wall) separating at ``u_min``: elastic, or a hair more (as DynamO's ``ElasticV`` and
+  Box2D's restitution threshold make slow collisions elastic). This ends every cascade after a
+  bounded number of impulses (about log(1/ratio)/log(1/e) per contact chain), and a pair that
+  round-off left closing after a plastic impact is set apart at once instead of being resolved
+  again and again at the same instant.
+
+The rule can add at most ``1/2 mu u_min^2`` of energy to a collision whose closing speed
+was below ``u_min`` (1e-18 of the kinetic energy with the default ratio), which is below the
+round-off of the energy itself. Elastic scenes are otherwise unaffected.
 
 Stick scenes (e = 0, ``inelastic="stick"``): colliding bodies merge into one rigid cluster that
 keeps the total momentum and the total angular momentum about the new centre of mass
@@ -32,31 +43,37 @@ from ._jit import njit
 
 
 @njit
-def restitution(closing_speed, ref_speed, e, collapse_ratio):
-    """The restitution to apply, after the collapse regulariser."""
-    if closing_speed <= collapse_ratio * ref_speed:
-        return 1.0
-    return e
+def elastic_threshold(vel, collapse_ratio, collapse_floor):
+    """``u_min`` for one scene: the closing speed at or below which a collision is elastic."""
+    fastest = 0.0
+    for i in range(vel.shape[0]):
+        fastest = max(fastest, vel[i, 0] * vel[i, 0] + vel[i, 1] * vel[i, 1])
+    return max(collapse_ratio * math.sqrt(fastest), collapse_floor)
 
 
 @njit
-def ball_ball(i, j, pos, vel, inv_mass, e, collapse_ratio):
+def separation_speed(closing_speed, e, u_min):
+    """Normal speed at which a collision leaves the pair separating (see the regulariser)."""
+    return e * closing_speed if closing_speed > u_min else u_min
+
+
+@njit
+def ball_ball(i, j, pos, vel, inv_mass, e, u_min):
     """Apply the impulse between balls ``i`` and ``j``. Returns the closing speed (0: no impulse)."""
-    nx = pos[j, 0] - pos[i, 0]
-    ny = pos[j, 1] - pos[i, 1]
-    d = math.sqrt(nx * nx + ny * ny)
-    if d == 0.0:
+    dx = pos[j, 0] - pos[i, 0]
+    dy = pos[j, 1] - pos[i, 1]
+    d = math.sqrt(dx * dx + dy * dy)
+    # "approaching" is decided by the same expression as in toi.toi_pair, so that the predictor
+    # and the response can never disagree about it through round-off
+    b = dx * (vel[j, 0] - vel[i, 0]) + dy * (vel[j, 1] - vel[i, 1])
+    if not (b < 0.0 and d > 0.0):
         return 0.0
-    nx /= d
-    ny /= d
-    u = (vel[j, 0] - vel[i, 0]) * nx + (vel[j, 1] - vel[i, 1]) * ny
-    if not u < 0.0:
-        return 0.0
-    ref = max(math.hypot(vel[i, 0], vel[i, 1]), math.hypot(vel[j, 0], vel[j, 1]))
-    e_eff = restitution(-u, ref, e, collapse_ratio)
+    nx = dx / d
+    ny = dy / d
+    u = b / d
     wi = inv_mass[i]
     wj = inv_mass[j]
-    jn = (1.0 + e_eff) * u / (wi + wj)
+    jn = (u - separation_speed(-u, e, u_min)) / (wi + wj)
     vel[i, 0] += jn * wi * nx
     vel[i, 1] += jn * wi * ny
     vel[j, 0] -= jn * wj * nx
@@ -65,15 +82,15 @@ def ball_ball(i, j, pos, vel, inv_mass, e, collapse_ratio):
 
 
 @njit
-def ball_wall(i, wall, vel, e, collapse_ratio):
+def ball_wall(i, wall, vel, e, u_min):
     """Reflect the normal component of ball ``i``'s velocity off ``wall``. Returns the closing speed."""
     axis = 0 if wall < 2 else 1
     vn = vel[i, axis]
     into = vn < 0.0 if wall % 2 == 0 else vn > 0.0
     if not into:
         return 0.0
-    e_eff = restitution(abs(vn), math.hypot(vel[i, 0], vel[i, 1]), e, collapse_ratio)
-    vel[i, axis] = -e_eff * vn
+    out = separation_speed(abs(vn), e, u_min)
+    vel[i, axis] = out if vn < 0.0 else -out
     return abs(vn)
 
 

@@ -145,13 +145,14 @@ class BatchSimulator:
         Cap on events per scene per step in exact mode. A scene that reaches it stops at its last
         event, in a valid state; :attr:`cap_reached` flags it and an :class:`EventCapWarning` is
         issued.
-    collapse_ratio:
-        The inelastic-collapse regulariser: a collision whose normal closing speed is at most this
-        fraction of the balls' speeds is elastic (see :mod:`collision_env.engine.response`).
+    collapse_ratio, collapse_floor:
+        The inelastic-collapse regulariser: a collision whose normal closing speed is at most
+        ``max(collapse_ratio * fastest speed at the step's start, collapse_floor)`` is elastic
+        (see :mod:`collision_env.engine.response`).
     """
 
     def __init__(self, scene, positions, velocities, masses, radii=None, *, mode="exact", substeps=1,
-                 max_events=10_000, collapse_ratio=1e-9):
+                 max_events=10_000, collapse_ratio=1e-9, collapse_floor=1e-15):
         if not isinstance(scene, Scene):
             raise ValueError(f"scene: expected a collision_env.engine.Scene, got {type(scene).__name__}")
         if mode not in MODES:
@@ -164,11 +165,14 @@ class BatchSimulator:
             raise ValueError(f"max_events: must be a positive integer, got {max_events!r}")
         if not (isinstance(collapse_ratio, (int, float)) and 0.0 <= collapse_ratio < 1.0):
             raise ValueError(f"collapse_ratio: must be a number in [0, 1), got {collapse_ratio!r}")
+        if not (isinstance(collapse_floor, (int, float)) and 0.0 <= collapse_floor < math.inf):
+            raise ValueError(f"collapse_floor: must be a finite speed >= 0 (m/s), got {collapse_floor!r}")
         self.scene = scene
         self.mode = mode
         self.substeps = int(substeps)
         self.max_events = int(max_events)
         self.collapse_ratio = float(collapse_ratio)
+        self.collapse_floor = float(collapse_floor)
 
         pos = np.array(positions, dtype=np.float64) if not isinstance(positions, np.ndarray) else positions
         if pos.ndim != 3 or pos.shape[-1] != 2:
@@ -191,7 +195,7 @@ class BatchSimulator:
         self._counters = np.zeros(4, dtype=np.int64)
 
         bounds = scene.bounds if scene.bounds is not None else (0.0, 0.0, 0.0, 0.0)
-        self._fparams = np.array([*bounds, scene.elasticity, self.collapse_ratio, 1.0])
+        self._fparams = np.array([*bounds, scene.elasticity, self.collapse_ratio, 1.0, self.collapse_floor])
         self._iparams = np.array(
             [scene.bounds is not None, scene.ball_collisions and n > 1, scene.dimension, scene.sticky,
              self.max_events],
@@ -596,10 +600,11 @@ class Simulator:
         )
 
     def get_state(self):
-        return self._batch.get_state()
+        """A dict of array copies (no batch axis) that :meth:`set_state` restores exactly."""
+        return {key: value[0] for key, value in self._batch.get_state().items()}
 
     def set_state(self, state):
-        self._batch.set_state(state)
+        self._batch.set_state({key: np.asarray(value)[None] for key, value in state.items()})
 
     def copy(self):
         new = object.__new__(Simulator)

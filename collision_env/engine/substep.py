@@ -6,6 +6,7 @@ from ._jit import njit
 from .motion import advance_all, has_rotation
 from .naive import resolve_naive
 from .posteriori import resolve_posteriori
+from .response import elastic_threshold
 
 NAIVE, POSTERIORI = 0, 1
 
@@ -30,6 +31,7 @@ def step_substeps(
     bounds = fparams[0:4]
     e = fparams[4]
     ratio = fparams[5]
+    floor = fparams[7]
     sign = fparams[6]
     has_walls = iparams[0] != 0
     pairs = iparams[1] != 0
@@ -45,6 +47,7 @@ def step_substeps(
         m = mass[sc]
         b = body[sc]
         w = omega[sc]
+        u_min = elastic_threshold(v, ratio, floor)
         while done[sc] < k_total:
             if imp.shape[0] - n_imp[0] < worst:
                 stalled[sc] = True
@@ -53,10 +56,10 @@ def step_substeps(
             t_end = t_start[sc] + sign * (dt_abs if k == k_total else h * k)
             advance_all(h, p, v, m, b, w, sticky and has_rotation(b, w))
             if mode == NAIVE:
-                resolve_naive(sc, t_end, p, v, m, inv_mass[sc], radius[sc], b, w, bounds, dim, e, ratio,
+                resolve_naive(sc, t_end, p, v, m, inv_mass[sc], radius[sc], b, w, bounds, dim, e, u_min,
                               has_walls, pairs, sticky, imp, n_imp, counters)
             else:
-                resolve_posteriori(sc, t_end, sign, h, p, v, m, inv_mass[sc], radius[sc], b, w, bounds, dim, e, ratio,
+                resolve_posteriori(sc, t_end, sign, h, p, v, m, inv_mass[sc], radius[sc], b, w, bounds, dim, e, u_min,
                                    has_walls, pairs, sticky, imp, n_imp, counters)
             done[sc] = k
             time[sc] = t_end

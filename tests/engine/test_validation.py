@@ -1,0 +1,115 @@
+"""Bad input: a ValueError that names the ball and the field, and the state left as it was."""
+
+import math
+
+import numpy as np
+import pytest
+
+from collision_env.engine import BatchSimulator, Scene, Simulator
+
+GOOD = dict(positions=[[-1.0, 0.0], [1.0, 0.0]], velocities=[[1.0, 0.0], [-1.0, 0.0]], masses=[1.0, 2.0])
+
+
+def make(**changes):
+    kw = {**GOOD, **changes}
+    scene = kw.pop("scene", Scene())
+    return Simulator(scene, kw.pop("positions"), kw.pop("velocities"), kw.pop("masses"), **kw)
+
+
+@pytest.mark.parametrize(
+    "changes, message",
+    [
+        (dict(positions=[[-1.0, math.nan], [1.0, 0.0]]), "ball 0: position must be finite"),
+        (dict(velocities=[[1.0, 0.0], [math.inf, 0.0]]), "ball 1: velocity must be finite"),
+        (dict(masses=[1.0, 0.0]), "ball 1: mass must be positive"),
+        (dict(masses=[-1.0, 1.0]), "ball 0: mass must be positive"),
+        (dict(masses=[1.0, math.nan]), "ball 1: mass must be positive"),
+        (dict(radii=[0.1, -0.1]), "ball 1: radius must be positive"),
+        (dict(positions=[[-1.0, 0.0], [-0.9, 0.0]]), "ball 0: position overlaps ball 1"),
+        (dict(positions=[[-1.95, 0.0], [1.0, 0.0]]), "ball 0: position must keep the ball inside"),
+        (dict(positions=[[-1.0, 0.0], [1.0, 0.95]]), "ball 1: position must keep the ball inside"),
+        (dict(positions=[[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]]), "positions: expected shape"),
+        (dict(velocities=[[1.0, 0.0]]), "velocities: expected shape"),
+        (dict(masses=[1.0, 2.0, 3.0]), "masses: expected shape"),
+        (dict(scene=Scene(dimension=1, bounds=(-2, -0.55, 2, 0.55)), velocities=[[1, 0.5], [0, 0]]),
+         "ball 0: velocity y must be 0 in a 1D scene"),
+        (dict(scene=Scene(dimension=1, bounds=(-2, -0.55, 2, 0.55)), positions=[[-1, 0], [1, 0.1]]),
+         "ball 1: position y must be 0 in a 1D scene"),
+        (dict(mode="fast"), "mode: must be one of"),
+        (dict(substeps=0), "substeps: must be a positive integer"),
+        (dict(substeps=4), "substeps: exact mode"),
+        (dict(max_events=0), "max_events"),
+        (dict(radii="big"), "radii: expected None, 'constant'"),
+    ],
+)
+def test_construction_rejects_bad_input(changes, message):
+    with pytest.raises(ValueError, match=message):
+        make(**changes)
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        (dict(elasticity=1.5), "elasticity: must lie in"),
+        (dict(elasticity=-0.1), "elasticity: must lie in"),
+        (dict(elasticity=math.nan), "elasticity: must lie in"),
+        (dict(dimension=3), "dimension: must be 1 or 2"),
+        (dict(inelastic="glue"), "inelastic: must be"),
+        (dict(bounds=(2, -1, -2, 1)), "bounds: need xmin < xmax"),
+        (dict(bounds=(0, 0, math.inf, 1)), "bounds: expected four finite numbers"),
+    ],
+)
+def test_scene_rejects_bad_input(kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        Scene(**kwargs)
+
+
+def test_touching_balls_are_allowed():
+    sim = make(positions=[[-1.0, 0.0], [-1.0 + 2 * 0.2, 0.0]], radii=[0.2, 0.2])
+    assert sim.step(0.1)  # they collide at once
+
+
+@pytest.mark.parametrize("dt, message", [(math.nan, "dt: must be finite"), (math.inf, "dt: must be finite"),
+                                         ("soon", "dt: expected a number")])
+def test_step_rejects_bad_dt_and_keeps_state(dt, message):
+    sim = make()
+    before = sim.get_state()
+    with pytest.raises(ValueError, match=message):
+        sim.step(dt)
+    for key, value in sim.get_state().items():
+        np.testing.assert_array_equal(value, before[key])
+
+
+def test_reverse_with_zero_elasticity_is_rejected():
+    sim = make(scene=Scene(elasticity=0.0))
+    sim.step(0.5)
+    before = sim.get_state()
+    with pytest.raises(ValueError, match="dt: cannot step backwards with elasticity 0"):
+        sim.step(-0.1)
+    np.testing.assert_array_equal(sim.positions, before["positions"])
+
+
+def test_rejected_nudge_and_set_leave_state_untouched():
+    sim = make()
+    before = sim.get_state()
+    with pytest.raises(ValueError, match="ball 1: nudge must be finite"):
+        sim.nudge([[0.1, 0.0], [math.nan, 0.0]])
+    with pytest.raises(ValueError, match="ball 0: position overlaps ball 1"):
+        sim.set_balls(positions=[[0.0, 0.0], [0.1, 0.0]])
+    for key, value in sim.get_state().items():
+        np.testing.assert_array_equal(value, before[key])
+
+
+def test_batch_errors_name_the_scene():
+    pos = np.array([[[-1.0, 0.0], [1.0, 0.0]]] * 3)
+    vel = np.zeros((3, 2, 2))
+    masses = np.ones((3, 2))
+    masses[2, 1] = -3
+    with pytest.raises(ValueError, match="scene 2, ball 1: mass must be positive"):
+        BatchSimulator(Scene(), pos, vel, masses)
+    batch = BatchSimulator(Scene(), pos, vel, np.ones(2))
+    before = batch.get_state()
+    with pytest.raises(ValueError, match="scene 1, ball 0: position must keep the ball inside"):
+        batch.set_scenes([0, 1], [[[-1.0, 0.0], [1.0, 0.0]], [[-5.0, 0.0], [1.0, 0.0]]], np.zeros((2, 2, 2)))
+    for key, value in batch.get_state().items():
+        np.testing.assert_array_equal(value, before[key])
