@@ -1,0 +1,317 @@
+"""Task configuration shared by every environment of the suite.
+
+One :class:`TaskConfig` describes a whole task: the scene the engine simulates, how balls and targets
+are placed at reset, which balls the agent nudges and whose impacts count, the rewards, the control
+step, and the engine's fidelity knobs. Each preset (``PRESETS``) is just a ``TaskConfig``; the generic
+env takes a preset name plus any field as a keyword override. Construction validates every field and
+raises ``ValueError`` naming it, so bad keyword arguments fail at ``gym.make`` time.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from collision_env.engine.scene import PLAY_AREA_1D, PLAY_AREA_2D, WALL_NAMES, radius_from_mass
+
+MODES = ("exact", "posteriori", "naive")
+SCORERS = ("any", "controlled", "others", "cluster")
+LAYOUTS = ("random", "rack")
+RADIUS_RULES = ("mass", "constant")
+
+#: Number of observation entries per ball, per target slot and global (see the env docstrings).
+BALL_FEATURES = 6
+TARGET_FEATURES = 10
+GLOBAL_FEATURES = 2
+
+
+def _pair(name, value, *, low=None, allow_equal=True):
+    try:
+        lo, hi = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected a (low, high) pair of numbers, got {value!r}") from None
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        raise ValueError(f"{name}: must be finite, got {value!r}")
+    if lo > hi or (not allow_equal and lo == hi):
+        raise ValueError(f"{name}: need low <= high, got {value!r}")
+    if low is not None and lo < low:
+        raise ValueError(f"{name}: values must be >= {low}, got {value!r}")
+    return (lo, hi)
+
+
+def _number(name, value, *, low=None, high=None, strict_low=False, integer=False):
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise ValueError(f"{name}: expected a number, got {value!r}")
+    if integer:
+        if int(value) != value:
+            raise ValueError(f"{name}: expected an integer, got {value!r}")
+        value = int(value)
+    else:
+        value = float(value)
+        if not math.isfinite(value):
+            raise ValueError(f"{name}: must be finite, got {value!r}")
+    if low is not None and (value < low or (strict_low and value == low)):
+        op = ">" if strict_low else ">="
+        raise ValueError(f"{name}: must be {op} {low}, got {value!r}")
+    if high is not None and value > high:
+        raise ValueError(f"{name}: must be <= {high}, got {value!r}")
+    return value
+
+
+@dataclass(frozen=True)
+class TaskConfig:
+    """Everything that defines a task. All fields can be given to ``gym.make`` as keywords.
+
+    Scene (passed to :class:`collision_env.engine.Scene`):
+        ``dimension`` (1 or 2), ``bounds`` ((xmin, ymin, xmax, ymax); ``None`` = PhET's play area for
+        the dimension), ``elasticity`` (0..1), ``inelastic`` ("slip" | "stick"), ``ball_collisions``.
+    Balls:
+        ``n_balls``; ``mass_range`` (each ball's mass uniform in it, kg); ``radius`` ("mass" = PhET's
+        density rule, "constant" = PhET's 0.15 m, or a number in metres); ``layout`` ("random":
+        anywhere without overlap, left-to-right by index in 1D; "rack": controlled balls in the left
+        40 %, the others in the right half); ``speed_range`` / ``others_speed_range`` (initial speed
+        of controlled / other balls, m/s, random direction).
+    Control:
+        ``controlled`` (indices of the nudged balls); ``dt`` (control step, s of simulated time);
+        ``max_dv`` (largest velocity change per action component and step, m/s); ``max_speed``
+        (a nudge never pushes a ball above max(max_speed, its current speed)).
+    Targets:
+        ``n_targets``; ``sequential`` (show and score one target at a time, else all at once);
+        ``target_width`` (m); ``target_walls`` (walls targets may sit on; ``None`` = all walls of
+        the dimension); ``window`` (``None``, or the length in s of each target's time window);
+        ``scorers`` (whose wall impacts count: "any", "controlled", "others", or "cluster" = balls
+        that have stuck to another ball).
+    Reward:
+        ``hit_reward`` per target hit, ``success_bonus`` when all are hit, ``miss_penalty`` per wall
+        impact of a scoring ball that hits no target, ``action_cost`` per m/s of requested nudge,
+        ``shaping`` (weight of the potential-based aiming term, see the docs).
+    Episode:
+        ``time_limit`` (s of simulated time; the env truncates after round(time_limit / dt) steps).
+    Engine:
+        ``mode`` ("exact" | "posteriori" | "naive"), ``substeps`` (>= 1), ``max_events`` (event cap
+        per step and scene).
+    """
+
+    dimension: int = 2
+    bounds: tuple | None = None
+    elasticity: float = 1.0
+    inelastic: str = "slip"
+    ball_collisions: bool = True
+    n_balls: int = 1
+    mass_range: tuple = (1.0, 1.0)
+    radius: object = "mass"
+    layout: str = "random"
+    speed_range: tuple = (0.3, 0.8)
+    others_speed_range: tuple = (0.0, 0.0)
+    controlled: tuple = (0,)
+    dt: float = 0.05
+    max_dv: float = 0.15
+    max_speed: float = 2.0
+    n_targets: int = 3
+    sequential: bool = True
+    target_width: float = 0.6
+    target_walls: tuple | None = None
+    window: float | None = None
+    scorers: str = "any"
+    hit_reward: float = 1.0
+    success_bonus: float = 1.0
+    miss_penalty: float = 0.05
+    action_cost: float = 0.02
+    shaping: float = 0.0
+    time_limit: float = 10.0
+    mode: str = "exact"
+    substeps: int = 1
+    max_events: int = 10_000
+    # derived (not arguments)
+    n_steps: int = field(init=False, default=0)
+
+    def __post_init__(self):  # noqa: C901 - one check per field, in order
+        s = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
+        if self.dimension not in (1, 2) or isinstance(self.dimension, bool):
+            raise ValueError(f"dimension: must be 1 or 2, got {self.dimension!r}")
+        s("dimension", int(self.dimension))
+        if self.bounds is None:
+            s("bounds", PLAY_AREA_1D if self.dimension == 1 else PLAY_AREA_2D)
+        try:
+            b = tuple(float(v) for v in self.bounds)
+        except (TypeError, ValueError):
+            raise ValueError(f"bounds: expected (xmin, ymin, xmax, ymax), got {self.bounds!r}") from None
+        if len(b) != 4 or not all(math.isfinite(v) for v in b) or not (b[0] < b[2] and b[1] < b[3]):
+            raise ValueError(f"bounds: expected finite (xmin, ymin, xmax, ymax) with min < max, got {self.bounds!r}")
+        if self.dimension == 1 and not (b[1] < 0.0 < b[3]):
+            raise ValueError(f"bounds: a 1D scene needs ymin < 0 < ymax, got {b}")
+        s("bounds", b)
+        s("elasticity", _number("elasticity", self.elasticity, low=0.0, high=1.0))
+        if self.inelastic not in ("slip", "stick"):
+            raise ValueError(f"inelastic: must be 'slip' or 'stick', got {self.inelastic!r}")
+        if not isinstance(self.ball_collisions, (bool, np.bool_)):
+            raise ValueError(f"ball_collisions: expected a bool, got {self.ball_collisions!r}")
+        s("ball_collisions", bool(self.ball_collisions))
+        s("n_balls", _number("n_balls", self.n_balls, low=1, integer=True))
+        s("mass_range", _pair("mass_range", self.mass_range))
+        if self.mass_range[0] <= 0:
+            raise ValueError(f"mass_range: masses must be > 0, got {self.mass_range!r}")
+        if isinstance(self.radius, str):
+            if self.radius not in RADIUS_RULES:
+                raise ValueError(f"radius: expected 'mass', 'constant' or a positive number, got {self.radius!r}")
+        else:
+            s("radius", _number("radius", self.radius, low=0.0, strict_low=True))
+        if self.layout not in LAYOUTS:
+            raise ValueError(f"layout: expected one of {LAYOUTS}, got {self.layout!r}")
+        s("speed_range", _pair("speed_range", self.speed_range, low=0.0))
+        s("others_speed_range", _pair("others_speed_range", self.others_speed_range, low=0.0))
+        try:
+            ctrl = tuple(int(i) for i in np.atleast_1d(np.asarray(self.controlled)))
+        except (TypeError, ValueError):
+            raise ValueError(f"controlled: expected ball indices, got {self.controlled!r}") from None
+        if not ctrl or len(set(ctrl)) != len(ctrl) or not all(0 <= i < self.n_balls for i in ctrl):
+            raise ValueError(f"controlled: need distinct ball indices in [0, {self.n_balls}), got {self.controlled!r}")
+        s("controlled", ctrl)
+        s("dt", _number("dt", self.dt, low=0.0, strict_low=True))
+        s("max_dv", _number("max_dv", self.max_dv, low=0.0))
+        s("max_speed", _number("max_speed", self.max_speed, low=0.0, strict_low=True))
+        s("n_targets", _number("n_targets", self.n_targets, low=1, integer=True))
+        s("sequential", bool(self.sequential))
+        allowed = WALL_NAMES[:2] if self.dimension == 1 else WALL_NAMES
+        walls = allowed if self.target_walls is None else self.target_walls
+        if isinstance(walls, str):
+            walls = (walls,)
+        walls = tuple(walls)
+        if not walls or not all(w in allowed for w in walls):
+            raise ValueError(f"target_walls: expected a non-empty subset of {allowed}, got {self.target_walls!r}")
+        s("target_walls", walls)
+        s("target_width", _number("target_width", self.target_width, low=0.0, strict_low=True))
+        shortest = min((b[3] - b[1]) if w in ("left", "right") else (b[2] - b[0]) for w in walls)
+        if self.dimension == 2 and self.target_width > shortest:
+            raise ValueError(f"target_width: {self.target_width} m is longer than the shortest target wall "
+                             f"({shortest} m)")
+        if self.scorers not in SCORERS:
+            raise ValueError(f"scorers: expected one of {SCORERS}, got {self.scorers!r}")
+        if self.scorers == "others" and len(ctrl) == self.n_balls:
+            raise ValueError("scorers: 'others' needs at least one ball that is not controlled")
+        sticky = self.inelastic == "stick" and self.elasticity == 0.0 and self.ball_collisions
+        if self.scorers == "cluster" and not sticky:
+            raise ValueError("scorers: 'cluster' needs a stick scene "
+                             "(inelastic='stick', elasticity=0, ball_collisions=True)")
+        if self.scorers == "cluster" and self.n_balls < 2:
+            raise ValueError("scorers: 'cluster' needs at least 2 balls")
+        for name in ("hit_reward", "success_bonus", "miss_penalty", "action_cost", "shaping"):
+            s(name, _number(name, getattr(self, name)))
+        s("time_limit", _number("time_limit", self.time_limit, low=0.0, strict_low=True))
+        if self.time_limit < self.dt:
+            raise ValueError(f"time_limit: must be at least one control step dt={self.dt}, got {self.time_limit}")
+        if self.window is not None:
+            s("window", _number("window", self.window, low=0.0, strict_low=True))
+            if self.window > self.time_limit:
+                raise ValueError(f"window: {self.window} s is longer than time_limit {self.time_limit} s")
+        if self.mode not in MODES:
+            raise ValueError(f"mode: expected one of {MODES}, got {self.mode!r}")
+        s("substeps", _number("substeps", self.substeps, low=1, integer=True))
+        s("max_events", _number("max_events", self.max_events, low=1, integer=True))
+        s("n_steps", max(1, int(round(self.time_limit / self.dt))))
+        # geometric feasibility: every ball must fit, and the balls must be placeable
+        r_max = float(self.radius_of(np.array([self.mass_range[1]]))[0])
+        r_min = float(self.radius_of(np.array([self.mass_range[0]]))[0])
+        r_big = max(r_max, r_min)
+        if 2 * r_big >= min(b[2] - b[0], b[3] - b[1]):
+            raise ValueError(f"radius: a ball of radius {r_big:.4g} m does not fit in bounds {b}")
+        if self.dimension == 1:
+            if 2 * r_big * self.n_balls > 0.8 * (b[2] - b[0]):
+                raise ValueError(f"n_balls: {self.n_balls} balls of radius up to {r_big:.4g} m do not fit on the line")
+        else:
+            room = 0.3 * (b[2] - b[0]) * (b[3] - b[1]) * (0.5 if self.layout == "rack" else 1.0)
+            if self.n_balls * math.pi * r_big**2 > room:
+                raise ValueError(f"n_balls: {self.n_balls} balls of radius up to {r_big:.4g} m are too many "
+                                 f"for bounds {b}")
+
+    # ----------------------------------------------------------------------------------------- #
+    def radius_of(self, masses: np.ndarray) -> np.ndarray:
+        """Radii (m) of balls with these masses under this config's radius rule."""
+        if self.radius == "mass":
+            return radius_from_mass(masses)
+        value = 0.15 if self.radius == "constant" else float(self.radius)
+        return np.full(np.shape(masses), value, dtype=np.float64)
+
+    @property
+    def action_dim(self) -> int:
+        return len(self.controlled) * self.dimension
+
+    @property
+    def target_slots(self) -> int:
+        return 1 if self.sequential else self.n_targets
+
+    @property
+    def obs_dim(self) -> int:
+        return self.n_balls * BALL_FEATURES + self.target_slots * TARGET_FEATURES + GLOBAL_FEATURES
+
+    @property
+    def scoring_mask(self) -> np.ndarray:
+        """(n_balls,) bool: balls whose wall impacts may score (before the cluster condition)."""
+        mask = np.zeros(self.n_balls, dtype=bool)
+        ctrl = list(self.controlled)
+        if self.scorers == "controlled":
+            mask[ctrl] = True
+        elif self.scorers == "others":
+            mask[:] = True
+            mask[ctrl] = False
+        else:
+            mask[:] = True
+        return mask
+
+    def replace(self, **changes) -> TaskConfig:
+        return dataclasses.replace(self, **changes)
+
+
+# --------------------------------------------------------------------------------------------- #
+# Presets: each registered env id is one of these, reachable as well through the generic env.
+
+PRESETS: dict[str, dict] = {
+    # 1. One ball in 2D, one target at a time (three per episode). Dense, documented shaping.
+    "one_ball": dict(
+        dimension=2, elasticity=1.0, n_balls=1, mass_range=(1.0, 1.0), radius="mass",
+        speed_range=(0.3, 0.8), controlled=(0,), n_targets=3, sequential=True, target_width=0.6,
+        scorers="any", hit_reward=1.0, success_bonus=1.0, miss_penalty=0.05, action_cost=0.02,
+        shaping=1.0, max_dv=0.15, max_speed=2.0,
+    ),
+    # 2. PhET Explore 1D: three balls on a line, the leftmost is nudged; end-wall impacts in windows.
+    "line_1d": dict(
+        dimension=1, elasticity=1.0, n_balls=3, mass_range=(0.5, 2.0), radius="mass",
+        speed_range=(0.0, 0.5), others_speed_range=(0.0, 0.5), controlled=(0,), n_targets=2,
+        sequential=False, window=2.0, scorers="any", hit_reward=1.0, success_bonus=1.0,
+        miss_penalty=0.0, action_cost=0.02, shaping=0.0, max_dv=0.1, max_speed=1.5,
+    ),
+    # 3. Billiards: a cue ball and three object balls (constant radius, e = 0.95); only object
+    #    balls score, so the skill is ball-ball transfer.
+    "billiards": dict(
+        dimension=2, elasticity=0.95, n_balls=4, mass_range=(1.0, 1.0), radius="constant",
+        layout="rack", speed_range=(0.0, 0.0), others_speed_range=(0.0, 0.0), controlled=(0,),
+        n_targets=2, sequential=False, target_width=0.6, scorers="others", hit_reward=1.0,
+        success_bonus=1.0, miss_penalty=0.0, action_cost=0.02, shaping=0.0, max_dv=0.2, max_speed=2.0,
+    ),
+    # 4. PhET Inelastic (e = 0, stick): ram the resting ball, then steer the cluster onto the target.
+    "inelastic_cluster": dict(
+        dimension=2, elasticity=0.0, inelastic="stick", n_balls=2, mass_range=(0.5, 1.5),
+        radius="mass", speed_range=(0.0, 0.3), others_speed_range=(0.0, 0.0), controlled=(0,),
+        n_targets=1, sequential=True, target_width=0.8, scorers="cluster", hit_reward=1.0,
+        success_bonus=1.0, miss_penalty=0.0, action_cost=0.02, shaping=0.0, max_dv=0.15, max_speed=1.5,
+    ),
+}
+
+
+def make_config(preset: str | None = "one_ball", **overrides) -> TaskConfig:
+    """The preset's :class:`TaskConfig` with ``overrides`` applied (``preset=None``: the defaults)."""
+    if preset is None:
+        base = {}
+    elif preset in PRESETS:
+        base = dict(PRESETS[preset])
+    else:
+        raise ValueError(f"preset: expected one of {sorted(PRESETS)} or None, got {preset!r}")
+    names = {f.name for f in dataclasses.fields(TaskConfig) if f.init}
+    unknown = sorted(set(overrides) - names)
+    if unknown:
+        raise TypeError(f"unexpected keyword argument(s) {unknown}; known: {sorted(names)}")
+    base.update(overrides)
+    return TaskConfig(**base)

@@ -1,0 +1,306 @@
+"""The batched task core shared by the single env (a batch of one) and the native vector env.
+
+:class:`TaskCore` owns one :class:`collision_env.engine.BatchSimulator` and the per-scene task state
+(targets, scoring flags, step counters). Episodes are drawn by :class:`EpisodeSampler` from one
+``np.random.Generator`` per scene, so a scene of the vector env and a single env seeded alike draw the
+same numbers in the same order. All physics happens in the engine; the core only turns actions into
+nudges and the engine's impact records into hits, reward and observations (see ``_kernels``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from collision_env.envs import _kernels as K
+from collision_env.envs._config import TaskConfig
+
+_WALL_CODE = {"left": 0, "right": 1, "bottom": 2, "top": 3}
+
+
+class Impacts:
+    """The impacts of one step as the engine reported them: a read-only view of its record array.
+
+    Fields (each an array, one entry per impact, in time order): ``time`` (absolute simulated time,
+    s; the episode starts at 0), ``ball``, ``other`` (the other ball, -1 for a wall), ``wall`` (index
+    into ``collision_env.engine.WALL_NAMES``, -1 for a ball-ball impact), ``x``, ``y`` (exact
+    contact point, m), ``speed`` (normal closing speed before impact, m/s) and ``scene`` (the
+    sub-env index in a vector env, 0 in a single env). ``len(impacts)``, ``impacts["time"]``,
+    ``impacts.point`` ((n, 2)), ``impacts.wall_names`` and ``impacts.to_list()`` are there for
+    convenience. Equality compares the records, so infos compare with ``data_equivalence``.
+    """
+
+    __slots__ = ("records",)
+
+    def __init__(self, records: np.ndarray):
+        self.records = records
+
+    def __len__(self) -> int:
+        return len(self.records)
+
+    def __getitem__(self, key):
+        return self.records[key]
+
+    def __iter__(self):
+        return iter(self.to_list())
+
+    def __eq__(self, other) -> bool:
+        if not isinstance(other, Impacts):
+            return NotImplemented
+        a, b = self.records, other.records
+        return a.dtype == b.dtype and a.shape == b.shape and bool(np.all(a == b))
+
+    __hash__ = None
+
+    @property
+    def point(self) -> np.ndarray:
+        return np.stack([self.records["x"], self.records["y"]], axis=-1)
+
+    @property
+    def wall_names(self) -> list:
+        from collision_env.engine import WALL_NAMES
+
+        return [WALL_NAMES[w] if w >= 0 else None for w in self.records["wall"].tolist()]
+
+    def for_scene(self, scene: int) -> Impacts:
+        return Impacts(self.records[self.records["scene"] == scene])
+
+    def to_list(self) -> list:
+        """One dict per impact: time, ball, other (None for a wall), wall (name or None), point, speed."""
+        from collision_env.engine import WALL_NAMES
+
+        out = []
+        for r in self.records.tolist():
+            rec = dict(zip(self.records.dtype.names, r, strict=True))
+            out.append({
+                "time": rec["time"], "ball": rec["ball"],
+                "other": None if rec["other"] < 0 else rec["other"],
+                "wall": None if rec["wall"] < 0 else WALL_NAMES[rec["wall"]],
+                "point": (rec["x"], rec["y"]), "speed": rec["speed"], "scene": rec["scene"],
+            })
+        return out
+
+    def __repr__(self) -> str:
+        return f"Impacts({len(self.records)} records)"
+
+
+# --------------------------------------------------------------------------------------------- #
+# episode sampling
+
+
+class Episodes:
+    """Start states for k scenes: balls (k, N, ...) and targets (k, K, ...)."""
+
+    __slots__ = ("positions", "velocities", "masses", "radii", "t_wall", "t_geo")
+
+    def __init__(self, positions, velocities, masses, radii, t_wall, t_geo):
+        self.positions = positions
+        self.velocities = velocities
+        self.masses = masses
+        self.radii = radii
+        self.t_wall = t_wall
+        self.t_geo = t_geo
+
+
+#: placement tries per ball inside one block of random numbers
+PLACEMENT_TRIES = 16
+#: blocks drawn for one episode before giving up (only very crowded configs come near this)
+MAX_ATTEMPTS = 1000
+
+
+class EpisodeSampler:
+    """Draws start states: one block of uniforms per episode from that episode's generator.
+
+    Each episode consumes ``rng.random(M)`` (M fixed by the config), repeated while the balls
+    do not fit, and the block is turned into the start state by a batched kernel. A sub-env of
+    the vector env and a single env seeded alike therefore draw the same episodes.
+    """
+
+    def __init__(self, cfg: TaskConfig):
+        self.cfg = cfg
+        n, k = cfg.n_balls, cfg.n_targets
+        self.M = K.block_size(n, k, PLACEMENT_TRIES)
+        self.ctrl_mask = np.zeros(n, dtype=bool)
+        self.ctrl_mask[list(cfg.controlled)] = True
+        self.walls = np.array([_WALL_CODE[w] for w in cfg.target_walls], dtype=np.int64)
+        E = np.zeros(K.E_LEN)
+        E[K.E_XMIN:K.E_YMAX + 1] = cfg.bounds
+        E[K.E_MLO], E[K.E_MHI] = cfg.mass_range
+        E[K.E_SLO], E[K.E_SHI] = cfg.speed_range
+        E[K.E_OLO], E[K.E_OHI] = cfg.others_speed_range
+        E[K.E_HW] = 0.5 * cfg.target_width
+        E[K.E_WINDOW] = -1.0 if cfg.window is None else cfg.window
+        E[K.E_TLIMIT] = cfg.time_limit
+        self.E = E
+        self.F = np.array([cfg.dimension, n, k, int(cfg.layout == "rack"), PLACEMENT_TRIES], dtype=np.int64)
+
+    def _build(self, U: np.ndarray) -> tuple:
+        cfg = self.cfg
+        r, n, k = U.shape[0], cfg.n_balls, cfg.n_targets
+        lo, hi = cfg.mass_range
+        masses = lo + (hi - lo) * U[:, :n]
+        radii = cfg.radius_of(masses)
+        pos = np.zeros((r, n, 2))
+        vel = np.zeros((r, n, 2))
+        t_wall = np.zeros((r, k), dtype=np.int64)
+        t_geo = np.zeros((r, k, 4))
+        ok = np.zeros(r, dtype=bool)
+        K.build_episodes(U, self.ctrl_mask, self.walls, self.E, self.F, pos, vel, masses, radii, t_wall, t_geo, ok)
+        return Episodes(pos, vel, masses, radii, t_wall, t_geo), ok
+
+    def sample(self, rngs: list) -> Episodes:
+        U = np.empty((len(rngs), self.M))
+        for row, rng in enumerate(rngs):
+            U[row] = rng.random(self.M)
+        eps, ok = self._build(U)
+        for row in np.flatnonzero(~ok):  # rare: draw fresh blocks for the rows that did not fit
+            for _ in range(MAX_ATTEMPTS):
+                one, good = self._build(rngs[row].random(self.M)[None])
+                if good[0]:
+                    for name in Episodes.__slots__:
+                        getattr(eps, name)[row] = getattr(one, name)[0]
+                    break
+            else:
+                raise RuntimeError(f"could not place {self.cfg.n_balls} balls without overlap in {self.cfg.bounds} "
+                                   f"after {MAX_ATTEMPTS} attempts; use fewer or smaller balls")
+        return eps
+
+
+def sample_episode(cfg: TaskConfig, rng: np.random.Generator) -> Episodes:
+    """One start state drawn from ``rng`` (arrays with a leading axis of length 1)."""
+    return EpisodeSampler(cfg).sample([rng])
+
+
+# --------------------------------------------------------------------------------------------- #
+
+
+class TaskCore:
+    """A batch of B task instances on one BatchSimulator."""
+
+    def __init__(self, cfg: TaskConfig, num_scenes: int):
+        from collision_env.engine import BatchSimulator, Scene
+
+        self.cfg = cfg
+        B, N, Kt = int(num_scenes), cfg.n_balls, cfg.n_targets
+        self.num_scenes = B
+        self.scene = Scene(bounds=cfg.bounds, elasticity=cfg.elasticity, dimension=cfg.dimension,
+                           inelastic=cfg.inelastic, ball_collisions=cfg.ball_collisions)
+        self.P = np.zeros(K.P_LEN)
+        self.P[K.P_XMIN:K.P_YMAX + 1] = cfg.bounds
+        self.P[K.P_HIT] = cfg.hit_reward
+        self.P[K.P_MISS] = cfg.miss_penalty
+        self.P[K.P_BONUS] = cfg.success_bonus
+        self.P[K.P_SHAPING] = cfg.shaping
+        self.P[K.P_VSCALE] = 2.0 * cfg.max_speed
+        self.P[K.P_MSCALE] = 3.0
+        self.P[K.P_TLIMIT] = cfg.time_limit
+        self.P[K.P_MAXDV] = cfg.max_dv
+        self.P[K.P_MAXSPEED] = cfg.max_speed
+        self.P[K.P_ACTCOST] = cfg.action_cost
+        self.Q = np.zeros(K.Q_LEN, dtype=np.int64)
+        self.Q[K.Q_SEQ] = int(cfg.sequential)
+        self.Q[K.Q_CLUSTER] = int(cfg.scorers == "cluster")
+        self.Q[K.Q_DIM] = cfg.dimension
+        self.Q[K.Q_NSTEPS] = cfg.n_steps
+        self.ctrl = np.array(cfg.controlled, dtype=np.int64)
+        self.qual = cfg.scoring_mask
+        self.obs_dim = cfg.obs_dim
+        self.action_dim = cfg.action_dim
+
+        # task state, one row per scene
+        self.masses = np.zeros((B, N))
+        self.radii = np.zeros((B, N))
+        self.t_wall = np.zeros((B, Kt), dtype=np.int64)
+        self.t_geo = np.zeros((B, Kt, 4))
+        self.t_status = np.zeros((B, Kt), dtype=np.int8)
+        self.cur = np.zeros(B, dtype=np.int64)
+        self.body = np.tile(np.arange(N, dtype=np.int64), (B, 1))
+        self.steps = np.zeros(B, dtype=np.int64)
+        self.phi = np.zeros(B)
+        # latest engine read-back (kept for the next nudge and for rendering)
+        self.pos = np.zeros((B, N, 2))
+        self.vel = np.zeros((B, N, 2))
+        self.time = np.zeros(B)
+        # scratch: the nudge and its cost (rewritten every step)
+        self._dv = np.zeros((B, N, 2))
+        self._cost = np.zeros(B)
+
+        # A placeholder layout drawn from a fixed seed builds the engine now, so that bad engine
+        # arguments fail at construction; reset() overwrites every scene.
+        self.sampler = EpisodeSampler(cfg)
+        ep = self.sampler.sample([np.random.default_rng(0)])
+        rep = lambda a: np.repeat(a, B, 0)  # noqa: E731
+        self.batch = BatchSimulator(self.scene, rep(ep.positions), rep(ep.velocities), rep(ep.masses),
+                                    radii=rep(ep.radii), mode=cfg.mode, substeps=cfg.substeps,
+                                    max_events=cfg.max_events)
+        self._write_episode(np.arange(B), Episodes(*(rep(getattr(ep, f)) for f in Episodes.__slots__)))
+        self.pos = self.batch.positions
+        self.vel = self.batch.velocities
+        self.impact_dtype = self.batch.step(0.0).dtype  # a zero step: only to learn the record dtype
+
+    # ------------------------------------------------------------------------------------- #
+    def _write_episode(self, idx: np.ndarray, eps: Episodes) -> None:
+        self.masses[idx] = eps.masses
+        self.radii[idx] = eps.radii
+        self.t_wall[idx] = eps.t_wall
+        self.t_geo[idx] = eps.t_geo
+        self.t_status[idx] = 0
+        self.cur[idx] = 0
+        self.body[idx] = np.arange(self.cfg.n_balls)
+        self.steps[idx] = 0
+
+    def reset_scenes(self, idx: np.ndarray, rngs: list) -> None:
+        """Draw a new episode for scenes ``idx`` (one generator each) and load it into the engine."""
+        eps = self.sampler.sample(rngs)
+        self.batch.set_scenes(idx, eps.positions, eps.velocities, masses=eps.masses, radii=eps.radii, time=0.0)
+        self._write_episode(idx, eps)
+
+    def advance(self, actions: np.ndarray, active: np.ndarray, dt: float):
+        """Nudge (actions (B, A) float64; inactive rows get none) and step the engine by dt.
+
+        Returns the engine's impact records and the action cost per scene (a scratch array,
+        valid until the next call). An action with NaN raises ValueError and changes nothing.
+        """
+        bad = K.nudge_kernel(actions, active, self.vel, self.ctrl, self.P, self.Q, self._dv, self._cost)
+        if bad >= 0:
+            where = f"sub-env {bad}: " if self.num_scenes > 1 else ""
+            raise ValueError(f"{where}action contains NaN: {actions[bad].tolist()}")
+        self.batch.nudge(self._dv)
+        return self.batch.step(dt), self._cost
+
+    def finish(self, flags: np.ndarray, imp: np.ndarray, cost: np.ndarray, out=None):
+        """Read the engine back and run the task kernel. Returns (obs, reward, term, trunc, success, n_hit, energy)."""
+        B = self.num_scenes
+        self.pos = self.batch.positions
+        self.vel = self.batch.velocities
+        self.time = self.batch.time
+        if out is None:
+            out = (np.zeros((B, self.obs_dim), dtype=np.float32), np.zeros(B), np.zeros(B, dtype=bool),
+                   np.zeros(B, dtype=bool), np.zeros(B, dtype=bool), np.zeros(B, dtype=np.int64), np.zeros(B))
+        obs, reward, term, trunc, success, n_hit, energy = out
+        clusters = self.batch.clusters if self.Q[K.Q_CLUSTER] else self.body
+        K.task_kernel(flags, imp, self.t_wall, self.t_geo, self.t_status, self.cur, self.qual, self.body,
+                      clusters, self.pos, self.vel, self.masses, self.radii, self.time, self.steps, cost, self.phi,
+                      self.P, self.Q, obs, reward, term, trunc, success, n_hit, energy)
+        return out
+
+    def empty_impacts(self) -> np.ndarray:
+        """A fresh zero-length impact record array (the engine's dtype)."""
+        return np.empty(0, dtype=self.impact_dtype)
+
+    # ------------------------------------------------------------------------------------- #
+    _TASK_FIELDS = ("masses", "radii", "t_wall", "t_geo", "t_status", "cur", "body", "steps", "phi",
+                    "pos", "vel", "time")
+
+    def get_state(self) -> dict:
+        state = {name: getattr(self, name).copy() for name in self._TASK_FIELDS}
+        state["engine"] = self.batch.get_state()
+        return state
+
+    def set_state(self, state: dict) -> None:
+        self.batch.set_state(state["engine"])
+        for name in self._TASK_FIELDS:
+            arr = np.asarray(state[name])
+            if arr.shape != getattr(self, name).shape:
+                raise ValueError(f"set_state: field {name!r} has shape {arr.shape}, "
+                                 f"expected {getattr(self, name).shape}")
+            setattr(self, name, arr.astype(getattr(self, name).dtype, copy=True))

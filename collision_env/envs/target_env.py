@@ -1,0 +1,217 @@
+"""The generic collision-target environment: every preset is a configuration of this class."""
+
+from __future__ import annotations
+
+import copy
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from collision_env.envs._config import PRESETS, TaskConfig, make_config
+from collision_env.envs._core import Impacts, TaskCore
+
+_CLASS_PRESET = "__class_preset__"
+
+
+class CollisionTargetEnv(gym.Env):
+    """
+    ## Description
+
+    Balls move in PhET Collision Lab's play area under a time-of-impact-exact collision engine
+    (`collision_env.engine`). The agent **nudges the velocities** of the balls it controls, once
+    per control step, and is rewarded when a scoring ball's **wall impact**, as the engine
+    reports it (exact time and contact point), lands on a **target**: a wall segment (wall,
+    centre, width), in some tasks only inside a time window. This class is the generic,
+    configurable task: `gym.make("CollisionEnv/Target-v0", preset=..., **fields)`; each registered
+    preset (`OneBallTarget`, `Line1D`, `Billiards`, `InelasticCluster`) is one configuration of it
+    (`collision_env.envs.PRESETS`), and any field of `TaskConfig` can be overridden by keyword.
+
+    ## Action Space
+
+    `Box(-1, 1, (len(controlled) * dimension,), float32)`: for each controlled ball in order,
+    (ax, ay) in 2D or ax in 1D. Component `a` becomes a velocity change `a * max_dv` (m/s),
+    applied as an impulse at the start of the step. **Out-of-range actions are clipped** to
+    [-1, 1]; an action containing NaN raises `ValueError`. A nudge never raises a ball's speed above
+    `max(max_speed, its current speed)` (the change is scaled back along the new velocity).
+
+    ## Observation Space
+
+    `Box(-1, 1, (D,), float32)` with a fixed layout, `D = 6 N + 10 S + 2` (N balls, S target slots:
+    1 when targets are sequential, else `n_targets`). Centre and half-size of the play area are
+    (xc, yc), (xh, yh); `vs = 2 * max_speed`. Every entry is clipped to [-1, 1].
+
+    | Index            | Observation                                                     |
+    |------------------|-----------------------------------------------------------------|
+    | 6i + 0, 6i + 1   | ball i position: (x - xc) / xh, (y - yc) / yh                   |
+    | 6i + 2, 6i + 3   | ball i velocity: vx / vs, vy / vs (0 for y in 1D)               |
+    | 6i + 4           | ball i mass / 3 kg                                              |
+    | 6i + 5           | 1 if ball i's wall impacts currently score, else 0              |
+    | 6N + 10s + 0, 1  | target s centre point, normalised like positions                |
+    | 6N + 10s + 2     | target s half width / half length of its wall                   |
+    | 6N + 10s + 3..6  | target s wall one-hot (left, right, bottom, top)                |
+    | 6N + 10s + 7     | target s status: 1 pending, 0 hit, -1 failed (window closed)    |
+    | 6N + 10s + 8, 9  | (window open - t) / time_limit, (window close - t) / time_limit |
+    | D - 2            | fraction of the episode's control steps left                    |
+    | D - 1            | fraction of targets not yet hit                                 |
+
+    With sequential targets the single slot shows the current target. Targets without a window
+    read -1 and 1 in the window entries.
+
+    ## Rewards
+
+    Per step: `hit_reward` per target hit, `+ success_bonus` when the last target is hit,
+    `- miss_penalty` per wall impact of a scoring ball that hits no target,
+    `- action_cost * sum |requested dv|` (m/s), and, when `shaping > 0` and no target was hit this
+    step, `shaping * (phi(s') - phi(s))` where `-phi` is the distance (over the play-area diagonal)
+    from the nearest point where a scoring ball would touch the border if it flew straight on to the
+    nearest visible pending target (a potential-based aiming heuristic that ignores other balls).
+
+    ## Starting State
+
+    Drawn from `self.np_random` at every reset: masses uniform in `mass_range`, radii by
+    `radius`, positions without overlap by `layout`, speeds uniform in `speed_range` (controlled)
+    and `others_speed_range` (others) in random directions; `n_targets` targets on random walls among
+    `target_walls` at random centres (the whole end wall in 1D), with time windows of length
+    `window` at random times if the task has them. The engine's time starts at 0.
+
+    ## Episode End
+
+    - Termination: every target hit (`info["is_success"] = True`), or a target's time window
+      closed before it was hit (`is_success = False`).
+    - Truncation: after `round(time_limit / dt)` control steps (also the registered
+      `max_episode_steps`; if you change `dt`, pass `max_episode_steps` to `gym.make` to match).
+
+    ## Info
+
+    `impacts` (`Impacts`: every wall and ball-ball impact of the step, exact time, balls, wall and
+    contact point), `event_cap` (the engine's per-step event cap stopped the step early),
+    `energy` (kinetic energy, J), `time` (simulated time, s), `targets_hit` (so far),
+    `is_success`. Fresh objects on every call.
+
+    ## Arguments
+
+    `preset` (a name in `PRESETS`, or `None` for the bare `TaskConfig` defaults), any
+    `TaskConfig` field (among them the engine's `mode`, `substeps`, `max_events` and the control
+    step `dt`), `render_mode` ("rgb_array" or "human"), `trails` (draw ball trails).
+    Bad values raise `ValueError` at construction.
+    """
+
+    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 20}
+    preset: str | None = "one_ball"
+
+    def __init__(self, preset: str | None = _CLASS_PRESET, render_mode: str | None = None, trails: bool = False,
+                 **overrides: Any):
+        if preset is _CLASS_PRESET:
+            preset = type(self).preset
+        self.config: TaskConfig = make_config(preset, **overrides)
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"render_mode: expected one of {self.metadata['render_modes']} or None, "
+                             f"got {render_mode!r}")
+        self.render_mode = render_mode
+        self.metadata = {**type(self).metadata, "render_fps": max(1, int(round(1.0 / self.config.dt)))}
+        self._core = TaskCore(self.config, 1)
+        cfg = self.config
+        self.action_space = spaces.Box(-1.0, 1.0, (cfg.action_dim,), np.float32)
+        self.observation_space = spaces.Box(-1.0, 1.0, (cfg.obs_dim,), np.float32)
+        self._ones = np.ones(1, dtype=bool)
+        self._reset_flag = np.zeros(1, dtype=np.int8)
+        self._step_flag = np.ones(1, dtype=np.int8)
+        self._zero_cost = np.zeros(1)
+        self._adim = cfg.action_dim
+        self._dt = cfg.dt
+        # scalar outputs are read into Python values at once, so their buffers are reused
+        self._scratch = (np.zeros(1), np.zeros(1, dtype=bool), np.zeros(1, dtype=bool), np.zeros(1, dtype=bool),
+                         np.zeros(1, dtype=np.int64), np.zeros(1))
+        self._trails = bool(trails)
+        self._renderer = None
+
+    def _out(self):
+        return (np.empty((1, self._core.obs_dim), dtype=np.float32), *self._scratch)
+
+    # ------------------------------------------------------------------------------------- #
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        super().reset(seed=seed)
+        core = self._core
+        core.reset_scenes(np.zeros(1, dtype=np.int64), [self.np_random])
+        imp = core.empty_impacts()
+        obs, _, _, _, _, n_hit, energy = core.finish(self._reset_flag, imp, self._zero_cost, out=self._out())
+        info = {"impacts": Impacts(imp), "event_cap": False, "energy": float(energy[0]),
+                "time": float(core.time[0]), "targets_hit": int(n_hit[0]), "is_success": False}
+        if self._renderer is not None:
+            self._renderer.start()
+        if self.render_mode == "human":
+            self.render()
+        return obs[0], info
+
+    def step(self, action):
+        a = np.asarray(action, dtype=np.float64)
+        if a.size != self._adim:
+            raise ValueError(f"action: expected shape {self.action_space.shape}, got {a.shape}")
+        core = self._core
+        imp, cost = core.advance(a.reshape(1, self._adim), self._ones, self._dt)  # raises on NaN
+        obs, reward, term, trunc, success, n_hit, energy = core.finish(self._step_flag, imp, cost, out=self._out())
+        info = {"impacts": Impacts(imp), "event_cap": bool(core.batch.cap_reached[0]),
+                "energy": float(energy[0]), "time": float(core.time[0]), "targets_hit": int(n_hit[0]),
+                "is_success": bool(success[0])}
+        if self._renderer is not None:
+            self._renderer.record(core, 0, imp)
+        if self.render_mode == "human":
+            self.render()
+        return obs[0], float(reward[0]), bool(term[0]), bool(trunc[0]), info
+
+    # ------------------------------------------------------------------------------------- #
+    def render(self):
+        if self.render_mode is None:
+            env_id = self.spec.id if self.spec is not None else "..."
+            gym.logger.warn(
+                "You are calling render method without specifying any render mode. You can specify the "
+                f'render_mode at initialization, e.g. gym.make("{env_id}", render_mode="rgb_array")'
+            )
+            return None
+        if self._renderer is None:
+            from collision_env.envs.rendering import Renderer
+
+            self._renderer = Renderer(self.config, trails=self._trails)
+            self._renderer.start()
+        frame = self._renderer.draw(self._core, 0)
+        if self.render_mode == "human":
+            self._renderer.show(frame, self.metadata["render_fps"])
+            return None
+        return frame
+
+    def close(self):
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+    # ------------------------------------------------------------------------------------- #
+    def get_state(self) -> dict:
+        """A snapshot of the whole env (engine, task, RNG) that :meth:`set_state` restores exactly."""
+        return {"core": self._core.get_state(), "rng": copy.deepcopy(self.np_random.bit_generator.state)}
+
+    def set_state(self, state: dict) -> None:
+        self._core.set_state(state["core"])
+        self.np_random.bit_generator.state = copy.deepcopy(state["rng"])
+        if self._renderer is not None:
+            self._renderer.start()
+
+    def __getstate__(self):
+        state = self.__dict__.copy()
+        state["_renderer"] = None  # pygame surfaces and windows do not pickle; rebuilt on demand
+        return state
+
+    @property
+    def core(self) -> TaskCore:
+        """The batched task core (a batch of one): engine in ``core.batch``, task arrays alongside."""
+        return self._core
+
+    @property
+    def simulator(self):
+        """The engine's :class:`~collision_env.engine.BatchSimulator` (one scene) behind this env."""
+        return self._core.batch
+
+
+def preset_names() -> list:
+    return sorted(PRESETS)

@@ -1,0 +1,274 @@
+"""The native vector env: one BatchSimulator steps every sub-env at once (no loop over envs).
+
+It is step-for-step identical to ``gym.make_vec(id, n, vectorization_mode="sync")`` for the same seeds
+and actions, autoresets included: every sub-env owns its own ``np.random.Generator``, seeded as the
+single env would be (``seed + i``), and the per-step task logic is the same batched kernel the single
+env runs on a batch of one. Infos follow Gymnasium's vector layout (an array per key and a ``_key``
+mask) with one documented difference: ``info["impacts"]`` is a single :class:`Impacts` holding every
+sub-env's impacts with their index in the ``scene`` field (the sync vector env has an object array of
+per-env ``Impacts``); ``Impacts.for_scene(i)`` splits it.
+"""
+
+from __future__ import annotations
+
+import copy
+from typing import Any
+
+import numpy as np
+from gymnasium import spaces
+from gymnasium.utils import seeding
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+
+from collision_env.envs._config import TaskConfig, make_config
+from collision_env.envs._core import Impacts, TaskCore
+
+_CLASS_PRESET = "__class_preset__"
+_SCALAR_KEYS = ("event_cap", "energy", "time", "targets_hit", "is_success")
+
+
+class CollisionTargetVectorEnv(VectorEnv):
+    """``num_envs`` copies of :class:`~collision_env.envs.CollisionTargetEnv` on one batched engine.
+
+    Arguments: ``num_envs``, ``max_episode_steps`` (its own truncation, as ``TimeLimit`` does for the
+    single env; ``gym.make_vec`` passes the registered value), ``render_mode`` (``"rgb_array"``:
+    ``render()`` returns a tuple of frames), ``autoreset_mode`` (``AutoresetMode.NEXT_STEP``, the
+    default, or ``SAME_STEP``; also as the strings "NextStep"/"SameStep"), ``preset`` and any
+    ``TaskConfig`` field, as for the single env.
+
+    ``reset(seed=s)`` seeds sub-env i with ``s + i`` (a list gives one seed each; ``None`` keeps the
+    current generators); ``options={"reset_mask": mask}`` resets only the masked sub-envs.
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 20, "autoreset_mode": AutoresetMode.NEXT_STEP}
+    preset: str | None = "one_ball"
+
+    def __init__(self, num_envs: int = 1, max_episode_steps: int | None = None, render_mode: str | None = None,
+                 autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP, preset: str | None = _CLASS_PRESET,
+                 trails: bool = False, **overrides: Any):
+        if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
+            raise ValueError(f"num_envs: must be a positive integer, got {num_envs!r}")
+        if max_episode_steps is not None and (not isinstance(max_episode_steps, (int, np.integer))
+                                              or max_episode_steps < 1):
+            raise ValueError(f"max_episode_steps: must be a positive integer or None, got {max_episode_steps!r}")
+        try:
+            autoreset_mode = AutoresetMode(autoreset_mode)
+        except ValueError:
+            raise ValueError(f"autoreset_mode: expected NEXT_STEP or SAME_STEP, got {autoreset_mode!r}") from None
+        if autoreset_mode not in (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP):
+            raise ValueError(f"autoreset_mode: {autoreset_mode} is not supported (NEXT_STEP or SAME_STEP)")
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"render_mode: expected 'rgb_array' or None, got {render_mode!r}")
+        if preset is _CLASS_PRESET:
+            preset = type(self).preset
+        self.config: TaskConfig = make_config(preset, **overrides)
+        cfg = self.config
+        self.num_envs = int(num_envs)
+        self.max_episode_steps = None if max_episode_steps is None else int(max_episode_steps)
+        self.render_mode = render_mode
+        self.autoreset_mode = autoreset_mode
+        self.metadata = {**type(self).metadata, "autoreset_mode": autoreset_mode,
+                         "render_fps": max(1, int(round(1.0 / cfg.dt)))}
+        self.single_action_space = spaces.Box(-1.0, 1.0, (cfg.action_dim,), np.float32)
+        self.single_observation_space = spaces.Box(-1.0, 1.0, (cfg.obs_dim,), np.float32)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+
+        self._core = TaskCore(cfg, self.num_envs)
+        self._rngs: list = [None] * self.num_envs
+        self._rng_seeds: list = [None] * self.num_envs
+        self._autoreset = np.zeros(self.num_envs, dtype=bool)
+        self._all = np.ones(self.num_envs, dtype=bool)
+        self._trails = bool(trails)
+        self._renderers = None
+
+    # ------------------------------------------------------------------------------------- #
+    def _seed_envs(self, seed, mask) -> None:
+        n = self.num_envs
+        if seed is None:
+            seeds = [None] * n
+        elif isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
+            seeds = [int(seed) + i for i in range(n)]
+        else:
+            seeds = list(seed)
+            if len(seeds) != n:
+                raise ValueError(f"seed: a list of seeds must have length num_envs={n}, got {len(seeds)}")
+        for i in np.flatnonzero(mask):
+            if seeds[i] is not None:
+                self._rngs[i], self._rng_seeds[i] = seeding.np_random(seeds[i])
+            elif self._rngs[i] is None:
+                self._rngs[i], self._rng_seeds[i] = seeding.np_random()
+        if isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
+            self._np_random, self._np_random_seed = seeding.np_random(int(seed))
+
+    def _info(self, energy, event_cap, success, n_hit, imp) -> dict:
+        n = self.num_envs
+        info = {"impacts": Impacts(imp), "_impacts": np.ones(n, dtype=bool)}
+        for key, value in (("event_cap", event_cap), ("energy", energy), ("time", self._core.time.copy()),
+                           ("targets_hit", n_hit), ("is_success", success)):
+            info[key] = value
+            info["_" + key] = np.ones(n, dtype=bool)
+        return info
+
+    def reset(self, *, seed: int | list | None = None, options: dict[str, Any] | None = None):
+        options = dict(options) if options else {}
+        mask = options.pop("reset_mask", None)
+        if mask is None:
+            mask = self._all
+        else:
+            if not isinstance(mask, np.ndarray) or mask.dtype != np.bool_ or mask.shape != (self.num_envs,):
+                raise ValueError(f"options['reset_mask']: expected a ({self.num_envs},) bool array, got {mask!r}")
+            if not mask.any():
+                raise ValueError("options['reset_mask']: must select at least one sub-env")
+        self._seed_envs(seed, mask)
+        idx = np.flatnonzero(mask)
+        core = self._core
+        core.reset_scenes(idx, [self._rngs[i] for i in idx])
+        flags = np.where(mask, 0, 3).astype(np.int8)  # the others are observed unchanged
+        imp = core.empty_impacts()
+        obs, _, _, _, success, n_hit, energy = core.finish(flags, imp, np.zeros(self.num_envs), out=self._fresh_out())
+        self._autoreset[mask] = False
+        if self._renderers is not None:
+            for i in idx:
+                self._renderers[i].start()
+        info = self._info(energy, np.zeros(self.num_envs, dtype=bool), success, n_hit, imp)
+        if not mask.all():  # a partial reset reports (and masks) only the sub-envs it reset
+            for key in _SCALAR_KEYS:
+                info[key] = np.where(mask, info[key], np.zeros_like(info[key]))
+                info["_" + key] = mask.copy()
+            info["_impacts"] = mask.copy()
+        return obs, info
+
+    def _fresh_out(self):
+        B, D = self.num_envs, self._core.obs_dim
+        return (np.zeros((B, D), dtype=np.float32), np.zeros(B), np.zeros(B, dtype=bool), np.zeros(B, dtype=bool),
+                np.zeros(B, dtype=bool), np.zeros(B, dtype=np.int64), np.zeros(B))
+
+    def step(self, actions):
+        a = np.asarray(actions, dtype=np.float64)
+        if a.shape != self.action_space.shape:
+            raise ValueError(f"actions: expected shape {self.action_space.shape}, got {a.shape}")
+        if np.isnan(a).any():
+            bad = np.flatnonzero(np.isnan(a).any(-1))
+            raise ValueError(f"actions: NaN in the action of sub-env(s) {bad.tolist()}")
+        core = self._core
+        B = self.num_envs
+        cap_limit = self.max_episode_steps
+        if self.autoreset_mode == AutoresetMode.NEXT_STEP:
+            resetting = self._autoreset
+            any_reset = bool(resetting.any())
+            active = ~resetting if any_reset else self._all
+            imp, cost = core.advance(a, active, self.config.dt)
+            event_cap = core.batch.cap_reached
+            if any_reset:
+                idx = np.flatnonzero(resetting)
+                core.reset_scenes(idx, [self._rngs[i] for i in idx])
+                flags = active.astype(np.int8)
+                imp = imp[active[imp["scene"]]]
+                event_cap &= active
+            else:
+                flags = np.ones(B, dtype=np.int8)
+            obs, reward, term, trunc, success, n_hit, energy = core.finish(flags, imp, cost, out=self._fresh_out())
+            if cap_limit is not None:
+                trunc |= (core.steps >= cap_limit) & active
+            self._autoreset = term | trunc
+            info = self._info(energy, event_cap, success, n_hit, imp)
+            if self._renderers is not None:
+                self._record(imp, resetting if any_reset else None)
+            return obs, reward, term, trunc, info
+
+        # SAME_STEP: step everything, then reset the sub-envs that ended and report their last step
+        imp, cost = core.advance(a, self._all, self.config.dt)
+        event_cap = core.batch.cap_reached
+        obs, reward, term, trunc, success, n_hit, energy = core.finish(
+            np.ones(B, dtype=np.int8), imp, cost, out=self._fresh_out())
+        if cap_limit is not None:
+            trunc |= core.steps >= cap_limit
+        done = term | trunc
+        if self._renderers is not None:
+            self._record(imp, None)
+        if not done.any():
+            return obs, reward, term, trunc, self._info(energy, event_cap, success, n_hit, imp)
+        idx = np.flatnonzero(done)
+        in_done = done[imp["scene"]]
+        final_obs = np.full(B, None, dtype=object)
+        for i in idx:
+            final_obs[i] = obs[i].copy()
+        final_info = {"impacts": Impacts(imp[in_done]), "_impacts": done.copy()}
+        time_now = core.time.copy()
+        for key, value in (("event_cap", event_cap), ("energy", energy), ("time", time_now),
+                           ("targets_hit", n_hit), ("is_success", success)):
+            v = np.zeros_like(value)
+            v[done] = value[done]
+            final_info[key] = v
+            final_info["_" + key] = done.copy()
+        core.reset_scenes(idx, [self._rngs[i] for i in idx])
+        flags = np.where(done, 0, 2).astype(np.int8)
+        r_out = (obs, np.zeros(B), np.zeros(B, dtype=bool), np.zeros(B, dtype=bool), np.zeros(B, dtype=bool),
+                 np.zeros(B, dtype=np.int64), np.zeros(B))
+        _, _, _, _, r_success, r_hit, r_energy = core.finish(flags, imp[:0], np.zeros(B), out=r_out)
+        event_cap = event_cap & ~done
+        energy = np.where(done, r_energy, energy)
+        success = success & ~done
+        n_hit = np.where(done, r_hit, n_hit)
+        info = self._info(energy, event_cap, success, n_hit, imp[~in_done])
+        info["final_obs"] = final_obs
+        info["_final_obs"] = done.copy()
+        info["final_info"] = final_info
+        info["_final_info"] = done.copy()
+        if self._renderers is not None:
+            for i in idx:
+                self._renderers[i].start()
+        return obs, reward, term, trunc, info
+
+    # ------------------------------------------------------------------------------------- #
+    def _record(self, imp, skip) -> None:
+        for i, r in enumerate(self._renderers):
+            if skip is not None and skip[i]:
+                r.start()
+            else:
+                r.record(self._core, i, imp[imp["scene"] == i])
+
+    def render(self):
+        """A tuple with one ``(H, W, 3)`` uint8 frame per sub-env (``render_mode="rgb_array"``)."""
+        if self.render_mode is None:
+            return None
+        if self._renderers is None:
+            from collision_env.envs.rendering import Renderer
+
+            self._renderers = [Renderer(self.config, trails=self._trails) for _ in range(self.num_envs)]
+            for r in self._renderers:
+                r.start()
+        return tuple(r.draw(self._core, i) for i, r in enumerate(self._renderers))
+
+    def close_extras(self, **kwargs: Any) -> None:
+        if self._renderers is not None:
+            for r in self._renderers:
+                r.close()
+            self._renderers = None
+
+    # ------------------------------------------------------------------------------------- #
+    def get_state(self) -> dict:
+        """Engine, task arrays, autoreset flags and every sub-env's RNG state."""
+        return {"core": self._core.get_state(), "autoreset": self._autoreset.copy(),
+                "rngs": [None if g is None else copy.deepcopy(g.bit_generator.state) for g in self._rngs]}
+
+    def set_state(self, state: dict) -> None:
+        self._core.set_state(state["core"])
+        self._autoreset = np.asarray(state["autoreset"], dtype=bool).copy()
+        for i, st in enumerate(state["rngs"]):
+            if st is None:
+                self._rngs[i] = None
+            else:
+                if self._rngs[i] is None:
+                    self._rngs[i] = np.random.Generator(np.random.PCG64())
+                self._rngs[i].bit_generator.state = copy.deepcopy(st)
+
+    def __getstate__(self):
+        state = self.__dict__.copy()
+        state["_renderers"] = None
+        return state
+
+    @property
+    def core(self) -> TaskCore:
+        return self._core
