@@ -416,15 +416,18 @@ def _scene(
 @njit
 def step_exact(
     pos, vel, mass, inv_mass, radius, body, omega, time, remaining, events, active,
-    fparams, iparams, imp, n_imp, stalled, capped, counters,
+    fparams, iparams, imp, n_imp, stalled, capped, counters, dt_abs, fresh,
 ):
     """Advance every active scene of the batch by its ``remaining`` time (see module doc).
 
     ``fparams`` = (xmin, ymin, xmax, ymax, e, collapse_ratio, sign, collapse_floor);
     ``iparams`` = (has_walls, pairs, dim, sticky, max_events).
+    ``fresh`` starts a step of ``dt_abs`` for every scene (all active, ``remaining = dt_abs``, no
+    events yet); otherwise the call resumes the scenes flagged ``active``.
     Impacts go to ``imp`` rows (scene, time, ball, other, wall, x, y, speed), ``n_imp[0]`` rows so
     far; a scene that finds the buffer full stops where it is and is flagged in ``stalled``, so
-    the caller can empty the buffer and call again for those scenes.
+    the caller can empty the buffer and call again for those scenes. Returns the number of
+    stalled scenes; ``n_imp[1]`` counts the scenes that reached the event cap.
     """
     n_scenes = pos.shape[0]
     n = pos.shape[1]
@@ -443,6 +446,14 @@ def step_exact(
     c_a = np.empty(n_contacts, dtype=np.int64)
     c_b = np.empty(n_contacts, dtype=np.int64)
     c_hit = np.empty(n_contacts, dtype=np.bool_)
+    if fresh:
+        for sc in range(n_scenes):
+            active[sc] = True
+            remaining[sc] = dt_abs
+            events[sc] = 0
+            capped[sc] = False
+        n_imp[1] = 0
+    n_stalled = 0
     for sc in range(n_scenes):
         if not active[sc]:
             continue
@@ -453,3 +464,7 @@ def step_exact(
             iparams[3] != 0, iparams[4], imp, n_imp, stalled, capped, counters,
             pt, rmin, rarg, wt, wid, involved, flag, ki, kj, in_group, c_a, c_b, c_hit,
         )
+        n_stalled += stalled[sc]
+        n_imp[1] += capped[sc]
+        active[sc] = stalled[sc]
+    return n_stalled

@@ -271,10 +271,10 @@ class BatchSimulator:
         b = self._n_scenes
         rows = max(4096, 2 * worst_case_impacts(self._n))
         self._imp = np.empty((rows, 8))
-        self._n_imp = np.zeros(1, dtype=np.int64)
+        self._n_imp = np.zeros(2, dtype=np.int64)  # rows filled, scenes that reached the cap
         self._remaining = np.empty(b)
         self._events = np.empty(b, dtype=np.int64)
-        self._active = np.empty(b, dtype=np.bool_)
+        self._active = np.zeros(b, dtype=np.bool_)
         self._stalled = np.zeros(b, dtype=np.bool_)
         self._t_start = np.empty(b)
         self._done = np.empty(b, dtype=np.int64)
@@ -294,8 +294,8 @@ class BatchSimulator:
         e = self.scene.elasticity
         if dt < 0.0 and e == 0.0:
             raise ValueError("dt: cannot step backwards with elasticity 0 (a perfectly inelastic collision has no inverse)")
-        self._capped[:] = False
         if dt == 0.0:
+            self._capped[:] = False
             return np.zeros(0, dtype=IMPACT_DTYPE)
         sign = 1.0 if dt > 0.0 else -1.0
         fp = self._fparams
@@ -310,7 +310,7 @@ class BatchSimulator:
             if sign < 0:
                 np.negative(self._vel, out=self._vel)
                 np.negative(self._omega, out=self._omega)
-        if self._capped.any():
+        if self._n_imp[1]:
             warnings.warn(
                 f"event cap of {self.max_events} per step reached in scene(s) {np.flatnonzero(self._capped).tolist()}; "
                 "they stopped early at their last event (see cap_reached and time)",
@@ -320,32 +320,28 @@ class BatchSimulator:
         return self._impacts(chunks, sign)
 
     def _run(self, dt_abs):
-        active = self._active
-        active[:] = True
         chunks = []
-        self._n_imp[0] = 0
-        if self.mode == "exact":
-            self._remaining[:] = dt_abs
-            self._events[:] = 0
-        else:
-            np.copyto(self._t_start, self._time)
-            self._done[:] = 0
+        fresh = True
         while True:
+            self._n_imp[0] = 0
             if self.mode == "exact":
-                step_exact(self._pos, self._vel, self._mass, self._inv_mass, self._radius, self._body, self._omega,
-                           self._time, self._remaining, self._events, active, self._fparams, self._iparams,
-                           self._imp, self._n_imp, self._stalled, self._capped, self._counters)
+                stalled = step_exact(
+                    self._pos, self._vel, self._mass, self._inv_mass, self._radius, self._body, self._omega,
+                    self._time, self._remaining, self._events, self._active, self._fparams, self._iparams,
+                    self._imp, self._n_imp, self._stalled, self._capped, self._counters, dt_abs, fresh,
+                )
             else:
-                step_substeps(NAIVE if self.mode == "naive" else POSTERIORI, self._pos, self._vel, self._mass,
-                              self._inv_mass, self._radius, self._body, self._omega, self._time, self._t_start,
-                              self._done, active, self._fparams, self._iparams, dt_abs, self.substeps,
-                              self._imp, self._n_imp, self._stalled, self._counters)
+                stalled = step_substeps(
+                    NAIVE if self.mode == "naive" else POSTERIORI, self._pos, self._vel, self._mass,
+                    self._inv_mass, self._radius, self._body, self._omega, self._time, self._t_start, self._done,
+                    self._active, self._fparams, self._iparams, dt_abs, self.substeps, self._imp, self._n_imp,
+                    self._stalled, self._counters, fresh,
+                )
             if self._n_imp[0]:
                 chunks.append(self._imp[: self._n_imp[0]].copy())
-                self._n_imp[0] = 0
-            if not self._stalled.any():
+            if not stalled:
                 return chunks
-            np.copyto(active, self._stalled)
+            fresh = False
 
     @staticmethod
     def _impacts(chunks, sign):

@@ -19,12 +19,13 @@ def worst_case_impacts(n):
 @njit
 def step_substeps(
     mode, pos, vel, mass, inv_mass, radius, body, omega, time, t_start, done, active,
-    fparams, iparams, dt_abs, k_total, imp, n_imp, stalled, counters,
+    fparams, iparams, dt_abs, k_total, imp, n_imp, stalled, counters, fresh,
 ):
     """Run the remaining sub-steps of every active scene (``done[sc]`` of ``k_total`` are done).
 
-    Parameters as :func:`exact.step_exact`; a scene stops between sub-steps when the impact
-    buffer could not hold another sub-step's worst case, and is flagged in ``stalled``.
+    Parameters as :func:`exact.step_exact` (``fresh`` starts a step for every scene); a scene
+    stops between sub-steps when the impact buffer could not hold another sub-step's worst case,
+    and is flagged in ``stalled``. Returns the number of stalled scenes.
     """
     n = pos.shape[1]
     worst = n * (n - 1) // 2 + 4 * n
@@ -38,6 +39,13 @@ def step_substeps(
     dim = iparams[2]
     sticky = iparams[3] != 0
     h = dt_abs / k_total
+    if fresh:
+        for sc in range(pos.shape[0]):
+            active[sc] = True
+            t_start[sc] = time[sc]
+            done[sc] = 0
+        n_imp[1] = 0
+    n_stalled = 0
     for sc in range(pos.shape[0]):
         if not active[sc]:
             continue
@@ -63,3 +71,6 @@ def step_substeps(
                                    has_walls, pairs, sticky, imp, n_imp, counters)
             done[sc] = k
             time[sc] = t_end
+        n_stalled += stalled[sc]
+        active[sc] = stalled[sc]
+    return n_stalled
