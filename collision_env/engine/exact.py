@@ -138,10 +138,12 @@ def _rescan(i, pt, rmin, rarg):
 
 
 @njit
-def _gap_pair(a, k, pos, radius):
+def _touching(a, k, pos, radius):
+    """Balls ``a`` and ``k`` touch within the contact tolerance."""
     dx = pos[k, 0] - pos[a, 0]
     dy = pos[k, 1] - pos[a, 1]
-    return math.sqrt(dx * dx + dy * dy) - radius[a] - radius[k]
+    scale = radius[a] + radius[k] + abs(pos[a, 0]) + abs(pos[a, 1]) + abs(pos[k, 0]) + abs(pos[k, 1])
+    return math.sqrt(dx * dx + dy * dy) - radius[a] - radius[k] <= _CONTACT_TOL * scale
 
 
 @njit
@@ -153,10 +155,10 @@ def _resolve_contact_group(
 
     At e < 1 an impact inside a touching group (a train pressed against a wall, a crowd) starts a
     cascade of ever smaller impulses at the same instant: sequential impulses converge to the
-    limit geometrically. Running that cascade here, over the group's contact list in a fixed
-    order, gives the same sequence of pairwise impulses as the event loop would, without
-    re-predicting every ball after each impulse; the collapse regulariser ends it. Contacts are
-    gaps within ``_CONTACT_TOL`` of zero. Every contact that takes an impulse is reported once.
+    limit geometrically. This runs that cascade here: sweeps over the group's contacts in a fixed
+    order apply the same pairwise impulses as the event loop would, one after another, without
+    re-predicting every ball after each; the collapse regulariser ends it. Contacts are gaps
+    within ``_CONTACT_TOL`` of zero. Every contact that takes an impulse is reported once.
     Returns the group size (its balls are in ``group``).
     """
     n = pos.shape[0]
@@ -168,38 +170,36 @@ def _resolve_contact_group(
             group[size] = start
             in_group[start] = True
             size += 1
-    n_contacts = 0
+    # the group: everything connected to the impact through contacts
     q = 0
-    while q < size:
+    while q < size and pairs:
         a = group[q]
         q += 1
-        scale = _CONTACT_TOL * (2.0 * radius[a] + abs(pos[a, 0]) + abs(pos[a, 1]))
+        for k in range(n):
+            if not in_group[k] and _touching(a, k, pos, radius):
+                group[size] = k
+                in_group[k] = True
+                size += 1
+    # its contacts, each once, in a fixed order
+    n_contacts = 0
+    for qa in range(size):
+        a = group[qa]
         if pairs:
-            for k in range(n):
-                if k == a:
-                    continue
-                if _gap_pair(a, k, pos, radius) <= scale + _CONTACT_TOL * (radius[k] + abs(pos[k, 0]) + abs(pos[k, 1])):
-                    if not in_group[k]:
-                        group[size] = k
-                        in_group[k] = True
-                        size += 1
-                        c_a[n_contacts] = a
-                        c_b[n_contacts] = k
-                        c_hit[n_contacts] = False
-                        n_contacts += 1
-                    elif k > a or not in_group[k]:
-                        c_a[n_contacts] = min(a, k)
-                        c_b[n_contacts] = max(a, k)
-                        c_hit[n_contacts] = False
-                        n_contacts += 1
+            for qb in range(qa + 1, size):
+                k = group[qb]
+                if _touching(a, k, pos, radius):
+                    c_a[n_contacts] = min(a, k)
+                    c_b[n_contacts] = max(a, k)
+                    c_hit[n_contacts] = False
+                    n_contacts += 1
         if has_walls:
+            scale = _CONTACT_TOL * (2.0 * radius[a] + abs(pos[a, 0]) + abs(pos[a, 1]))
             for wall in range(4 if dim == 2 else 2):
                 if wall_gap(a, wall, pos, radius, bounds) <= scale:
                     c_a[n_contacts] = a
                     c_b[n_contacts] = -1 - wall
                     c_hit[n_contacts] = False
                     n_contacts += 1
-    # the list may hold a pair twice (found from both ends): harmless, the second sees it receding
     for _ in range(_MAX_SWEEPS):
         changed = False
         for c in range(n_contacts):
@@ -212,7 +212,7 @@ def _resolve_contact_group(
             if speed > 0.0:
                 changed = True
                 counters[EVENTS] += 1
-                if not c_hit[c] and n_imp[0] < imp.shape[0]:
+                if not c_hit[c]:
                     c_hit[c] = True
                     if b >= 0:
                         dx = pos[b, 0] - pos[a, 0]
@@ -236,6 +236,7 @@ def _scene(
 ):
     n = pos.shape[0]
     cascades = e < 1.0  # forward inelastic: resolve touching groups at one instant
+    room = n * (n - 1) // 2 + 4 * n + 1  # the most impacts one event can record (a contact group)
     horizon_end = remaining[sc]
     t0 = time[sc]
     now = 0.0
@@ -282,7 +283,7 @@ def _scene(
         if events[sc] >= max_events:
             capped[sc] = True
             break
-        if n_imp[0] >= imp.shape[0]:
+        if n_imp[0] + room > imp.shape[0]:
             stalled[sc] = True
             break
         if best > now:
@@ -442,7 +443,7 @@ def step_exact(
     ki = np.empty(7)
     kj = np.empty(7)
     in_group = np.zeros(n, dtype=np.bool_)
-    n_contacts = n * (n - 1) + 4 * n
+    n_contacts = n * (n - 1) // 2 + 4 * n
     c_a = np.empty(n_contacts, dtype=np.int64)
     c_b = np.empty(n_contacts, dtype=np.int64)
     c_hit = np.empty(n_contacts, dtype=np.bool_)

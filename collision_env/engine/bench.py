@@ -1,0 +1,565 @@
+"""Engine benchmark: what each mode costs, against peers measured in the same run.
+
+Run it as::
+
+    python -m collision_env.engine.bench            # full run, a few minutes
+    python -m collision_env.engine.bench --quick    # about 30 s
+    python -m collision_env.engine.bench --json bench.json --markdown bench.md
+    python -m collision_env.engine.bench --render bench.json --markdown bench.md   # tables only
+
+It is not a test: it measures and prints. Three parts, each printed as a Markdown table:
+
+1. **Gas**: exact mode's events per second against the ``billiards`` package (PyPI 0.5.0, pure
+   Python, event-driven) on a 50-disk elastic gas (r = 0.02 in [-1, 1]^2, T = 20 s, the research
+   note's setup), both from the same initial state, once as a single long step and once in
+   frames of 1/60 s. The same section checks the trajectories: over a short horizon (about 3
+   collisions per ball, before chaos amplifies round-off) the collision sequences must be the
+   same, and it reports the largest position difference; at T = 20 s (about 30 collisions per
+   ball) it only reports how far the two chaotic runs drifted apart.
+2. **Per step**: microseconds per ``Simulator.step(1/60)`` for each mode (naive, posteriori with
+   1 and 4 substeps, exact) at 1, 2, 4, 16 and 64 balls in the default play area, with pymunk
+   (a C engine, impulse solver, no time of impact) stepping the same balls as a peer.
+3. **Batch**: scene-steps per second of one :class:`BatchSimulator` of 1024 scenes of 4 balls
+   against a Python loop over 1024 single :class:`Simulator` objects holding the same scenes
+   (and a check that both end in the same state).
+
+The machine is shared and noisy, so every figure is the best (and the median) of several
+repeats, and the figures that matter are the ratios, measured in the same run. Numba compile
+time is excluded: every kernel is warmed up before it is timed. ``--json`` writes the raw
+figures; ``--markdown`` writes the tables (from this run, or from ``--render``'s JSON file).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import platform
+import statistics
+import sys
+import time
+
+import numpy as np
+
+from . import BACKEND, PLAY_AREA_2D, BatchSimulator, Scene, Simulator
+
+GAS_N = 50
+GAS_RADIUS = 0.02
+GAS_HALF = 1.0
+GAS_T = 20.0
+GAS_CHECK_COLLISIONS_PER_BALL = 3
+FRAME = 1.0 / 60.0
+STEP_BALLS = (1, 2, 4, 16, 64)
+STEP_RADIUS = 0.05  # 64 balls of r = 0.05 fill 6 % of the 4 m x 2 m play area
+MODE_CONFIGS = (("naive", 1), ("posteriori", 1), ("posteriori", 4), ("exact", 1))
+BATCH_SCENES = 1024
+BATCH_BALLS = 4
+
+
+# ---------------------------------------------------------------------------------------- helpers
+def _repeat(fn, repeats, reset=None):
+    """Run ``fn()`` ``repeats`` times (after an untimed ``reset()``); return the durations (s)."""
+    out = []
+    for _ in range(repeats):
+        if reset is not None:
+            reset()
+        t0 = time.perf_counter()
+        fn()
+        out.append(time.perf_counter() - t0)
+    return out
+
+
+def _summary(durations, per=1.0):
+    """Best and median of ``durations`` divided by ``per`` (e.g. seconds per step)."""
+    return {"best": min(durations) / per, "median": statistics.median(durations) / per, "repeats": len(durations)}
+
+
+def random_balls(rng, n, bounds, radius, speed=1.0, gap=1.05):
+    """``n`` non-overlapping balls of ``radius`` inside ``bounds``, random directions at ``speed``.
+
+    Returns ``(positions (n, 2), velocities (n, 2))``; centres are at least ``gap * 2 radius`` apart.
+    """
+    xmin, ymin, xmax, ymax = bounds
+    pos = np.empty((n, 2))
+    for i in range(n):
+        for _ in range(100_000):
+            p = rng.uniform((xmin + radius, ymin + radius), (xmax - radius, ymax - radius))
+            if i == 0 or np.min(np.hypot(*(pos[:i] - p).T)) > 2.0 * radius * gap:
+                pos[i] = p
+                break
+        else:  # pragma: no cover - only for absurd densities
+            raise RuntimeError(f"could not place {n} balls of radius {radius} in {bounds}")
+    angle = rng.uniform(0.0, 2.0 * np.pi, n)
+    vel = speed * np.stack([np.cos(angle), np.sin(angle)], axis=1)
+    return pos, vel
+
+
+def _versions():
+    out = {"python": platform.python_version(), "numpy": np.__version__, "backend": BACKEND}
+    for name in ("numba", "billiards", "pymunk"):
+        try:
+            module = __import__(name)
+        except ImportError:
+            out[name] = None
+            continue
+        out[name] = str(getattr(module, "__version__", getattr(module, "version", "?")))
+    return out
+
+
+def _warm_up():
+    """Compile (or load from cache) every kernel the benchmark times, outside the timings."""
+    rng = np.random.default_rng(0)
+    for n in (1, 2, 4):
+        pos, vel = random_balls(rng, n, PLAY_AREA_2D, STEP_RADIUS)
+        for mode, k in MODE_CONFIGS:
+            sim = Simulator(Scene(), pos, vel, np.ones(n), radii=np.full(n, STEP_RADIUS), mode=mode, substeps=k)
+            for _ in range(5):
+                sim.step(FRAME)
+            sim.step(10.0)
+
+
+# ---------------------------------------------------------------------------------------- 1. gas
+def _billiards_box(billiards):
+    w = billiards.InfiniteWall
+    h = GAS_HALF
+    return [w((-h, -h), (h, -h)), w((h, -h), (h, h)), w((h, h), (-h, h)), w((-h, h), (-h, -h))]
+
+
+def _billiards_table(billiards, pos, vel, radius):
+    table = billiards.Billiard(_billiards_box(billiards))
+    for i in range(len(pos)):
+        table.add_ball(pos[i].copy(), vel[i].copy(), radius, 1.0)
+    return table
+
+
+def _billiards_pairs(events, billiards):
+    """Events as comparable keys: ``(i, j)`` for a ball pair, ``(i, -1)`` for a wall."""
+    out = []
+    for _, i, other in events:
+        if isinstance(other, billiards.obstacles.Obstacle):
+            out.append((int(i), -1))
+        else:
+            out.append((min(int(i), int(other)), max(int(i), int(other))))
+    return out
+
+
+def _our_pairs(impacts):
+    return [(h.ball, -1) if h.other is None else (min(h.ball, h.other), max(h.ball, h.other)) for h in impacts]
+
+
+def bench_gas(quick):
+    """Exact mode against billiards on the 50-disk gas; see the module doc."""
+    try:
+        import billiards
+    except ImportError:
+        return {"skipped": "billiards is not installed (pip install 'collision_env[peers]')"}
+    rng = np.random.default_rng(2024)
+    pos, vel = random_balls(rng, GAS_N, (-GAS_HALF, -GAS_HALF, GAS_HALF, GAS_HALF), GAS_RADIUS, gap=1.0001)
+    masses = np.ones(GAS_N)
+    radii = np.full(GAS_N, GAS_RADIUS)
+    scene = Scene(bounds=(-GAS_HALF, -GAS_HALF, GAS_HALF, GAS_HALF), elasticity=1.0)
+    n_frames = round(GAS_T / FRAME)
+    peer_repeats, our_repeats = (2, 5) if quick else (5, 20)
+
+    # billiards: the set-up (its O(N^2) first prediction) is outside the timing, as ours is
+    peer_result = {}
+
+    def peer_one_step():
+        table = peer_result["table"] = _billiards_table(billiards, pos, vel, GAS_RADIUS)
+        t0 = time.perf_counter()
+        peer_result["events"] = table.evolve(GAS_T)
+        return time.perf_counter() - t0
+
+    def peer_frames():
+        table = peer_result["frames_table"] = _billiards_table(billiards, pos, vel, GAS_RADIUS)
+        t0 = time.perf_counter()
+        count = 0
+        for k in range(1, n_frames + 1):
+            count += len(table.evolve(k * FRAME))
+        peer_result["frames_events"] = count
+        return time.perf_counter() - t0
+
+    ours = {}
+
+    def our_one_step():
+        sim = ours["sim"] = Simulator(scene, pos, vel, masses, radii=radii, mode="exact", max_events=10**7)
+        t0 = time.perf_counter()
+        ours["impacts"] = sim.step(GAS_T)
+        return time.perf_counter() - t0
+
+    def our_frames():
+        sim = ours["frames_sim"] = Simulator(scene, pos, vel, masses, radii=radii, mode="exact")
+        t0 = time.perf_counter()
+        for _ in range(n_frames):
+            sim.step(FRAME)
+        return time.perf_counter() - t0
+
+    our_one_step()  # warm-up
+    peer_t = [peer_one_step() for _ in range(peer_repeats)]
+    peer_frame_t = [peer_frames() for _ in range(max(1, peer_repeats - 1))]
+    our_t = [our_one_step() for _ in range(our_repeats)]
+    our_frame_t = [our_frames() for _ in range(our_repeats)]
+
+    peer_events = len(peer_result["events"])
+    our_events = ours["sim"].stats["events"]
+    our_frame_events = ours["frames_sim"].stats["events"]
+    peer_frame_events = peer_result["frames_events"]
+
+    # trajectory check over a short horizon (before chaos): same sequence, position difference
+    events = peer_result["events"]
+    involved = np.cumsum([1 if pair[1] < 0 else 2 for pair in _billiards_pairs(events, billiards)])
+    k = int(np.searchsorted(involved, GAS_CHECK_COLLISIONS_PER_BALL * GAS_N))
+    t_check = 0.5 * (events[k][0] + events[k + 1][0])
+    table = _billiards_table(billiards, pos, vel, GAS_RADIUS)
+    peer_short = table.evolve(t_check)
+    sim = Simulator(scene, pos, vel, masses, radii=radii, mode="exact")
+    our_short = sim.step(t_check)
+    same_sequence = _our_pairs(our_short) == _billiards_pairs(peer_short, billiards)
+    time_diff = (
+        max(abs(a.time - b[0]) for a, b in zip(our_short, peer_short, strict=True)) if same_sequence else None
+    )
+    check = {
+        "horizon_s": t_check,
+        "collisions_per_ball": float(involved[k - 1] / GAS_N) if k > 0 else 0.0,
+        "events": len(peer_short),
+        "same_sequence": same_sequence,
+        "max_time_diff_s": time_diff,
+        "max_position_diff_m": float(np.abs(sim.positions - table.balls_position).max()),
+        "max_velocity_diff_m_s": float(np.abs(sim.velocities - table.balls_velocity).max()),
+    }
+    # at the full horizon the runs are chaotic: report the drift, and how long the sequences agree
+    long_ours = _our_pairs(ours["impacts"])
+    long_peer = _billiards_pairs(events, billiards)
+    agree = (i for i, (a, b) in enumerate(zip(long_ours, long_peer, strict=False)) if a != b)
+    prefix = next(agree, min(len(long_ours), len(long_peer)))
+    full = {
+        "horizon_s": GAS_T,
+        "collisions_per_ball": float(involved[-1] / GAS_N),
+        "events_ours": our_events,
+        "events_billiards": peer_events,
+        "sequences_agree_for_events": prefix,
+        "max_position_diff_m": float(np.abs(ours["sim"].positions - peer_result["table"].balls_position).max()),
+    }
+    rows = []
+    for label, ours_t, ours_n, peer_t_, peer_n in (
+        ("one step of 20 s", our_t, our_events, peer_t, peer_events),
+        ("1200 frames of 1/60 s", our_frame_t, our_frame_events, peer_frame_t, peer_frame_events),
+    ):
+        o = _summary(ours_t)
+        p = _summary(peer_t_)
+        rows.append({
+            "how": label,
+            "ours_events": int(ours_n),
+            "ours_s": o,
+            "ours_events_per_s": ours_n / o["best"],
+            "billiards_events": int(peer_n),
+            "billiards_s": p,
+            "billiards_events_per_s": peer_n / p["best"],
+            "speedup_best": (ours_n / o["best"]) / (peer_n / p["best"]),
+            "speedup_median": (ours_n / o["median"]) / (peer_n / p["median"]),
+        })
+    return {"n": GAS_N, "radius": GAS_RADIUS, "box": [-GAS_HALF, GAS_HALF], "rows": rows, "check": check,
+            "full_horizon": full}
+
+
+# ---------------------------------------------------------------------------------------- 2. per step
+def _pymunk_space(pymunk, pos, vel, radius, bounds):
+    space = pymunk.Space()
+    space.gravity = (0.0, 0.0)
+    xmin, ymin, xmax, ymax = bounds
+    corners = [(xmin, ymin), (xmax, ymin), (xmax, ymax), (xmin, ymax)]
+    for a, b in zip(corners, corners[1:] + corners[:1], strict=True):
+        seg = pymunk.Segment(space.static_body, a, b, 0.0)
+        seg.elasticity = 1.0
+        seg.friction = 0.0
+        space.add(seg)
+    for p, v in zip(pos, vel, strict=True):
+        body = pymunk.Body(1.0, pymunk.moment_for_circle(1.0, 0.0, radius))
+        body.position = tuple(p)
+        body.velocity = tuple(v)
+        shape = pymunk.Circle(body, radius)
+        shape.elasticity = 1.0
+        shape.friction = 0.0
+        space.add(body, shape)
+    return space
+
+
+def bench_per_step(quick):
+    """Microseconds per ``step(1/60)`` of each mode at each ball count (and pymunk's)."""
+    try:
+        import pymunk
+    except ImportError:
+        pymunk = None
+    steps, repeats = (100, 3) if quick else (600, 7)
+    rng = np.random.default_rng(7)
+    rows = []
+    for n in STEP_BALLS:
+        pos, vel = random_balls(rng, n, PLAY_AREA_2D, STEP_RADIUS)
+        masses = rng.uniform(0.5, 2.0, n)
+        radii = np.full(n, STEP_RADIUS)
+        row = {"balls": n, "steps": steps, "modes": {}}
+        for mode, k in MODE_CONFIGS:
+            sim = Simulator(Scene(), pos, vel, masses, radii=radii, mode=mode, substeps=k)
+            start = sim.get_state()
+            for _ in range(3):
+                sim.step(FRAME)
+            impacts = [0]
+
+            def reset(sim=sim, start=start, impacts=impacts):
+                sim.set_state(start)
+                impacts[0] = 0
+
+            def run(sim=sim, impacts=impacts):
+                for _ in range(steps):
+                    impacts[0] += len(sim.step(FRAME))
+
+            before = sim.stats["events"]
+            s = _summary(_repeat(run, repeats, reset), per=steps / 1e6)
+            s["impacts_per_step"] = impacts[0] / steps
+            s["events_per_step"] = (sim.stats["events"] - before) / (steps * repeats)
+            row["modes"][f"{mode}/{k}"] = s
+        if pymunk is not None:
+            space = _pymunk_space(pymunk, pos, vel, STEP_RADIUS, PLAY_AREA_2D)
+            for _ in range(3):
+                space.step(FRAME)
+
+            def run_pymunk(space=space):
+                for _ in range(steps):
+                    space.step(FRAME)
+
+            row["modes"]["pymunk"] = _summary(_repeat(run_pymunk, repeats), per=steps / 1e6)
+        rows.append(row)
+    return {"dt": FRAME, "radius": STEP_RADIUS, "bounds": list(PLAY_AREA_2D), "rows": rows}
+
+
+# ---------------------------------------------------------------------------------------- 3. batch
+def bench_batch(quick):
+    """Scene-steps per second: one BatchSimulator of 1024 scenes against a loop of Simulators."""
+    steps, repeats = (10, 3) if quick else (30, 5)
+    rng = np.random.default_rng(11)
+    b, n = BATCH_SCENES, BATCH_BALLS
+    pos = np.empty((b, n, 2))
+    vel = np.empty((b, n, 2))
+    for s in range(b):
+        pos[s], vel[s] = random_balls(rng, n, PLAY_AREA_2D, STEP_RADIUS)
+    masses = rng.uniform(0.5, 2.0, (b, n))
+    radii = np.full((b, n), STEP_RADIUS)
+    rows = []
+    for mode, k in MODE_CONFIGS:
+        batch = BatchSimulator(Scene(), pos, vel, masses, radii, mode=mode, substeps=k)
+        singles = [Simulator(Scene(), pos[s], vel[s], masses[s], radii=radii[s], mode=mode, substeps=k)
+                   for s in range(b)]
+        batch_start = batch.get_state()
+        single_starts = [sim.get_state() for sim in singles]
+
+        def reset_batch(batch=batch, batch_start=batch_start):
+            batch.set_state(batch_start)
+
+        def reset_loop(singles=singles, single_starts=single_starts):
+            for sim, st in zip(singles, single_starts, strict=True):
+                sim.set_state(st)
+
+        def run_batch(batch=batch):
+            for _ in range(steps):
+                batch.step(FRAME)
+
+        def run_loop(singles=singles):
+            for _ in range(steps):
+                for sim in singles:
+                    sim.step(FRAME)
+
+        run_batch()  # warm-up
+        run_loop()
+        tb = _summary(_repeat(run_batch, repeats, reset_batch), per=steps * b)
+        tl = _summary(_repeat(run_loop, repeats, reset_loop), per=steps * b)
+        diff = max(float(np.abs(batch.positions[s] - singles[s].positions).max()) for s in range(b))
+        rows.append({
+            "mode": f"{mode}/{k}",
+            "batch_scene_steps_per_s": 1.0 / tb["best"],
+            "loop_scene_steps_per_s": 1.0 / tl["best"],
+            "speedup_best": tl["best"] / tb["best"],
+            "speedup_median": tl["median"] / tb["median"],
+            "batch_s_per_scene_step": tb,
+            "loop_s_per_scene_step": tl,
+            "max_position_diff_m": diff,
+        })
+    return {"scenes": b, "balls": n, "steps": steps, "dt": FRAME, "rows": rows}
+
+
+# ---------------------------------------------------------------------------------------- tables
+def _fmt(x, digits=3):
+    if x is None:
+        return "n/a"
+    if isinstance(x, bool):
+        return "yes" if x else "**no**"
+    if isinstance(x, (int, np.integer)):
+        return f"{x:,}"
+    if x == 0:
+        return "0"
+    if abs(x) >= 1e5 or abs(x) < 1e-3:
+        return f"{x:.2e}"
+    return f"{x:,.{digits}g}" if abs(x) < 1000 else f"{x:,.0f}"
+
+
+def render_markdown(results):
+    """The benchmark's figures as Markdown (a string), from :func:`run`'s dict or its JSON."""
+    meta = results["meta"]
+    v = meta["versions"]
+    lines = [
+        "## Engine benchmark",
+        "",
+        f"`python -m collision_env.engine.bench{' --quick' if meta['quick'] else ''}` on {meta['machine']}, "
+        f"{meta['cpus']} CPUs, Python {v['python']}, numpy {v['numpy']}, numba {v['numba']}, "
+        f"billiards {v['billiards']}, pymunk {v['pymunk']}; engine backend `{v['backend']}`; "
+        f"{meta['date']}, {meta['duration_s']:.0f} s. Times are the best of several repeats (median in "
+        "brackets); compare the ratios, which are measured in the same run.",
+        "",
+    ]
+    gas = results.get("gas", {})
+    if "skipped" in gas:
+        lines += ["### Exact mode against billiards", "", f"Skipped: {gas['skipped']}", ""]
+    elif gas:
+        lines += [
+            f"### Exact mode against billiards: {gas['n']}-disk elastic gas (r = {gas['radius']}, box [-1, 1]², "
+            f"T = {gas['full_horizon']['horizon_s']:g} s)",
+            "",
+            "| run | our events | our time (s) | our events/s | billiards events | billiards time (s) "
+            "| billiards events/s | speed-up |",
+            "|---|---:|---:|---:|---:|---:|---:|---:|",
+        ]
+        for r in gas["rows"]:
+            lines.append(
+                f"| {r['how']} | {_fmt(r['ours_events'])} "
+                f"| {_fmt(r['ours_s']['best'])} ({_fmt(r['ours_s']['median'])}) "
+                f"| {_fmt(r['ours_events_per_s'])} | {_fmt(r['billiards_events'])} "
+                f"| {_fmt(r['billiards_s']['best'])} ({_fmt(r['billiards_s']['median'])}) "
+                f"| {_fmt(r['billiards_events_per_s'])} | **{r['speedup_best']:.0f}×** ({r['speedup_median']:.0f}×) |"
+            )
+        c = gas["check"]
+        f = gas["full_horizon"]
+        lines += [
+            "",
+            f"Same trajectories: over the first {c['horizon_s']:.3g} s ({c['collisions_per_ball']:.1f} collisions per "
+            f"ball, {c['events']} events) the collision sequences are identical: {_fmt(c['same_sequence'])}; largest "
+            f"difference in impact time {_fmt(c['max_time_diff_s'])} s, "
+            f"in position {_fmt(c['max_position_diff_m'])} m, "
+            f"in velocity {_fmt(c['max_velocity_diff_m_s'])} m/s. Over the full {f['horizon_s']:g} s "
+            f"({f['collisions_per_ball']:.0f} collisions per ball) the gas is chaotic: the sequences agree for the "
+            f"first {f['sequences_agree_for_events']} of {f['events_ours']} (ours) / {f['events_billiards']} "
+            f"(billiards) events and the positions end up to {_fmt(f['max_position_diff_m'])} m apart.",
+            "",
+        ]
+    ps = results.get("per_step")
+    if ps:
+        names = list(ps["rows"][0]["modes"])
+        lines += [
+            f"### Cost per step (µs per `Simulator.step(1/60)`), play area {tuple(ps['bounds'])}, r = {ps['radius']}, "
+            "~1 m/s",
+            "",
+            "| balls | " + " | ".join(names) + " | exact ÷ naive | impacts per step (exact) |",
+            "|---:|" + "---:|" * (len(names) + 2),
+        ]
+        for r in ps["rows"]:
+            m = r["modes"]
+            cells = [f"{m[k]['best']:.2f} ({m[k]['median']:.2f})" for k in names]
+            ratio = m["exact/1"]["best"] / m["naive/1"]["best"]
+            lines.append(f"| {r['balls']} | " + " | ".join(cells) + f" | {ratio:.2f} | "
+                         f"{m['exact/1']['impacts_per_step']:.3f} |")
+        lines += ["", "Mode names are `mode/substeps`; pymunk is the C peer (impulse solver, no time of impact) "
+                  "stepping the same balls.", ""]
+    bt = results.get("batch")
+    if bt:
+        lines += [
+            f"### Batched stepping: {bt['scenes']} scenes of {bt['balls']} balls, dt = 1/60 s",
+            "",
+            "| mode | batch scene-steps/s | loop of Simulators, scene-steps/s | speed-up "
+            "| same end state (max Δx, m) |",
+            "|---|---:|---:|---:|---:|",
+        ]
+        for r in bt["rows"]:
+            lines.append(
+                f"| {r['mode']} | {_fmt(r['batch_scene_steps_per_s'])} | {_fmt(r['loop_scene_steps_per_s'])} "
+                f"| **{r['speedup_best']:.0f}×** ({r['speedup_median']:.0f}×) | {_fmt(r['max_position_diff_m'])} |"
+            )
+        lines.append("")
+    return "\n".join(lines)
+
+
+# ---------------------------------------------------------------------------------------- main
+def run(quick=False, parts=("gas", "per_step", "batch"), log=print):
+    """Run the benchmark; returns the raw figures as a JSON-ready dict."""
+    t0 = time.perf_counter()
+    log("warming up the kernels (numba compile or cache load) ...")
+    _warm_up()
+    results = {}
+    if "gas" in parts:
+        log("gas: exact mode against billiards ...")
+        results["gas"] = bench_gas(quick)
+    if "per_step" in parts:
+        log("per-step cost of each mode ...")
+        results["per_step"] = bench_per_step(quick)
+    if "batch" in parts:
+        log("batch of 1024 against a loop ...")
+        results["batch"] = bench_batch(quick)
+    try:
+        import os
+
+        cpus = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):  # pragma: no cover
+        cpus = os.cpu_count()
+    results["meta"] = {
+        "quick": quick,
+        "versions": _versions(),
+        "machine": f"{platform.machine()} {platform.system()}",
+        "cpus": cpus,
+        "date": time.strftime("%Y-%m-%d %H:%M"),
+        "duration_s": time.perf_counter() - t0,
+    }
+    return results
+
+
+def _jsonable(obj):
+    if isinstance(obj, dict):
+        return {k: _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, (np.integer,)):
+        return int(obj)
+    if isinstance(obj, (np.floating,)):
+        return float(obj)
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python -m collision_env.engine.bench", description=__doc__.split("\n")[0])
+    parser.add_argument("--quick", action="store_true", help="fewer repeats: about 30 s instead of a few minutes")
+    parser.add_argument("--json", metavar="PATH", help="write the raw figures to PATH")
+    parser.add_argument("--markdown", metavar="PATH", help="write the tables to PATH")
+    parser.add_argument("--render", metavar="JSON", help="do not measure: render the tables of a --json file")
+    parser.add_argument("--only", choices=("gas", "per_step", "batch"), action="append",
+                        help="run only this part (repeatable)")
+    args = parser.parse_args(argv)
+
+    if args.render:
+        with open(args.render) as fh:
+            results = json.load(fh)
+    else:
+        results = _jsonable(run(quick=args.quick, parts=tuple(args.only or ("gas", "per_step", "batch")),
+                                log=lambda msg: print(msg, file=sys.stderr, flush=True)))
+        if args.json:
+            with open(args.json, "w") as fh:
+                json.dump(results, fh, indent=1)
+    text = render_markdown(results)
+    print(text)
+    if args.markdown:
+        with open(args.markdown, "w") as fh:
+            fh.write(text + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
