@@ -139,8 +139,8 @@ class CollisionTargetEnv(gym.Env):
         obs, _, _, _, _, n_hit, energy = core.finish(self._reset_flag, imp, self._zero_cost, out=self._out())
         info = {"impacts": Impacts(imp), "event_cap": False, "energy": float(energy[0]),
                 "time": float(core.time[0]), "targets_hit": int(n_hit[0]), "is_success": False}
-        if self._renderer is not None:
-            self._renderer.start()
+        if self.render_mode is not None:
+            self._get_renderer().start()  # trails and flashes are recorded from the episode start
         if self.render_mode == "human":
             self.render()
         return obs[0], info
@@ -170,16 +170,18 @@ class CollisionTargetEnv(gym.Env):
                 f'render_mode at initialization, e.g. gym.make("{env_id}", render_mode="rgb_array")'
             )
             return None
-        if self._renderer is None:
-            from collision_env.envs.rendering import Renderer
-
-            self._renderer = Renderer(self.config, trails=self._trails)
-            self._renderer.start()
-        frame = self._renderer.draw(self._core, 0)
+        frame = self._get_renderer().draw(self._core, 0)
         if self.render_mode == "human":
             self._renderer.show(frame, self.metadata["render_fps"])
             return None
         return frame
+
+    def _get_renderer(self):
+        if self._renderer is None:
+            from collision_env.envs.rendering import Renderer
+
+            self._renderer = Renderer(self.config, trails=self._trails)
+        return self._renderer
 
     def close(self):
         if self._renderer is not None:

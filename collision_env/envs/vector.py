@@ -128,9 +128,10 @@ class CollisionTargetVectorEnv(VectorEnv):
         imp = core.empty_impacts()
         obs, _, _, _, success, n_hit, energy = core.finish(flags, imp, np.zeros(self.num_envs), out=self._fresh_out())
         self._autoreset[mask] = False
-        if self._renderers is not None:
+        if self.render_mode is not None:
+            renderers = self._get_renderers()
             for i in idx:
-                self._renderers[i].start()
+                renderers[i].start()
         info = self._info(energy, np.zeros(self.num_envs, dtype=bool), success, n_hit, imp)
         if not mask.all():  # a partial reset reports (and masks) only the sub-envs it reset
             for key in _SCALAR_KEYS:
@@ -233,13 +234,14 @@ class CollisionTargetVectorEnv(VectorEnv):
         """A tuple with one ``(H, W, 3)`` uint8 frame per sub-env (``render_mode="rgb_array"``)."""
         if self.render_mode is None:
             return None
+        return tuple(r.draw(self._core, i) for i, r in enumerate(self._get_renderers()))
+
+    def _get_renderers(self) -> list:
         if self._renderers is None:
             from collision_env.envs.rendering import Renderer
 
             self._renderers = [Renderer(self.config, trails=self._trails) for _ in range(self.num_envs)]
-            for r in self._renderers:
-                r.start()
-        return tuple(r.draw(self._core, i) for i, r in enumerate(self._renderers))
+        return self._renderers
 
     def close_extras(self, **kwargs: Any) -> None:
         if self._renderers is not None:
