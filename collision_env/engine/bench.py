@@ -159,7 +159,7 @@ def bench_gas(quick):
     radii = np.full(GAS_N, GAS_RADIUS)
     scene = Scene(bounds=(-GAS_HALF, -GAS_HALF, GAS_HALF, GAS_HALF), elasticity=1.0)
     n_frames = round(GAS_T / FRAME)
-    peer_repeats, our_repeats = (2, 5) if quick else (5, 20)
+    peer_repeats, our_repeats = (3, 10) if quick else (5, 30)
 
     # billiards: the set-up (its O(N^2) first prediction) is outside the timing, as ours is
     peer_result = {}
@@ -290,7 +290,7 @@ def bench_per_step(quick):
         import pymunk
     except ImportError:
         pymunk = None
-    steps, repeats = (100, 3) if quick else (600, 7)
+    steps, repeats = (200, 5) if quick else (600, 9)
     rng = np.random.default_rng(7)
     rows = []
     for n in STEP_BALLS:
@@ -335,7 +335,7 @@ def bench_per_step(quick):
 # ---------------------------------------------------------------------------------------- 3. batch
 def bench_batch(quick):
     """Scene-steps per second: one BatchSimulator of 1024 scenes against a loop of Simulators."""
-    steps, repeats = (10, 3) if quick else (30, 5)
+    steps, repeats = (10, 3) if quick else (30, 7)
     rng = np.random.default_rng(11)
     b, n = BATCH_SCENES, BATCH_BALLS
     pos = np.empty((b, n, 2))
@@ -456,14 +456,15 @@ def render_markdown(results):
             f"### Cost per step (µs per `Simulator.step(1/60)`), play area {tuple(ps['bounds'])}, r = {ps['radius']}, "
             "~1 m/s",
             "",
-            "| balls | " + " | ".join(names) + " | exact ÷ naive | impacts per step (exact) |",
-            "|---:|" + "---:|" * (len(names) + 2),
+            "| balls | " + " | ".join(names) + " | exact ÷ naive | exact ÷ pymunk | impacts per step (exact) |",
+            "|---:|" + "---:|" * (len(names) + 3),
         ]
         for r in ps["rows"]:
             m = r["modes"]
             cells = [f"{m[k]['best']:.2f} ({m[k]['median']:.2f})" for k in names]
             ratio = m["exact/1"]["best"] / m["naive/1"]["best"]
-            lines.append(f"| {r['balls']} | " + " | ".join(cells) + f" | {ratio:.2f} | "
+            peer = f"{m['exact/1']['best'] / m['pymunk']['best']:.1f}" if "pymunk" in m else "n/a"
+            lines.append(f"| {r['balls']} | " + " | ".join(cells) + f" | {ratio:.2f} | {peer} | "
                          f"{m['exact/1']['impacts_per_step']:.3f} |")
         lines += ["", "Mode names are `mode/substeps`; pymunk is the C peer (impulse solver, no time of impact) "
                   "stepping the same balls.", ""]
