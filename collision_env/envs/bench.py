@@ -1,0 +1,136 @@
+"""Environment benchmark: step cost of every registered id against Gymnasium's CartPole, same run.
+
+    python -m collision_env.envs.bench [--seconds 1.0] [--num-envs 1024] [--modes exact naive posteriori]
+
+Prints two tables (ratios, not pass/fail tests):
+
+* single env via ``gym.make`` (all default wrappers, random actions, resets included), in us per
+  step and as a multiple of ``CartPole-v1`` via ``gym.make`` (goal: <= 2x);
+* the native vector env at ``--num-envs`` sub-envs (next-step autoreset, random
+  actions), in env-steps/s and as a fraction of Gymnasium's ``CartPoleVectorEnv`` (goal: >= 1 M
+  env-steps/s, i.e. >= 0.1x).
+
+The "engine" column is the part of a step spent in the engine's own calls (``nudge`` and ``step``
+of the ``BatchSimulator``), measured on a copy of the env's engine in the same state.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import time
+
+import gymnasium as gym
+import numpy as np
+
+import collision_env
+
+
+def _single_us(env, seconds: float) -> float:
+    env.reset(seed=0)
+    env.action_space.seed(0)
+    actions = [env.action_space.sample() for _ in range(1024)]
+    for i in range(300):  # warm-up (compiles the kernels on a first run)
+        if any(env.step(actions[i % 1024])[2:4]):
+            env.reset()
+    n, t0 = 0, time.perf_counter()
+    while True:
+        for i in range(1000):
+            _, _, term, trunc, _ = env.step(actions[i % 1024])
+            if term or trunc:
+                env.reset()
+        n += 1000
+        elapsed = time.perf_counter() - t0
+        if elapsed >= seconds:
+            return elapsed / n * 1e6
+
+
+def _vector_sps(venv, seconds: float) -> float:
+    venv.reset(seed=0)
+    venv.action_space.seed(0)
+    actions = [venv.action_space.sample() for _ in range(16)]
+    for i in range(10):
+        venv.step(actions[i % 16])
+    n, t0 = 0, time.perf_counter()
+    while True:
+        for i in range(20):
+            venv.step(actions[i % 16])
+        n += 20
+        elapsed = time.perf_counter() - t0
+        if elapsed >= seconds:
+            return n * venv.num_envs / elapsed
+
+
+def _engine_us(core, seconds: float, steps: int = 200) -> float:
+    """us per (nudge + step) call pair of the engine alone, on a copy of ``core``'s engine."""
+    sim = core.batch.copy()
+    dv = np.zeros_like(core.vel)
+    dt = core.cfg.dt
+    n, total = 0, 0.0
+    state = sim.get_state()
+    while total < seconds:
+        sim.set_state(state)
+        t0 = time.perf_counter()
+        for _ in range(steps):
+            sim.nudge(dv)
+            sim.step(dt)
+        total += time.perf_counter() - t0
+        n += steps
+    return total / n * 1e6
+
+
+def _fmt_rate(x: float) -> str:
+    return f"{x / 1e6:.2f} M" if x >= 1e6 else f"{x / 1e3:.0f} k"
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--seconds", type=float, default=1.0, help="time per measurement (s)")
+    parser.add_argument("--num-envs", type=int, default=1024, help="sub-envs of the vector env")
+    parser.add_argument("--modes", nargs="+", default=["exact"], choices=["exact", "posteriori", "naive"],
+                        help="engine modes to time the envs in")
+    parser.add_argument("--ids", nargs="+", default=list(collision_env.ENV_IDS), help="env ids")
+    args = parser.parse_args(argv)
+
+    from collision_env.engine import BACKEND
+
+    print(f"collision_env {collision_env.__version__} env benchmark | gymnasium {gym.__version__}, numpy "
+          f"{np.__version__}, engine backend {BACKEND} | python {platform.python_version()}, "
+          f"{os.cpu_count()} CPUs | {args.seconds:g} s per figure")
+    print("All figures from this run; ratios are what to compare.\n")
+
+    cart = _single_us(gym.make("CartPole-v1"), args.seconds)
+    print("Single env via gym.make (default wrappers, random actions, resets included)")
+    print(f"{'id':40s} {'mode':>10s} {'us/step':>9s} {'engine':>8s} {'x CartPole':>11s}  goal <= 2x")
+    print(f"{'CartPole-v1':40s} {'':>10s} {cart:9.2f} {'':>8s} {1.0:11.2f}")
+    for env_id in args.ids:
+        for mode in args.modes:
+            env = gym.make(env_id, mode=mode)
+            us = _single_us(env, args.seconds)
+            eng = _engine_us(env.unwrapped.core, args.seconds / 2)
+            ratio = us / cart
+            print(f"{env_id:40s} {mode:>10s} {us:9.2f} {eng:8.2f} {ratio:11.2f}  {'met' if ratio <= 2 else 'not met'}")
+            env.close()
+
+    n = args.num_envs
+    cart_vec = _vector_sps(gym.make_vec("CartPole-v1", n, vectorization_mode="vector_entry_point"), args.seconds)
+    print(f"\nNative vector env, {n} sub-envs (next-step autoreset, random actions)")
+    print(f"{'id':40s} {'mode':>10s} {'env-steps/s':>12s} {'engine':>8s} {'x CartPoleVec':>14s}  goal >= 1 M and >= 0.1x")
+    print(f"{'CartPoleVectorEnv':40s} {'':>10s} {_fmt_rate(cart_vec):>12s} {'':>8s} {1.0:14.3f}")
+    for env_id in args.ids:
+        for mode in args.modes:
+            venv = gym.make_vec(env_id, n, vectorization_mode="vector_entry_point", mode=mode)
+            sps = _vector_sps(venv, args.seconds)
+            eng = _engine_us(venv.unwrapped.core, args.seconds / 2, steps=20)
+            share = eng / (n / sps * 1e6)
+            ratio = sps / cart_vec
+            ok = sps >= 1e6 and ratio >= 0.1
+            print(f"{env_id:40s} {mode:>10s} {_fmt_rate(sps):>12s} {share:7.0%}  {ratio:14.3f}  "
+                  f"{'met' if ok else 'not met'}")
+            venv.close()
+    print("\nengine: single env, us per step in the engine's nudge + step; vector env, that share of the step.")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,217 @@
+"""Scripted policies that aim with the engine's exact prediction (baselines, tests, demo GIFs).
+
+* :class:`AimingPolicy` (one controlled ball, no others in the way): each step it asks a copy of the
+  engine (``BatchSimulator.copy()`` then ``step``) where the ball's next wall impact will land; if not
+  on the current target, it searches directions the same way and steers towards one that is.
+* :class:`ShootingPolicy` (any preset): candidate plans (action sequences) are run ahead on the env
+  itself from a saved state (``get_state``/``set_state``); the first whose predicted rollout hits a
+  target is executed. Because the engine is deterministic and exact, the real episode hits the
+  target at exactly the predicted step with exactly the predicted impact.
+
+``scripted_policy(env)`` picks the right one for a preset.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+
+Plan = Callable[[int, object], np.ndarray]
+
+
+def on_target(core, b: int, k: int, wall: int, x: float, y: float, t: float) -> bool:
+    """Whether an impact at wall code ``wall``, point (x, y), time t lands on target k of scene b."""
+    c, hw, t_open, t_close = core.t_geo[b, k]
+    s = y if wall < 2 else x
+    return core.t_wall[b, k] == wall and abs(s - c) <= hw and t_open <= t <= t_close
+
+
+def first_wall_impact(records: np.ndarray, ball: int | None = None):
+    for r in records:
+        if r["wall"] >= 0 and (ball is None or r["ball"] == ball):
+            return r
+    return None
+
+
+class AimingPolicy:
+    """Steer one ball so that its next wall impact lands on the current target.
+
+    Works on an unwrapped :class:`~collision_env.envs.CollisionTargetEnv` whose ball 0 is
+    controlled and scores (``OneBallTarget``). Call it with no argument each step.
+    """
+
+    def __init__(self, env, speed: float = 1.2, lookahead: float = 6.0, directions: int = 144):
+        self.env = env
+        self.speed = speed
+        self.lookahead = lookahead
+        self.angles = np.linspace(-math.pi, math.pi, directions, endpoint=False)
+        self.want = None
+
+    def predicts_hit(self, dv: np.ndarray) -> bool:
+        """Does ball 0 hit the current target next if its velocity changes by ``dv`` now?"""
+        core = self.env.core
+        sim = core.batch.copy()
+        sim.nudge(dv[None, None, :])
+        r = first_wall_impact(sim.step(self.lookahead), ball=0)
+        k = min(int(core.cur[0]), core.t_wall.shape[1] - 1)
+        return r is not None and on_target(core, 0, k, r["wall"], r["x"], r["y"], r["time"])
+
+    def __call__(self, obs=None) -> np.ndarray:
+        core, cfg = self.env.core, self.env.config
+        v = core.vel[0, 0]
+        if self.predicts_hit(np.zeros(2)):
+            self.want = None
+            return np.zeros(2, np.float32)  # already on course: coast
+        if self.want is None or not self.predicts_hit(self.want - v):
+            self.want = None
+            cur = math.atan2(v[1], v[0])
+            for ang in sorted(self.angles, key=lambda a: abs(math.remainder(a - cur, 2 * math.pi))):
+                want = self.speed * np.array([math.cos(ang), math.sin(ang)])
+                if self.predicts_hit(want - v):
+                    self.want = want
+                    break
+        if self.want is None:
+            return np.zeros(2, np.float32)
+        return np.clip((self.want - v) / cfg.max_dv, -1, 1).astype(np.float32)
+
+
+# --------------------------------------------------------------------------------------------- #
+
+
+def push(direction, steps: int, delay: int = 0) -> Plan:
+    """A plan: full action along ``direction`` for ``steps`` steps after ``delay``, then nothing."""
+    d = np.asarray(direction, np.float32)
+    zero = np.zeros_like(d)
+    return lambda t, env: d if delay <= t < delay + steps else zero
+
+
+def shoot(env, plans, horizon: int):
+    """The first plan whose predicted rollout hits a target within ``horizon`` steps.
+
+    Each plan runs on ``env`` itself from its current state, which is restored afterwards.
+    Returns ``(plan, hit_step, impacts of that step)`` or ``(None, None, None)``.
+    """
+    start = env.get_state()
+    try:
+        for plan in plans:
+            env.set_state(start)
+            hits = int((env.core.t_status[0] == 1).sum())
+            for t in range(horizon):
+                _, _, term, trunc, info = env.step(plan(t, env))
+                if info["targets_hit"] > hits:
+                    return plan, t, info["impacts"].records.copy()
+                if term or trunc:
+                    break
+        return None, None, None
+    finally:
+        env.set_state(start)
+
+
+def _target_point(cfg, wall: int, c: float):
+    xmin, ymin, xmax, ymax = cfg.bounds
+    return {0: (xmin, c), 1: (xmax, c), 2: (c, ymin), 3: (c, ymax)}[wall]
+
+
+def billiards_plans(env) -> list:
+    """Ghost-ball shots: send the cue ball at the spot from which each object ball heads for each target."""
+    core, cfg = env.core, env.config
+    pos, r = core.pos[0], core.radii[0]
+    plans = []
+    for k in np.flatnonzero(core.t_status[0] == 0):
+        target = _target_point(cfg, int(core.t_wall[0, k]), core.t_geo[0, k, 0])
+        for j in range(cfg.n_balls):
+            if j in cfg.controlled:
+                continue
+            u = np.subtract(target, pos[j])
+            ghost = pos[j] - (r[0] + r[j]) * u / np.linalg.norm(u)
+            base = math.atan2(ghost[1] - pos[0, 1], ghost[0] - pos[0, 0])
+            for off in (0.0, 0.5, -0.5, 1.0, -1.0, 2.0, -2.0, 3.0, -3.0):
+                ang = base + math.radians(off)
+                for steps in (8, 14):
+                    plans.append(push((math.cos(ang), math.sin(ang)), steps))
+    return plans
+
+
+def stuck(env) -> bool:
+    """Is ball 0 part of a cluster?"""
+    core = env.core
+    return bool((core.body[0] == core.body[0, 0]).sum() > 1)
+
+
+def cluster_plans(env) -> list:
+    """Once stuck: push the cluster in one of 64 directions for 8, 20 or 40 steps."""
+    if not stuck(env):
+        return []
+    return [push((math.cos(a), math.sin(a)), steps)
+            for steps in (8, 20, 40) for a in np.linspace(0, 2 * math.pi, 64, endpoint=False)]
+
+
+def ram(env) -> np.ndarray:
+    """Steer ball 0 straight at ball 1 (to form a cluster)."""
+    core = env.core
+    d = core.pos[0, 1] - core.pos[0, 0]
+    want = 0.8 * d / np.linalg.norm(d)
+    return np.clip((want - core.vel[0, 0]) / env.config.max_dv, -1, 1).astype(np.float32)
+
+
+def line_plans(env) -> list:
+    """Pushes of the first ball either way, of several lengths and delays."""
+    return [push((s,), steps, delay) for delay in (0, 20, 40, 60, 90) for steps in (2, 6, 12) for s in (1.0, -1.0)]
+
+
+class ShootingPolicy:
+    """Plan by shooting (see :func:`shoot`), follow the plan, re-plan after each hit.
+
+    ``candidates(env)`` lists plans; ``fallback(env)`` gives the action while no plan hits
+    (default: no nudge); planning is retried every ``retry`` steps.
+    """
+
+    def __init__(self, env, candidates: Callable, fallback: Callable | None = None, retry: int = 10):
+        self.env = env
+        self.candidates = candidates
+        self.fallback = fallback
+        self.retry = retry
+        self.plan = None
+        self.t = 0
+        self.hit_step = None
+        self.wait = 0
+
+    def __call__(self, obs=None) -> np.ndarray:
+        env = self.env
+        if self.plan is None and self.wait <= 0:
+            horizon = env.config.n_steps - int(env.core.steps[0])
+            plans = self.candidates(env)
+            plan, hit_step, _ = shoot(env, plans, horizon) if plans else (None, None, None)
+            if plan is not None:
+                self.plan, self.t, self.hit_step = plan, 0, hit_step
+            else:
+                self.wait = self.retry if plans else 0
+        if self.plan is None:
+            self.wait -= 1
+            if self.fallback is not None:
+                return self.fallback(env)
+            return np.zeros(env.action_space.shape, np.float32)
+        action = self.plan(self.t, env)
+        self.t += 1
+        if self.t > self.hit_step:
+            self.plan = None  # the predicted hit happens in this step: plan afresh next step
+        return action
+
+
+def scripted_policy(env):
+    """A scripted policy for the unwrapped env's preset (``None`` when there is none)."""
+    cfg = env.config
+    if cfg.n_balls == 1 and cfg.dimension == 2:
+        return AimingPolicy(env)
+    if cfg.scorers == "cluster":
+        def ram_first(e):
+            return np.zeros(e.action_space.shape, np.float32) if stuck(e) else ram(e)
+
+        return ShootingPolicy(env, cluster_plans, fallback=ram_first)
+    if cfg.scorers == "others":
+        return ShootingPolicy(env, billiards_plans)
+    if cfg.dimension == 1:
+        return ShootingPolicy(env, line_plans)
+    return None
