@@ -62,7 +62,7 @@ def main(argv=None) -> None:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     every = max(1, round(20 / args.fps))
-    for preset, env_id in PRESET_IDS.items():
+    for env_id in PRESET_IDS.values():
         still, frames, info = render_episode(env_id, args.seed, args.ppm, every)
         name = env_id.split("/")[1].removesuffix("-v0").lower()
         iio.imwrite(out / f"{name}.png", still)

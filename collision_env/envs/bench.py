@@ -116,7 +116,8 @@ def main(argv=None) -> None:
     n = args.num_envs
     cart_vec = _vector_sps(gym.make_vec("CartPole-v1", n, vectorization_mode="vector_entry_point"), args.seconds)
     print(f"\nNative vector env, {n} sub-envs (next-step autoreset, random actions)")
-    print(f"{'id':40s} {'mode':>10s} {'env-steps/s':>12s} {'engine':>8s} {'x CartPoleVec':>14s}  goal >= 1 M and >= 0.1x")
+    print(f"{'id':40s} {'mode':>10s} {'env-steps/s':>12s} {'engine':>8s} {'x CartPoleVec':>14s}  "
+          "goal >= 1 M and >= 0.1x")
     print(f"{'CartPoleVectorEnv':40s} {'':>10s} {_fmt_rate(cart_vec):>12s} {'':>8s} {1.0:14.3f}")
     for env_id in args.ids:
         for mode in args.modes:
