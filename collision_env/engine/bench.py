@@ -3,7 +3,7 @@
 Run it as::
 
     python -m collision_env.engine.bench            # full run, a few minutes
-    python -m collision_env.engine.bench --quick    # about 30 s
+    python -m collision_env.engine.bench --quick    # about 10 s (plus ~30 s of numba compile when cold)
     python -m collision_env.engine.bench --json bench.json --markdown bench.md
     python -m collision_env.engine.bench --render bench.json --markdown bench.md   # tables only
 
@@ -11,11 +11,12 @@ It is not a test: it measures and prints. Three parts, each printed as a Markdow
 
 1. **Gas**: exact mode's events per second against the ``billiards`` package (PyPI 0.5.0, pure
    Python, event-driven) on a 50-disk elastic gas (r = 0.02 in [-1, 1]^2, T = 20 s, the research
-   note's setup), both from the same initial state, once as a single long step and once in
-   frames of 1/60 s. The same section checks the trajectories: over a short horizon (about 3
-   collisions per ball, before chaos amplifies round-off) the collision sequences must be the
-   same, and it reports the largest position difference; at T = 20 s (about 30 collisions per
-   ball) it only reports how far the two chaotic runs drifted apart.
+   note's setup; the full run adds its 200-disk gas over 5 s), both from the same initial state,
+   once as a single long step and once in frames of 1/60 s. The same section checks the
+   trajectories: over a short horizon (about 3 collisions per ball, before chaos amplifies
+   round-off) the collision sequences must be the same, and it reports the largest position
+   difference; at the full horizon (tens of collisions per ball) it only reports how far the two
+   chaotic runs drifted apart.
 2. **Per step**: microseconds per ``Simulator.step(1/60)`` for each mode (naive, posteriori with
    1 and 4 substeps, exact) at 1, 2, 4, 16 and 64 balls in the default play area, with pymunk
    (a C engine, impulse solver, no time of impact) stepping the same balls as a peer.
@@ -43,10 +44,10 @@ import numpy as np
 
 from . import BACKEND, PLAY_AREA_2D, BatchSimulator, Scene, Simulator
 
-GAS_N = 50
+GAS_CASES = ((50, 20.0),)  # (disks, horizon in s); the full run adds GAS_CASES_FULL
+GAS_CASES_FULL = ((200, 5.0),)  # the research note's second gas (billiards: ~0.7 k events/s)
 GAS_RADIUS = 0.02
 GAS_HALF = 1.0
-GAS_T = 20.0
 GAS_CHECK_COLLISIONS_PER_BALL = 3
 FRAME = 1.0 / 60.0
 STEP_BALLS = (1, 2, 4, 16, 64)
@@ -147,19 +148,21 @@ def _our_pairs(impacts):
     return [(h.ball, -1) if h.other is None else (min(h.ball, h.other), max(h.ball, h.other)) for h in impacts]
 
 
-def bench_gas(quick):
-    """Exact mode against billiards on the 50-disk gas; see the module doc."""
+def bench_gas(quick, n=50, horizon=20.0):
+    """Exact mode against billiards on an ``n``-disk gas over ``horizon`` s; see the module doc."""
     try:
         import billiards
     except ImportError:
         return {"skipped": "billiards is not installed (pip install 'collision_env[peers]')"}
     rng = np.random.default_rng(2024)
-    pos, vel = random_balls(rng, GAS_N, (-GAS_HALF, -GAS_HALF, GAS_HALF, GAS_HALF), GAS_RADIUS, gap=1.0001)
-    masses = np.ones(GAS_N)
-    radii = np.full(GAS_N, GAS_RADIUS)
+    pos, vel = random_balls(rng, n, (-GAS_HALF, -GAS_HALF, GAS_HALF, GAS_HALF), GAS_RADIUS, gap=1.0001)
+    masses = np.ones(n)
+    radii = np.full(n, GAS_RADIUS)
     scene = Scene(bounds=(-GAS_HALF, -GAS_HALF, GAS_HALF, GAS_HALF), elasticity=1.0)
-    n_frames = round(GAS_T / FRAME)
-    peer_repeats, our_repeats = (3, 10) if quick else (5, 30)
+    n_frames = round(horizon / FRAME)
+    peer_repeats, our_repeats = (3, 10) if quick else (7, 50)
+    if n > 100:  # billiards takes seconds per run here
+        peer_repeats = 3
 
     # billiards: the set-up (its O(N^2) first prediction) is outside the timing, as ours is
     peer_result = {}
@@ -167,7 +170,7 @@ def bench_gas(quick):
     def peer_one_step():
         table = peer_result["table"] = _billiards_table(billiards, pos, vel, GAS_RADIUS)
         t0 = time.perf_counter()
-        peer_result["events"] = table.evolve(GAS_T)
+        peer_result["events"] = table.evolve(horizon)
         return time.perf_counter() - t0
 
     def peer_frames():
@@ -184,7 +187,7 @@ def bench_gas(quick):
     def our_one_step():
         sim = ours["sim"] = Simulator(scene, pos, vel, masses, radii=radii, mode="exact", max_events=10**7)
         t0 = time.perf_counter()
-        ours["impacts"] = sim.step(GAS_T)
+        ours["impacts"] = sim.step(horizon)
         return time.perf_counter() - t0
 
     def our_frames():
@@ -208,7 +211,7 @@ def bench_gas(quick):
     # trajectory check over a short horizon (before chaos): same sequence, position difference
     events = peer_result["events"]
     involved = np.cumsum([1 if pair[1] < 0 else 2 for pair in _billiards_pairs(events, billiards)])
-    k = int(np.searchsorted(involved, GAS_CHECK_COLLISIONS_PER_BALL * GAS_N))
+    k = int(np.searchsorted(involved, GAS_CHECK_COLLISIONS_PER_BALL * n))
     t_check = 0.5 * (events[k][0] + events[k + 1][0])
     table = _billiards_table(billiards, pos, vel, GAS_RADIUS)
     peer_short = table.evolve(t_check)
@@ -220,7 +223,7 @@ def bench_gas(quick):
     )
     check = {
         "horizon_s": t_check,
-        "collisions_per_ball": float(involved[k - 1] / GAS_N) if k > 0 else 0.0,
+        "collisions_per_ball": float(involved[k - 1] / n) if k > 0 else 0.0,
         "events": len(peer_short),
         "same_sequence": same_sequence,
         "max_time_diff_s": time_diff,
@@ -233,8 +236,8 @@ def bench_gas(quick):
     agree = (i for i, (a, b) in enumerate(zip(long_ours, long_peer, strict=False)) if a != b)
     prefix = next(agree, min(len(long_ours), len(long_peer)))
     full = {
-        "horizon_s": GAS_T,
-        "collisions_per_ball": float(involved[-1] / GAS_N),
+        "horizon_s": horizon,
+        "collisions_per_ball": float(involved[-1] / n),
         "events_ours": our_events,
         "events_billiards": peer_events,
         "sequences_agree_for_events": prefix,
@@ -242,8 +245,8 @@ def bench_gas(quick):
     }
     rows = []
     for label, ours_t, ours_n, peer_t_, peer_n in (
-        ("one step of 20 s", our_t, our_events, peer_t, peer_events),
-        ("1200 frames of 1/60 s", our_frame_t, our_frame_events, peer_frame_t, peer_frame_events),
+        (f"one step of {horizon:g} s", our_t, our_events, peer_t, peer_events),
+        (f"{n_frames} frames of 1/60 s", our_frame_t, our_frame_events, peer_frame_t, peer_frame_events),
     ):
         o = _summary(ours_t)
         p = _summary(peer_t_)
@@ -258,7 +261,7 @@ def bench_gas(quick):
             "speedup_best": (ours_n / o["best"]) / (peer_n / p["best"]),
             "speedup_median": (ours_n / o["median"]) / (peer_n / p["median"]),
         })
-    return {"n": GAS_N, "radius": GAS_RADIUS, "box": [-GAS_HALF, GAS_HALF], "rows": rows, "check": check,
+    return {"n": n, "radius": GAS_RADIUS, "box": [-GAS_HALF, GAS_HALF], "rows": rows, "check": check,
             "full_horizon": full}
 
 
@@ -290,7 +293,7 @@ def bench_per_step(quick):
         import pymunk
     except ImportError:
         pymunk = None
-    steps, repeats = (200, 5) if quick else (600, 9)
+    steps, repeats = (200, 5) if quick else (1000, 25)
     rng = np.random.default_rng(7)
     rows = []
     for n in STEP_BALLS:
@@ -335,7 +338,7 @@ def bench_per_step(quick):
 # ---------------------------------------------------------------------------------------- 3. batch
 def bench_batch(quick):
     """Scene-steps per second: one BatchSimulator of 1024 scenes against a loop of Simulators."""
-    steps, repeats = (10, 3) if quick else (30, 7)
+    steps, repeats = (10, 3) if quick else (30, 15)
     rng = np.random.default_rng(11)
     b, n = BATCH_SCENES, BATCH_BALLS
     pos = np.empty((b, n, 2))
@@ -415,13 +418,13 @@ def render_markdown(results):
         "brackets); compare the ratios, which are measured in the same run.",
         "",
     ]
-    gas = results.get("gas", {})
-    if "skipped" in gas:
-        lines += ["### Exact mode against billiards", "", f"Skipped: {gas['skipped']}", ""]
-    elif gas:
+    for gas in results.get("gas", []):
+        if "skipped" in gas:
+            lines += ["### Exact mode against billiards", "", f"Skipped: {gas['skipped']}", ""]
+            continue
         lines += [
-            f"### Exact mode against billiards: {gas['n']}-disk elastic gas (r = {gas['radius']}, box [-1, 1]², "
-            f"T = {gas['full_horizon']['horizon_s']:g} s)",
+            f"### Exact mode against billiards: {gas['n']}-disk elastic gas (r = {gas['radius']}, "
+            f"box [-1, 1]², T = {gas['full_horizon']['horizon_s']:g} s)",
             "",
             "| run | our events | our time (s) | our events/s | billiards events | billiards time (s) "
             "| billiards events/s | speed-up |",
@@ -433,20 +436,21 @@ def render_markdown(results):
                 f"| {_fmt(r['ours_s']['best'])} ({_fmt(r['ours_s']['median'])}) "
                 f"| {_fmt(r['ours_events_per_s'])} | {_fmt(r['billiards_events'])} "
                 f"| {_fmt(r['billiards_s']['best'])} ({_fmt(r['billiards_s']['median'])}) "
-                f"| {_fmt(r['billiards_events_per_s'])} | **{r['speedup_best']:.0f}×** ({r['speedup_median']:.0f}×) |"
+                f"| {_fmt(r['billiards_events_per_s'])} "
+                f"| **{r['speedup_best']:.0f}×** ({r['speedup_median']:.0f}×) |"
             )
         c = gas["check"]
         f = gas["full_horizon"]
         lines += [
             "",
-            f"Same trajectories: over the first {c['horizon_s']:.3g} s ({c['collisions_per_ball']:.1f} collisions per "
-            f"ball, {c['events']} events) the collision sequences are identical: {_fmt(c['same_sequence'])}; largest "
-            f"difference in impact time {_fmt(c['max_time_diff_s'])} s, "
-            f"in position {_fmt(c['max_position_diff_m'])} m, "
-            f"in velocity {_fmt(c['max_velocity_diff_m_s'])} m/s. Over the full {f['horizon_s']:g} s "
-            f"({f['collisions_per_ball']:.0f} collisions per ball) the gas is chaotic: the sequences agree for the "
-            f"first {f['sequences_agree_for_events']} of {f['events_ours']} (ours) / {f['events_billiards']} "
-            f"(billiards) events and the positions end up to {_fmt(f['max_position_diff_m'])} m apart.",
+            f"Same trajectories: over the first {c['horizon_s']:.3g} s ({c['collisions_per_ball']:.1f} "
+            f"collisions per ball, {c['events']} events) the collision sequences are identical: "
+            f"{_fmt(c['same_sequence'])}; largest difference in impact time {_fmt(c['max_time_diff_s'])} s, "
+            f"in position {_fmt(c['max_position_diff_m'])} m, in velocity {_fmt(c['max_velocity_diff_m_s'])} m/s. "
+            f"Over the full {f['horizon_s']:g} s ({f['collisions_per_ball']:.0f} collisions per ball) the gas is "
+            f"chaotic: the sequences agree for the first {f['sequences_agree_for_events']} of {f['events_ours']} "
+            f"(ours) / {f['events_billiards']} (billiards) events and the positions end up to "
+            f"{_fmt(f['max_position_diff_m'])} m apart.",
             "",
         ]
     ps = results.get("per_step")
@@ -494,8 +498,10 @@ def run(quick=False, parts=("gas", "per_step", "batch"), log=print):
     _warm_up()
     results = {}
     if "gas" in parts:
-        log("gas: exact mode against billiards ...")
-        results["gas"] = bench_gas(quick)
+        results["gas"] = []
+        for n, horizon in GAS_CASES + (() if quick else GAS_CASES_FULL):
+            log(f"gas of {n} disks: exact mode against billiards ...")
+            results["gas"].append(bench_gas(quick, n, horizon))
     if "per_step" in parts:
         log("per-step cost of each mode ...")
         results["per_step"] = bench_per_step(quick)
