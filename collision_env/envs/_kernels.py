@@ -44,7 +44,7 @@ Q_LEN = 4
 def nudge_kernel(actions, active, vel, ctrl, P, Q, dv, cost):  # pragma: no cover - numba
     """Scale actions to velocity changes ``dv`` (B, N, 2) and their cost (B,).
 
-    Returns -1, or the first row holding a NaN (then nothing is written). Only the controlled
+    Returns -1, or the first active row holding a NaN (then nothing is written). Only the controlled
     balls' entries of ``dv`` are written (the others must be zero).
     Each action component is clipped to [-1, 1] and multiplied by ``max_dv``. The nudge never
     raises a ball's speed above max(max_speed, current speed); the cost is ``action_cost`` times
@@ -52,9 +52,10 @@ def nudge_kernel(actions, active, vel, ctrl, P, Q, dv, cost):  # pragma: no cove
     """
     B = actions.shape[0]
     for b in range(B):
-        for c in range(actions.shape[1]):
-            if actions[b, c] != actions[b, c]:
-                return b  # NaN: reject the whole call before changing anything
+        if active[b]:  # (an inactive row's action is ignored, NaN or not)
+            for c in range(actions.shape[1]):
+                if actions[b, c] != actions[b, c]:
+                    return b  # NaN: reject the whole call before changing anything
     dim = Q[Q_DIM]
     max_dv = P[P_MAXDV]
     max_speed = P[P_MAXSPEED]

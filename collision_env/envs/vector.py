@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 from gymnasium import spaces
+from gymnasium.error import ResetNeeded
 from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
@@ -146,12 +147,11 @@ class CollisionTargetVectorEnv(VectorEnv):
                 np.zeros(B, dtype=bool), np.zeros(B, dtype=np.int64), np.zeros(B))
 
     def step(self, actions):
+        if self._rngs[0] is None:
+            raise ResetNeeded("call reset() before step() on the vector env")
         a = np.asarray(actions, dtype=np.float64)
         if a.shape != self.action_space.shape:
             raise ValueError(f"actions: expected shape {self.action_space.shape}, got {a.shape}")
-        if np.isnan(a).any():
-            bad = np.flatnonzero(np.isnan(a).any(-1))
-            raise ValueError(f"actions: NaN in the action of sub-env(s) {bad.tolist()}")
         core = self._core
         B = self.num_envs
         cap_limit = self.max_episode_steps
