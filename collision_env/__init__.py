@@ -22,6 +22,7 @@ _ENVS = {
     "CollisionEnv/Billiards-v0": ("billiards:BilliardsEnv", "billiards:BilliardsVectorEnv"),
     "CollisionEnv/InelasticCluster-v0": ("inelastic_cluster:InelasticClusterEnv",
                                          "inelastic_cluster:InelasticClusterVectorEnv"),
+    "CollisionEnv/MultiBall-v0": ("multi_ball:MultiBallEnv", "multi_ball:MultiBallVectorEnv"),
     "CollisionEnv/Target-v0": ("target_env:CollisionTargetEnv", "vector:CollisionTargetVectorEnv"),
 }
 

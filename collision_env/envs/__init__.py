@@ -11,6 +11,7 @@ from collision_env.envs._core import EpisodeSampler, Impacts, sample_episode
 from collision_env.envs.billiards import BilliardsEnv, BilliardsVectorEnv
 from collision_env.envs.inelastic_cluster import InelasticClusterEnv, InelasticClusterVectorEnv
 from collision_env.envs.line_1d import Line1DEnv, Line1DVectorEnv
+from collision_env.envs.multi_ball import MultiBallEnv, MultiBallVectorEnv
 from collision_env.envs.one_ball import OneBallTargetEnv, OneBallTargetVectorEnv
 from collision_env.envs.target_env import CollisionTargetEnv
 from collision_env.envs.vector import CollisionTargetVectorEnv
@@ -21,6 +22,7 @@ PRESET_IDS = {
     "line_1d": "CollisionEnv/Line1D-v0",
     "billiards": "CollisionEnv/Billiards-v0",
     "inelastic_cluster": "CollisionEnv/InelasticCluster-v0",
+    "multi_ball": "CollisionEnv/MultiBall-v0",
 }
 
 __all__ = [
@@ -35,6 +37,8 @@ __all__ = [
     "InelasticClusterVectorEnv",
     "Line1DEnv",
     "Line1DVectorEnv",
+    "MultiBallEnv",
+    "MultiBallVectorEnv",
     "OneBallTargetEnv",
     "OneBallTargetVectorEnv",
     "TaskConfig",

@@ -298,6 +298,14 @@ PRESETS: dict[str, dict] = {
         n_targets=1, sequential=True, target_width=0.8, scorers="cluster", hit_reward=1.0,
         success_bonus=1.0, miss_penalty=0.0, action_cost=0.02, shaping=0.0, max_dv=0.15, max_speed=1.5,
     ),
+    # 5. Three balls, all nudged, that pass through each other (no ball-ball collisions), explicit
+    #    radius, walls with e = 0.8; three targets at once, any ball may take any target.
+    "multi_ball": dict(
+        dimension=2, elasticity=0.8, ball_collisions=False, n_balls=3, mass_range=(0.5, 1.5), radius=0.12,
+        speed_range=(0.2, 0.6), controlled=(0, 1, 2), n_targets=3, sequential=False, target_width=0.6,
+        scorers="any", hit_reward=1.0, success_bonus=1.0, miss_penalty=0.02, action_cost=0.01, shaping=0.5,
+        max_dv=0.15, max_speed=2.0,
+    ),
 }
 
 

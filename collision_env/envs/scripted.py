@@ -1,8 +1,8 @@
 """Scripted policies that aim with the engine's exact prediction (baselines, tests, demo GIFs).
 
-* :class:`AimingPolicy` (one controlled ball, no others in the way): each step it asks a copy of the
-  engine (``BatchSimulator.copy()`` then ``step``) where the ball's next wall impact will land; if not
-  on the current target, it searches directions the same way and steers towards one that is.
+* :class:`AimingPolicy` (controlled balls with nothing but walls in the way): each step it asks a copy
+  of the engine (``BatchSimulator.copy()`` then ``step``) where each ball's next wall impact will land;
+  if not on a target, it searches directions the same way and steers towards one that is.
 * :class:`ShootingPolicy` (any preset): candidate plans (action sequences) are run ahead on the env
   itself from a saved state (``get_state``/``set_state``); the first whose predicted rollout hits a
   target is executed. Because the engine is deterministic and exact, the real episode hits the
@@ -36,10 +36,12 @@ def first_wall_impact(records: np.ndarray, ball: int | None = None):
 
 
 class AimingPolicy:
-    """Steer one ball so that its next wall impact lands on the current target.
+    """Steer each controlled ball so that its next wall impact lands on a pending target.
 
-    Works on an unwrapped :class:`~collision_env.envs.CollisionTargetEnv` whose ball 0 is
-    controlled and scores (``OneBallTarget``). Call it with no argument each step.
+    For scenes where the controlled balls score and meet nothing on the way but walls (one ball,
+    or ``ball_collisions=False``): ``OneBallTarget`` and ``MultiBall``. Ball j of the controlled
+    balls aims at the (j mod n)-th of the n pending visible targets. Call it with no argument each
+    step; it returns the action.
     """
 
     def __init__(self, env, speed: float = 1.2, lookahead: float = 6.0, directions: int = 144):
@@ -47,34 +49,50 @@ class AimingPolicy:
         self.speed = speed
         self.lookahead = lookahead
         self.angles = np.linspace(-math.pi, math.pi, directions, endpoint=False)
-        self.want = None
+        self.want = {}
 
-    def predicts_hit(self, dv: np.ndarray) -> bool:
-        """Does ball 0 hit the current target next if its velocity changes by ``dv`` now?"""
+    def _pending(self) -> list:
+        core, cfg = self.env.core, self.env.config
+        if cfg.sequential:
+            k = int(core.cur[0])
+            return [k] if k < core.t_wall.shape[1] else []
+        return np.flatnonzero(core.t_status[0] == 0).tolist()
+
+    def predicts_hit(self, ball: int, dv: np.ndarray, targets) -> bool:
+        """Does ``ball`` hit one of ``targets`` next if its velocity changes by ``dv`` now?"""
         core = self.env.core
         sim = core.batch.copy()
-        sim.nudge(dv[None, None, :])
-        r = first_wall_impact(sim.step(self.lookahead), ball=0)
-        k = min(int(core.cur[0]), core.t_wall.shape[1] - 1)
-        return r is not None and on_target(core, 0, k, r["wall"], r["x"], r["y"], r["time"])
+        nudge = np.zeros((1, core.cfg.n_balls, 2))
+        nudge[0, ball] = dv
+        sim.nudge(nudge)
+        r = first_wall_impact(sim.step(self.lookahead), ball=ball)
+        return r is not None and any(on_target(core, 0, k, r["wall"], r["x"], r["y"], r["time"]) for k in targets)
 
     def __call__(self, obs=None) -> np.ndarray:
         core, cfg = self.env.core, self.env.config
-        v = core.vel[0, 0]
-        if self.predicts_hit(np.zeros(2)):
-            self.want = None
-            return np.zeros(2, np.float32)  # already on course: coast
-        if self.want is None or not self.predicts_hit(self.want - v):
-            self.want = None
-            cur = math.atan2(v[1], v[0])
-            for ang in sorted(self.angles, key=lambda a: abs(math.remainder(a - cur, 2 * math.pi))):
-                want = self.speed * np.array([math.cos(ang), math.sin(ang)])
-                if self.predicts_hit(want - v):
-                    self.want = want
-                    break
-        if self.want is None:
-            return np.zeros(2, np.float32)
-        return np.clip((self.want - v) / cfg.max_dv, -1, 1).astype(np.float32)
+        action = np.zeros(len(cfg.controlled) * 2, np.float32)
+        pending = self._pending()
+        if not pending:
+            return action
+        for j, i in enumerate(cfg.controlled):
+            v = core.vel[0, i]
+            if self.predicts_hit(i, np.zeros(2), pending):
+                self.want[i] = None
+                continue  # already on course to some target: coast
+            mine = [pending[j % len(pending)]]
+            want = self.want.get(i)
+            if want is None or not self.predicts_hit(i, want - v, mine):
+                want = None
+                cur = math.atan2(v[1], v[0])
+                for ang in sorted(self.angles, key=lambda a: abs(math.remainder(a - cur, 2 * math.pi))):
+                    cand = self.speed * np.array([math.cos(ang), math.sin(ang)])
+                    if self.predicts_hit(i, cand - v, mine):
+                        want = cand
+                        break
+                self.want[i] = want
+            if want is not None:
+                action[2 * j:2 * j + 2] = np.clip((want - v) / cfg.max_dv, -1, 1)
+        return action
 
 
 # --------------------------------------------------------------------------------------------- #
@@ -203,7 +221,8 @@ class ShootingPolicy:
 def scripted_policy(env):
     """A scripted policy for the unwrapped env's preset (``None`` when there is none)."""
     cfg = env.config
-    if cfg.n_balls == 1 and cfg.dimension == 2:
+    if cfg.dimension == 2 and cfg.scorers in ("any", "controlled") and (cfg.n_balls == 1 or not cfg.ball_collisions) \
+            and len(cfg.controlled) == cfg.n_balls:
         return AimingPolicy(env)
     if cfg.scorers == "cluster":
         def ram_first(e):

@@ -26,7 +26,7 @@ def rollout(env, seed, n=60, action_seed=0):
 
 
 def test_every_id_is_registered_with_a_vector_entry_point():
-    assert set(PRESET_IDS.values()) < set(collision_env.ENV_IDS)
+    assert set(PRESET_IDS.values()) < set(collision_env.ENV_IDS) and len(PRESET_IDS) == 5
     for env_id in collision_env.ENV_IDS:
         spec = gym.spec(env_id)
         assert spec.namespace == "CollisionEnv" and spec.version == 0
@@ -198,3 +198,22 @@ def test_info_is_fresh_and_impacts_match_the_engine():
         if term or trunc:
             break
     assert seen > 0
+
+
+def test_engine_models_only_what_each_preset_needs():
+    expect = {  # id: (ball pairs, clusters, dimension)
+        "CollisionEnv/OneBallTarget-v0": (False, False, 2),
+        "CollisionEnv/MultiBall-v0": (False, False, 2),
+        "CollisionEnv/Line1D-v0": (True, False, 1),
+        "CollisionEnv/Billiards-v0": (True, False, 2),
+        "CollisionEnv/InelasticCluster-v0": (True, True, 2),
+    }
+    for env_id, (pairs, clusters, dim) in expect.items():
+        env = gym.make(env_id).unwrapped
+        models = env.simulator.models
+        assert (models["ball_pairs"], models["clusters"], models["dimension"]) == (pairs, clusters, dim), env_id
+        env.reset(seed=0)
+        for _ in range(50):
+            env.step(env.action_space.sample())
+        if not pairs:
+            assert env.simulator.stats["pair_tests"] == 0, env_id

@@ -1,0 +1,72 @@
+"""Three balls, all nudged, passing through each other; three targets at once."""
+
+from __future__ import annotations
+
+from collision_env.envs.target_env import CollisionTargetEnv
+from collision_env.envs.vector import CollisionTargetVectorEnv
+
+
+class MultiBallEnv(CollisionTargetEnv):
+    """
+    ## Description
+
+    Three balls (0.5-1.5 kg, explicit radius 0.12 m) in the 4 m x 2 m area with ball-ball
+    collisions **off** (they pass through each other; the engine does no pair work at all) and
+    walls of restitution e = 0.8. The agent nudges all three at once; three 0.6 m targets are shown
+    together and any ball's wall impact may take any of them. `CollisionEnv/MultiBall-v0`; the
+    generic env with `preset="multi_ball"`.
+
+    ## Action Space
+
+    `Box(-1, 1, (6,), float32)`: (ax, ay) for balls 0, 1, 2 in order, each scaled to a velocity
+    change of up to 0.15 m/s per component for this 0.05 s step. Out-of-range values are clipped;
+    NaN raises `ValueError`. A nudge cannot push a ball above 2 m/s (or above its current speed,
+    if that is higher).
+
+    ## Observation Space
+
+    `Box(-1, 1, (50,), float32)`:
+
+    | Index           | Observation                                                       |
+    |-----------------|-------------------------------------------------------------------|
+    | 6i + 0, 1       | ball i position x / 2 m, y / 1 m (i = 0, 1, 2)                    |
+    | 6i + 2, 3       | ball i velocity / 4 m/s                                           |
+    | 6i + 4          | ball i mass / 3 kg                                                |
+    | 6i + 5          | 1 (every ball's impacts score)                                    |
+    | 18 + 10s + 0, 1 | target s = 0, 1, 2: centre point x / 2 m, y / 1 m                 |
+    | 18 + 10s + 2    | half width / half length of its wall                              |
+    | 18 + 10s + 3..6 | wall one-hot (left, right, bottom, top)                           |
+    | 18 + 10s + 7    | status: 1 pending, 0 hit                                          |
+    | 18 + 10s + 8, 9 | -1, 1 (no time window)                                            |
+    | 48              | fraction of the 200 control steps left                            |
+    | 49              | fraction of the 3 targets not yet hit                             |
+
+    ## Rewards
+
+    +1 per target hit (exact contact point on a pending target), +1 more when all three are hit,
+    -0.02 per wall impact off target, -0.01 per m/s of requested nudge, and the aiming shaping term
+    `0.5 * (phi(s') - phi(s))` (see `CollisionTargetEnv`) on steps without a hit.
+
+    ## Starting State
+
+    Balls at random non-overlapping places, speeds uniform in [0.2, 0.6] m/s in random directions;
+    three targets on random walls.
+
+    ## Episode End
+
+    Terminates with `info["is_success"] = True` when all three targets are hit; truncates after
+    200 steps (10 s).
+
+    ## Arguments
+
+    Any `TaskConfig` field as a keyword (e.g. `n_balls=5, controlled=(0, 1, 2, 3, 4)`);
+    `render_mode`; `trails`.
+    """
+
+    preset = "multi_ball"
+
+
+class MultiBallVectorEnv(CollisionTargetVectorEnv):
+    """Native vector version of :class:`MultiBallEnv` (see :class:`CollisionTargetVectorEnv`)."""
+
+    preset = "multi_ball"
