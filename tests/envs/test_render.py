@@ -6,6 +6,8 @@ import pytest
 
 from .conftest import ENV_IDS
 
+pytest.importorskip("pygame")
+
 
 @pytest.mark.parametrize("trails", [False, True])
 def test_rgb_frames_are_nonblank_and_change_as_balls_move(env_id, trails):

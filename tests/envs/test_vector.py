@@ -133,6 +133,7 @@ def test_vector_pickle_and_state():
 
 
 def test_vector_render_frames():
+    pytest.importorskip("pygame")
     venv = gym.make_vec("CollisionEnv/OneBallTarget-v0", 2, render_mode="rgb_array")
     venv.reset(seed=0)
     frames = venv.render()
@@ -144,6 +145,7 @@ def test_vector_render_frames():
 
 
 def test_sb3_adapter_matches_dummy_vec_env():
+    pytest.importorskip("stable_baselines3")
     from stable_baselines3.common.vec_env import DummyVecEnv
 
     from collision_env.envs.sb3 import CollisionSB3VecEnv
@@ -173,6 +175,7 @@ def test_sb3_adapter_matches_dummy_vec_env():
 
 
 def test_sb3_ppo_trains_on_the_native_vector_env():
+    pytest.importorskip("stable_baselines3")
     from stable_baselines3 import PPO
 
     from collision_env.envs.sb3 import make_sb3_vec_env
