@@ -177,7 +177,7 @@ class TaskCore:
     """A batch of B task instances on one BatchSimulator."""
 
     def __init__(self, cfg: TaskConfig, num_scenes: int):
-        from collision_env.engine import BatchSimulator, Scene
+        from collision_env.engine import IMPACT_DTYPE, BatchSimulator, Scene
 
         self.cfg = cfg
         B, N, Kt = int(num_scenes), cfg.n_balls, cfg.n_targets
@@ -235,7 +235,7 @@ class TaskCore:
         self._write_episode(np.arange(B), Episodes(*(rep(getattr(ep, f)) for f in Episodes.__slots__)))
         self.pos = self.batch.positions
         self.vel = self.batch.velocities
-        self.impact_dtype = self.batch.step(0.0).dtype  # a zero step: only to learn the record dtype
+        self.impact_dtype = IMPACT_DTYPE
 
     # ------------------------------------------------------------------------------------- #
     def _write_episode(self, idx: np.ndarray, eps: Episodes) -> None:
