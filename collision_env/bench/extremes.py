@@ -1,0 +1,581 @@
+"""Stability at the extremes: every mode over a stress grid, pass or the reason it fails.
+
+Run it as ``python -m collision_env.bench.extremes [--quick] [--out docs/bench]``.
+
+The grid (:func:`cells`) spans speeds 1e-6 to 1e4 m/s, radii 1e-4 to 0.5 m, mass ratios up to
+1e12, restitution 0 (slip and stick), 0.05, 0.5 and 1, control steps 1e-6 to 1 s, episodes up to
+1e5 s of simulated time, balls touching at the start (each other and the walls), exact corner hits
+and grazing contacts. Each cell is one scene, one control step and one duration; every mode runs
+it, stepping the public :class:`~collision_env.engine.Simulator` and checking after every step:
+
+- **NaN**: a position or velocity is not finite;
+- **escape**: a ball sticks out of the reflecting border by more than ``1e-9 (r + |x|)``;
+- **overlap**: two balls overlap by more than ``1e-9 (r_i + r_j) + 1e-12 |x|``;
+- **energy growth**: the kinetic energy rises above its start value, or above its value at the
+  previous step, by more than a relative 1e-9;
+- **event cap**: the step stopped at the event cap (``cap_reached``);
+- **time limit**: the mode's steps took longer in all than the budget (``--budget``, per cell and mode;
+  the checks between steps are not counted);
+- **wrong**: the cell has an analytic answer (pi-billiard collision count, corner reversal,
+  Newton's cradle, a lone ball's position after up to 1e5 s within 1e-12 of its path length, a
+  graze or a miss) and the mode got it wrong.
+
+The event cap is set per cell above the physical number of events in one step (estimated from
+speeds, sizes and the box), so that reaching it flags a runaway (Zeno) step rather than a busy but
+finite one: a ball at 1e4 m/s in a 4 m box hits ~1e4 walls per second, which a 1 s step must
+resolve. Cheaper modes failing cells is the documented trade; exact mode must pass every cell.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+import sys
+import time
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from collision_env.engine import PLAY_AREA_1D, PLAY_AREA_2D, EventCapWarning, Scene, Simulator
+
+from .scenes import Case, _case, gas, inelastic_pileup, pi_billiard, pi_collisions
+
+MODES = (("naive", 1), ("posteriori", 1), ("exact", 1))
+REASONS = ("NaN", "escape", "overlap", "energy growth", "event cap", "time limit", "wrong")
+TOL = 1e-9
+
+
+@dataclass
+class Cell:
+    """One scene, control step and duration of the stress grid."""
+
+    name: str
+    group: str
+    build: Callable[[], Case]
+    dt: float
+    duration: float
+    events_per_s: float = 0.0  # rough physical event rate (sets the cap)
+    check: Callable | None = None  # (sim, n_impacts, impacts or None) -> None or a message
+    quick: bool = False
+    params: dict = field(default_factory=dict)
+    cap: int | None = None  # event cap per step, when the physics bounds it better than the rate
+
+    @property
+    def steps(self) -> int:
+        return max(1, int(round(self.duration / self.dt)))
+
+    @property
+    def max_events(self) -> int:
+        if self.cap is not None:
+            return self.cap
+        return int(max(10_000, 20 * self.events_per_s * self.dt + 1000))
+
+
+# --------------------------------------------------------------------------- scene helpers
+def _box_rate(n, speed, bounds, radius):
+    """Rough events per second: each ball meets a wall or another ball every ~free length."""
+    if bounds is None:
+        return n * speed
+    free = max(min(bounds[2] - bounds[0], bounds[3] - bounds[1]) - 2 * radius, radius)
+    return 2 * n * speed / free + n * speed / max(radius, 1e-12) * 0.05
+
+
+def _two_ball_graze(delta):
+    """Two balls r = 0.1 passing with impact parameter sigma (1 - delta); no border."""
+    sigma = 0.2
+    b = sigma * (1.0 - delta)
+    return _case(Scene(bounds=None), [[-1.0, 0.0], [1.0, b]], [[1.0, 0.0], [-1.0, 0.0]], [1.0, 1.0], [0.1, 0.1])
+
+
+def _corner(e, r=0.5):
+    """A ball from the centre aimed exactly at the top-right corner: both wall times are 0.5 s."""
+    return _case(Scene(bounds=PLAY_AREA_2D, elasticity=e), [[0.0, 0.0]], [[3.0, 1.0]], [1.0], [r])
+
+
+def _cradle(n, e, r=0.1):
+    """``n - 1`` touching balls at rest, a hitter at 1 m/s 0.2 m away; 1D."""
+    x0 = -(n - 2) * r
+    pos = [[x0 - 2 * r - 0.2, 0.0]] + [[x0 + 2 * r * k, 0.0] for k in range(n - 1)]
+    vel = [[1.0, 0.0]] + [[0.0, 0.0]] * (n - 1)
+    return _case(Scene(bounds=PLAY_AREA_1D, elasticity=e, dimension=1), pos, vel, np.ones(n), np.full(n, r))
+
+
+def _train_on_wall(n, e, r=0.1, inelastic="slip"):
+    """``n`` balls touching each other and the left wall, all moving left at 1 m/s; 1D."""
+    pos = [[-2.0 + r + 2 * r * k, 0.0] for k in range(n)]
+    vel = [[-1.0, 0.0]] * n
+    return _case(Scene(bounds=PLAY_AREA_1D, elasticity=e, dimension=1, inelastic=inelastic), pos, vel, np.ones(n),
+                 np.full(n, r))
+
+
+def _wall_touch(e):
+    """A ball touching the right wall and moving into it, another touching it from the left, 2D."""
+    return _case(Scene(bounds=PLAY_AREA_2D, elasticity=e), [[1.9, 0.0], [1.7, 0.0]], [[1.0, 0.3], [0.5, 0.0]],
+                 [1.0, 1.0], [0.1, 0.1])
+
+
+def _wedged(e, gap):
+    """A ball ``gap`` m shorter than the box is tall (r = 1 - gap/2), moving diagonally (gap 0: along x)."""
+    vy = 0.5 if gap > 0 else 0.0
+    return _case(Scene(bounds=PLAY_AREA_2D, elasticity=e), [[0.0, 0.0]], [[1.0, vy]], [1.0], [1.0 - gap / 2])
+
+
+def _slide(e):
+    """A ball touching the bottom wall and sliding along it into the corner (grazing a wall)."""
+    return _case(Scene(bounds=PLAY_AREA_2D, elasticity=e), [[0.0, -0.9]], [[1.0, 0.0]], [1.0], [0.1])
+
+
+def _simultaneous(e):
+    """Ball 0 catches up with ball 1 just as ball 1 hits the right wall, at t = 0.5 s."""
+    return _case(Scene(bounds=PLAY_AREA_2D, elasticity=e), [[1.1, 0.0], [1.4, 0.0]], [[1.2, 0.0], [1.0, 0.0]],
+                 [1.0, 1.0], [0.1, 0.1])
+
+
+def _mass_gas(ratio, e):
+    """A heavy ball (``ratio`` kg) at rest among three 1 kg balls at 1 m/s, r = 0.2, 2D."""
+    rng = np.random.default_rng(5)
+    pos = [[0.0, 0.0], [-1.2, 0.5], [1.2, -0.5], [0.8, 0.6]]
+    ang = rng.uniform(0, 2 * math.pi, 3)
+    vel = [[0.0, 0.0]] + [[math.cos(a), math.sin(a)] for a in ang]
+    return _case(Scene(bounds=PLAY_AREA_2D, elasticity=e), pos, vel, [ratio, 1.0, 1.0, 1.0], [0.2] * 4)
+
+
+def _hex_pack(e, inelastic="slip"):
+    """19 touching balls (r = 0.1) in a hexagon at rest in the middle, a 5 m/s ball coming in; 2D."""
+    r = 0.1
+    pos = []
+    for row in range(-2, 3):
+        count = 5 - abs(row)
+        for k in range(count):
+            pos.append([(k - (count - 1) / 2) * 2 * r, row * math.sqrt(3) * r])
+    pos.append([-1.5, 0.013])
+    vel = [[0.0, 0.0]] * 19 + [[5.0, 0.0]]
+    return _case(Scene(bounds=PLAY_AREA_2D, elasticity=e, inelastic=inelastic), pos, vel, np.ones(20),
+                 np.full(20, r))
+
+
+def _heavy_cradle(ratio):
+    """A touching row of alternating 1 kg and ``ratio`` kg balls, hit by a 1 kg ball; 1D, e = 1."""
+    r = 0.1
+    n = 6
+    pos = [[-1.0, 0.0]] + [[-0.5 + 2 * r * k, 0.0] for k in range(n - 1)]
+    vel = [[1.0, 0.0]] + [[0.0, 0.0]] * (n - 1)
+    m = [1.0] + [ratio if k % 2 == 0 else 1.0 for k in range(n - 1)]
+    return _case(Scene(bounds=PLAY_AREA_1D, elasticity=1.0, dimension=1), pos, vel, m, np.full(n, r))
+
+
+def _inelastic_pi(ratio, e):
+    """Galperin's geometry at restitution ``e``: wall, light ball at rest, heavy ball coming in."""
+    c = pi_billiard(2, 1)
+    return _case(Scene(bounds=c.scene.bounds, elasticity=e, dimension=1), c.positions, c.velocities,
+                 [1.0, ratio], c.radii)
+
+
+def _stuck_pair_corner():
+    """Two balls that stick on contact, heading together for the top-right corner; 2D, stick."""
+    return _case(Scene(bounds=PLAY_AREA_2D, elasticity=0.0, inelastic="stick"), [[0.5, 0.2], [1.0, 0.5]],
+                 [[1.5, 0.9], [0.5, 0.3]], [1.0, 2.0], [0.15, 0.2])
+
+
+def _stuck_gas(n):
+    c = gas(n, radius=0.1, packing=0.1, speed=1.0, seed=3)
+    return Case(Scene(bounds=c.scene.bounds, elasticity=0.0, inelastic="stick"), *c[1:])
+
+
+# --------------------------------------------------------------------------- analytic checks
+def _check_pi(digits):
+    def check(sim, count, impacts):
+        want = pi_collisions(digits)
+        return None if count == want else f"{count} collisions, expected {want}"
+    return check
+
+
+def _check_corner(e):
+    def check(sim, count, impacts):
+        v = sim.velocities[0]
+        want = np.array([-3.0 * e, -1.0 * e])
+        if np.allclose(v, want, rtol=1e-12, atol=1e-15):
+            return None
+        return f"velocity after the corner {v.tolist()}, expected {want.tolist()}"
+    return check
+
+
+def _check_cradle(n):
+    """After the chain (and before the far ball reaches the wall) only the far ball moves, at 1 m/s."""
+    def check(sim, count, impacts):
+        v = sim.velocities[:, 0]
+        want = np.zeros(n)
+        want[-1] = 1.0
+        if np.allclose(v, want, rtol=0, atol=1e-12):
+            return None
+        return f"velocities after the chain {np.round(v, 12).tolist()}, expected {want.tolist()}"
+    return check
+
+
+def _lone_position(x0, v, lo, hi, t):
+    """Position at time t of a point bouncing elastically in [lo, hi] (centre range)."""
+    span = hi - lo
+    u = (x0 - lo + v * t) % (2 * span)
+    return lo + (u if u <= span else 2 * span - u)
+
+
+def _check_lone(case, t_end):
+    def check(sim, count, impacts):
+        (x0, y0), (vx, vy), r = case.positions[0], case.velocities[0], case.radii[0]
+        b = case.scene.bounds
+        want = np.array([_lone_position(x0, vx, b[0] + r, b[2] - r, t_end),
+                         _lone_position(y0, vy, b[1] + r, b[3] - r, t_end)])
+        err = float(np.hypot(*(sim.positions[0] - want)))
+        # round-off in the event times moves the ball along the wall a little at every bounce: allow
+        # 1e-12 of the path length (about 5000 ulps), or 1e-6 of a radius
+        tol = max(1e-6 * r, 1e-12 * float(np.hypot(vx, vy)) * t_end)
+        return None if err <= tol else f"position off the analytic one by {err:.3g} m after {t_end:g} s (tol {tol:.2g})"
+    return check
+
+
+def _check_graze(hit):
+    def check(sim, count, impacts):
+        v = sim.velocities
+        if not hit:
+            ok = count == 0 and np.array_equal(v, [[1.0, 0.0], [-1.0, 0.0]])
+            return None if ok else f"{count} impacts for a miss / exact graze, velocities {v.tolist()}"
+        return None if count == 1 else f"{count} impacts for a (near-grazing) hit, expected 1"
+    return check
+
+
+# --------------------------------------------------------------------------- the grid
+def cells(quick: bool = False) -> list[Cell]:
+    """The stress grid (``quick``: a subset marked ``quick``)."""
+    out: list[Cell] = []
+
+    def add(name, group, build, dt, duration, rate=0.0, check=None, q=False, cap=None, **params):
+        out.append(Cell(name, group, build, dt, duration, rate, check, q, params, cap))
+
+    # speed x control step: an 8-ball gas, r = 0.1, PhET box, e = 1
+    for v in (1e-6, 1e-3, 1.0, 1e2, 1e4):
+        for dt in (1e-6, 1e-3, 1.0):
+            rate = _box_rate(8, v, PLAY_AREA_2D, 0.1)
+            steps = int(min(200, max(2, 2e5 / max(rate * dt, 1e-300))))
+            q = (v, dt) in ((1e-6, 1.0), (1.0, 1e-3), (1e4, 1e-6), (1e4, 1.0), (1e2, 1e-3))
+
+            def build(v=v):
+                c = gas(8, radius=0.1, packing=8 * math.pi * 0.01 / 8.0, speed=v, seed=4)
+                return c
+            add(f"gas8 v={v:g} dt={dt:g}", "speed x dt", build, dt, steps * dt, rate, q=q, speed=v)
+    # radius: a gas of 4 (3 at r = 0.5), speed 1
+    for r in (1e-4, 1e-3, 1e-2, 0.1, 0.5):
+        n = 3 if r >= 0.5 else 4
+        for dt in (1e-3, 0.1):
+            def build(r=r, n=n):
+                c = gas(n, radius=r, packing=n * math.pi * r * r / 8.0, speed=1.0, seed=6)
+                return c
+            add(f"gas{n} r={r:g} dt={dt:g}", "radius", build, dt, 5.0, _box_rate(n, 1.0, PLAY_AREA_2D, r),
+                q=(dt == 0.1 and r in (1e-4, 0.5)), radius=r)
+    # mass ratio: Galperin's billiard (count must be exact) and a heavy ball in a gas
+    for digits in (1, 2, 3, 4, 5, 6):
+        for dt in (1e-3, 1.0):
+            if digits == 6 and dt < 1:
+                continue  # the 3.1 million collisions happen within microseconds: one step size is enough
+            add(f"pi billiard 1e{2 * digits} dt={dt:g}", "mass ratio", lambda d=digits: pi_billiard(2, d), dt,
+                12.0 if digits < 4 else 8.0, 0.0, _check_pi(digits),
+                q=(digits in (2, 6) and dt == 1.0) or (digits == 3 and dt == 1e-3),
+                cap=pi_collisions(digits) + 10_000, ratio=100.0**digits)
+    for ratio in (1e3, 1e6, 1e9, 1e12):
+        for e in (1.0, 0.5):
+            add(f"heavy in gas 1e{round(math.log10(ratio))} e={e:g}", "mass ratio",
+                lambda ratio=ratio, e=e: _mass_gas(ratio, e), 0.01, 20.0, _box_rate(4, 1.0, PLAY_AREA_2D, 0.2),
+                q=(ratio == 1e12), ratio=ratio, e=e)
+    # restitution: pile-up into a wall, a 2D gas cooling, stick clusters
+    for e in (0.0, 0.05, 0.5, 1.0):
+        for dt in (0.01, 1.0):
+            add(f"pile-up 8 e={e:g} dt={dt:g}", "restitution", lambda e=e: inelastic_pileup(8, e), dt, 4.0,
+                _box_rate(8, 1.5, PLAY_AREA_1D, 0.1) * 10, q=(dt == 0.01 and e in (0.0, 0.05)), e=e)
+        add(f"gas16 cooling e={e:g}", "restitution",
+            lambda e=e: gas(16, radius=0.1, packing=0.4, speed=1.0, seed=7, elasticity=e), 0.05, 20.0,
+            _box_rate(16, 1.0, (-1, -0.5, 1, 0.5), 0.1) * 10, q=(e == 0.05), e=e)
+    add("gas16 stick e=0", "restitution", lambda: _stuck_gas(16), 0.05, 20.0, 2e3, q=True, e=0.0)
+    add("stuck pair into corner", "restitution", _stuck_pair_corner, 0.01, 5.0, 100.0, e=0.0)
+    for ratio in (1e6, 1e12):
+        add(f"pi geometry 1e{round(math.log10(ratio))} e=0.05", "mass ratio",
+            lambda ratio=ratio: _inelastic_pi(ratio, 0.05), 0.01, 8.0, 1e3, q=ratio == 1e6, ratio=ratio, e=0.05)
+    # a touching row of alternating light and heavy balls: each light ball then rattles between two
+    # heavy ones, ~pi sqrt(ratio) collisions per squeeze (1e9 already gives 4e7 events in 3 s, so the
+    # grid stops at 1e6 here; the pi billiard covers 1e12)
+    add("touching cradle 1:1e6", "mass ratio", lambda: _heavy_cradle(1e6), 0.01, 3.0, 0.0, cap=100_000, ratio=1e6)
+    # control step on PhET's Explore 2D scene
+    from .scenes import explore_2d
+
+    for dt in (1e-6, 1e-4, 1e-2, 1.0):
+        add(f"explore_2d 4 dt={dt:g}", "dt", lambda: explore_2d(4), dt, min(2000 * dt, 50.0), 20.0,
+            q=dt in (1e-6, 1.0))
+    # long episodes: a lone ball (analytic position), PhET's four balls, an inelastic gas
+    lone = _case(Scene(bounds=PLAY_AREA_2D), [[0.3, -0.2]], [[0.7, 0.45]], [1.0], [0.15])
+    for t_end, dt in ((1e4, 1.0), (1e5, 1.0), (1e5, 100.0)):
+        add(f"lone ball T={t_end:g} dt={dt:g}", "long", lambda: lone, dt, t_end, 2.0, _check_lone(lone, t_end),
+            q=(t_end, dt) == (1e4, 1.0), T=t_end)
+    tiny = _case(Scene(bounds=PLAY_AREA_2D), [[0.3, -0.2]], [[7000.0, 4500.0]], [1.0], [1e-4])
+    add("lone tiny ball v=8e3 r=1e-4 T=100", "long", lambda: tiny, 1.0, 100.0, 1e4, _check_lone(tiny, 100.0),
+        T=100.0)
+    add("explore_2d 4 T=1e5 dt=100", "long", lambda: explore_2d(4), 100.0, 1e5, 20.0, q=False, T=1e5)
+    add("gas16 e=0.5 T=1e5 dt=100", "long",
+        lambda: gas(16, radius=0.1, packing=0.4, speed=1.0, seed=7, elasticity=0.5), 100.0, 1e5, 2e3, T=1e5)
+    # touching at the start
+    for e in (1.0, 0.5, 0.05, 0.0):
+        chk = _check_cradle(5) if e == 1.0 else None
+        add(f"cradle 5 touching e={e:g}", "touching", lambda e=e: _cradle(5, e), 0.01, 1.0, 100.0, chk,
+            q=e in (1.0, 0.05), e=e)
+        add(f"train on wall 5 e={e:g}", "touching", lambda e=e: _train_on_wall(5, e), 0.01, 2.0, 1e3,
+            q=e in (0.0, 0.05), e=e)
+        add(f"wall touch pair e={e:g}", "touching", lambda e=e: _wall_touch(e), 0.01, 3.0, 100.0, q=e == 1.0, e=e)
+        add(f"wedged 2r=H e={e:g}", "touching", lambda e=e: _wedged(e, 0.0), 0.01, 5.0, 100.0, q=e == 0.5, e=e)
+        add(f"wedged 2r=H-2e-6 e={e:g}", "touching", lambda e=e: _wedged(e, 2e-6), 0.01, 2.0, 3e5, q=e == 1.0, e=e)
+    for e in (1.0, 0.05, 0.0):
+        add(f"hex pack 19 touching e={e:g}", "touching", lambda e=e: _hex_pack(e), 0.01, 3.0, 1e4, q=e == 0.05, e=e)
+    add("hex pack 19 touching stick", "touching", lambda: _hex_pack(0.0, "stick"), 0.01, 3.0, 1e4, e=0.0)
+    add("train on wall 5 stick", "touching", lambda: _train_on_wall(5, 0.0, inelastic="stick"), 0.01, 2.0, 1e3,
+        q=True, e=0.0)
+    # exact corner hits, simultaneous wall + ball, sliding along a wall
+    for e in (1.0, 0.5, 0.05, 0.0):
+        add(f"corner hit e={e:g}", "corner", lambda e=e: _corner(e), 0.6, 0.6, 10.0, _check_corner(e),
+            q=e in (1.0, 0.0), e=e)
+        add(f"ball+wall same instant e={e:g}", "corner", lambda e=e: _simultaneous(e), 0.01, 3.0, 100.0,
+            q=e == 1.0, e=e)
+        add(f"slide along wall e={e:g}", "grazing", lambda e=e: _slide(e), 0.01, 3.0, 10.0, q=e == 1.0, e=e)
+    # grazing ball-ball contacts (free space)
+    for delta, hit in ((1e-3, True), (1e-8, True), (1e-12, True), (0.0, False), (-1e-12, False)):
+        add(f"graze 1-{delta:g}", "grazing", lambda d=delta: _two_ball_graze(d), 0.013, 2.0, 10.0, _check_graze(hit),
+            q=delta in (1e-12, 0.0), delta=delta)
+    return [c for c in out if c.quick] if quick else out
+
+
+# --------------------------------------------------------------------------- running a cell
+def _escape_depth(pos, radii, bounds, dim):
+    if bounds is None:
+        return 0.0
+    xmin, ymin, xmax, ymax = bounds
+    depth = np.maximum(xmin + radii - pos[:, 0], pos[:, 0] - (xmax - radii))
+    if dim == 2:
+        depth = np.maximum(depth, np.maximum(ymin + radii - pos[:, 1], pos[:, 1] - (ymax - radii)))
+    scale = TOL * (radii + np.abs(pos).max(1))
+    return float(np.max(depth - scale))
+
+
+def _overlap_depth(pos, radii):
+    n = len(radii)
+    if n < 2:
+        return -math.inf
+    d = np.sqrt(((pos[:, None, :] - pos[None, :, :]) ** 2).sum(-1))
+    sigma = radii[:, None] + radii[None, :]
+    excess = sigma - d - (TOL * sigma + 1e-12 * np.abs(pos).max())
+    iu = np.triu_indices(n, 1)
+    return float(excess[iu].max())
+
+
+def run_cell(cell: Cell, mode: str, substeps: int, budget: float) -> dict:
+    """Run one cell in one mode; returns the row (status "pass" or the failure reasons)."""
+    case = cell.build()
+    reasons: list[str] = []
+    details: list[str] = []
+    sim = Simulator(case.scene, case.positions, case.velocities, case.masses, case.radii, mode=mode,
+                    substeps=substeps, max_events=cell.max_events)
+    radii = case.radii
+    scene = case.scene
+    check_pairs = scene.ball_collisions and len(radii) > 1 and len(radii) <= 64
+    ke0 = sim.kinetic_energy()
+    ke_prev = ke0
+    count = 0
+    keep = []
+    kept = 0
+    worst_step = 0.0
+    engine_time = 0.0
+    t0 = time.perf_counter()
+    steps = cell.steps
+    done = 0
+    for k in range(steps):
+        dt = cell.dt if k < steps - 1 else cell.duration - cell.dt * (steps - 1)
+        s0 = time.perf_counter()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", EventCapWarning)
+            rows = sim.batch.step(dt)
+        spent = time.perf_counter() - s0
+        engine_time += spent
+        worst_step = max(worst_step, spent)
+        done += 1
+        count += len(rows)
+        if keep is not None:
+            keep.append(rows)
+            kept += len(rows)
+            if kept > 100_000:
+                keep = None
+        pos, vel = sim.positions, sim.velocities
+        if not (np.isfinite(pos).all() and np.isfinite(vel).all()):
+            reasons.append("NaN")
+            details.append(f"non-finite state at step {k}")
+            break
+        if "escape" not in reasons:
+            depth = _escape_depth(pos, radii, scene.bounds, scene.dimension)
+            if depth > 0:
+                reasons.append("escape")
+                details.append(f"escape by {depth:.3g} m at step {k}")
+        if check_pairs and "overlap" not in reasons:
+            depth = _overlap_depth(pos, radii)
+            if depth > 0:
+                reasons.append("overlap")
+                details.append(f"overlap by {depth:.3g} m at step {k}")
+        ke = sim.kinetic_energy()
+        if "energy growth" not in reasons and (ke > ke0 * (1 + TOL) or ke > ke_prev * (1 + TOL)):
+            reasons.append("energy growth")
+            details.append(f"kinetic energy {ke / ke0 - 1:+.3g} relative at step {k}")
+        ke_prev = ke
+        if sim.cap_reached and "event cap" not in reasons:
+            reasons.append("event cap")
+            details.append(f"cap {cell.max_events} reached at step {k}")
+        if engine_time > budget:
+            if k < steps - 1:
+                reasons.append("time limit")
+                details.append(f"{done}/{steps} steps in {engine_time:.3g} s of stepping")
+            break
+    wall = time.perf_counter() - t0
+    if cell.check is not None and not reasons:
+        impacts = np.concatenate(keep) if keep else None
+        msg = cell.check(sim, count, impacts)
+        if msg:
+            reasons.append("wrong")
+            details.append(msg)
+    ke = sim.kinetic_energy()
+    return {
+        "cell": cell.name, "group": cell.group, "mode": mode if substeps == 1 else f"{mode} k={substeps}",
+        "status": "pass" if not reasons else ", ".join(reasons), "detail": "; ".join(details),
+        "dt": cell.dt, "duration": cell.duration, "steps": done, "impacts": count, "max_events": cell.max_events,
+        "wall_s": wall, "engine_s": engine_time, "worst_step_s": worst_step,
+        "energy_change": (ke / ke0 - 1) if ke0 > 0 else 0.0,
+    }
+
+
+def repro(cell: Cell) -> str:
+    """A minimal, self-contained Python snippet that replays ``cell`` in exact mode."""
+    c = cell.build()
+    steps = cell.steps
+    return "\n".join([
+        "import numpy as np",
+        "from collision_env.engine import Scene, Simulator",
+        f"scene = {c.scene!r}",
+        f"pos = np.array({c.positions.tolist()!r})",
+        f"vel = np.array({c.velocities.tolist()!r})",
+        f"mass = np.array({c.masses.tolist()!r})",
+        f"radii = np.array({c.radii.tolist()!r})",
+        f"sim = Simulator(scene, pos, vel, mass, radii, mode='exact', max_events={cell.max_events})",
+        f"for k in range({steps}):",
+        f"    sim.step({cell.dt!r})",
+        "print(sim.positions, sim.velocities, sim.cap_reached, sim.kinetic_energy())",
+    ])
+
+
+def run_extremes(quick: bool, budget: float | None = None, modes=MODES, log=print) -> list[dict]:
+    budget = budget if budget is not None else (5.0 if quick else 30.0)
+    rows = []
+    grid = cells(quick)
+    for cell in grid:
+        t0 = time.perf_counter()
+        for mode, k in modes:
+            rows.append(run_cell(cell, mode, k, budget))
+        status = {r["mode"]: r["status"] for r in rows[-len(modes):]}
+        log(f"  {cell.name:34s} {time.perf_counter() - t0:6.2f} s  " +
+            "  ".join(f"{m}: {s}" for m, s in status.items()))
+    return rows
+
+
+EXTREME_FIELDS = ("cell", "group", "mode", "status", "detail", "dt", "duration", "steps", "impacts", "max_events",
+                  "wall_s", "engine_s", "worst_step_s", "energy_change")
+
+
+def extremes_markdown(rows: list[dict], quick: bool, budget: float) -> str:
+    modes = list(dict.fromkeys(r["mode"] for r in rows))
+    by_cell: dict = {}
+    for r in rows:
+        by_cell.setdefault((r["group"], r["cell"]), {})[r["mode"]] = r
+    lines = [
+        "## Extremes: stability over the stress grid",
+        "",
+        f"Generated by `python -m collision_env.bench.extremes{' --quick' if quick else ''}`: {len(by_cell)} cells, "
+        f"each run in every mode with a wall-time budget of {budget:g} s per cell and mode. A cell passes when, after "
+        "every step, no position or velocity is NaN, no ball sticks out of the border or into another ball "
+        "(beyond 1e-9 relative), the kinetic energy never grows (beyond 1e-9 relative), the event cap is not "
+        "reached and the budget is not exceeded, and (where the cell has one) the analytic answer is right.",
+        "",
+        "| mode | cells passed | failures by reason |",
+        "|---|---:|---|",
+    ]
+    for m in modes:
+        rs = [r for r in rows if r["mode"] == m]
+        passed = sum(r["status"] == "pass" for r in rs)
+        counts = {reason: sum(reason in r["status"].split(", ") for r in rs) for reason in REASONS}
+        fails = ", ".join(f"{k}: {v}" for k, v in counts.items() if v) or "none"
+        lines.append(f"| {m} | {passed} / {len(rs)} | {fails} |")
+    lines += ["", "| group | cell | dt (s) | duration (s) | " + " | ".join(modes) + " |",
+              "|---|---|---:|---:|" + "---|" * len(modes)]
+    for (group, name), per in by_cell.items():
+        any_row = next(iter(per.values()))
+        cells_ = []
+        for m in modes:
+            r = per.get(m)
+            if r is None:
+                cells_.append("")
+            elif r["status"] == "pass":
+                cells_.append("pass")
+            else:
+                cells_.append(f"**{r['status']}**")
+        lines.append(f"| {group} | {name} | {any_row['dt']:g} | {any_row['duration']:g} | " + " | ".join(cells_) + " |")
+    exact_fail = [r for r in rows if r["mode"] == "exact" and r["status"] != "pass"]
+    lines += [""]
+    if exact_fail:
+        lines += ["**Exact mode fails cells** (an engine problem to fix, not a trade):", ""]
+        lines += [f"- {r['cell']}: {r['status']} ({r['detail']})" for r in exact_fail]
+    else:
+        lines.append("Exact mode passes every cell.")
+    lines.append("")
+    return "\n".join(lines)
+
+
+def write_csv(path, rows, fields):
+    with open(path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=fields, extrasaction="ignore")
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: r.get(k, "") for k in fields})
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python -m collision_env.bench.extremes", description=__doc__.split("\n")[0])
+    parser.add_argument("--quick", action="store_true", help="a subset of the grid (about 15 s)")
+    parser.add_argument("--out", default="docs/bench", help="output folder (default docs/bench)")
+    parser.add_argument("--budget", type=float, default=None, help="wall-time budget per cell and mode (s)")
+    parser.add_argument("--repro", metavar="CELL", help="print a repro snippet for the named cell and exit")
+    args = parser.parse_args(argv)
+    if args.repro:
+        for c in cells(False):
+            if c.name == args.repro:
+                print(repro(c))
+                return 0
+        print(f"no cell named {args.repro!r}", file=sys.stderr)
+        return 2
+    from .sweep import warm_up
+
+    warm_up()
+    budget = args.budget if args.budget is not None else (5.0 if args.quick else 30.0)
+    rows = run_extremes(args.quick, budget, log=lambda m: print(m, file=sys.stderr, flush=True))
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    write_csv(out / "extremes.csv", rows, EXTREME_FIELDS)
+    text = extremes_markdown(rows, args.quick, budget)
+    (out / "extremes.md").write_text(text)
+    print(text)
+    return 1 if any(r["mode"] == "exact" and r["status"] != "pass" for r in rows) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
