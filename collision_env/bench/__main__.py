@@ -135,7 +135,7 @@ def main(argv=None):
         print(report.env_markdown(env_rows))
     print(f"Wrote {', '.join(sorted(p.name for p in out.iterdir()))} to {out}/")
     if args.readme:
-        rel = os.path.relpath(out, Path(args.readme).resolve().parent) if out.is_absolute() else str(out)
+        rel = os.path.relpath(out.resolve(), Path(args.readme).resolve().parent)
         block = report.readme_block(rows, plots, rel.replace(os.sep, "/"), quick)
         if report.update_readme(args.readme, block):
             print(f"Updated the study block of {args.readme}")

@@ -17,8 +17,9 @@ it, stepping the public :class:`~collision_env.engine.Simulator` and checking af
 - **time limit**: the mode's steps took longer in all than the budget (``--budget``, per cell and mode;
   the checks between steps are not counted);
 - **wrong**: the cell has an analytic answer (pi-billiard collision count, corner reversal,
-  Newton's cradle, a lone ball's position after up to 1e5 s within 1e-12 of its path length, a
-  graze or a miss) and the mode got it wrong.
+  Newton's cradle, a lone ball's position after up to 1e5 s within 1e-12 of its path length and
+  its impact times within 1e-13 of the elapsed time with points exactly on the walls, a graze or
+  a miss) and the mode got it wrong.
 
 The event cap is set per cell above the physical number of events in one step (estimated from
 speeds, sizes and the box), so that reaching it flags a runaway (Zeno) step rather than a busy but
@@ -224,6 +225,7 @@ def _lone_position(x0, v, lo, hi, t):
 
 
 def _check_lone(case, t_end):
+    """Final position, and (when kept) every impact's time and point, against the analytic bounce."""
     def check(sim, count, impacts):
         (x0, y0), (vx, vy), r = case.positions[0], case.velocities[0], case.radii[0]
         b = case.scene.bounds
@@ -233,7 +235,24 @@ def _check_lone(case, t_end):
         # round-off in the event times moves the ball along the wall a little at every bounce: allow
         # 1e-12 of the path length (about 5000 ulps), or 1e-6 of a radius
         tol = max(1e-6 * r, 1e-12 * float(np.hypot(vx, vy)) * t_end)
-        return None if err <= tol else f"position off the analytic one by {err:.3g} m after {t_end:g} s (tol {tol:.2g})"
+        if err > tol:
+            return f"position off the analytic one by {err:.3g} m after {t_end:g} s (tol {tol:.2g})"
+        if impacts is None:
+            return None
+        # absolute impact times late in a long run: within 1e-13 of the elapsed time (~500 ulps)
+        t_tol = 1e-13 * max(t_end, 1.0)
+        for axis, walls, x_start, v in ((0, (0, 1), x0, vx), (1, (2, 3), y0, vy)):
+            sel = np.isin(impacts["wall"], walls)
+            lo, hi = b[axis] + r, b[axis + 2] - r
+            span = hi - lo
+            u = (x_start - lo + v * impacts["time"][sel]) / span
+            t_err = float(np.max(np.abs(u - np.round(u)) * span / abs(v), initial=0.0))
+            if t_err > t_tol:
+                return f"impact times off the analytic ones by up to {t_err:.3g} s (tol {t_tol:.2g})"
+            coord = impacts["x" if axis == 0 else "y"][sel]
+            if not np.all((coord == b[axis]) | (coord == b[axis + 2])):
+                return "an impact point is not exactly on its wall"
+        return None
     return check
 
 
