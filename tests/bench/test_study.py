@@ -91,7 +91,7 @@ def test_extremes_cells_pass_and_fail_as_they_should():
 def test_summary_thresholds_on_synthetic_rows():
     def row(fam, s, err, missed=0, e=1.0):
         return {"status": "ok", "family": fam, "speed_dt_over_r": s, "pos_err": err, "missed": missed,
-                "spurious": 0, "elasticity": e}
+                "spurious": 0, "elasticity": e, "scene": "gas" if e == 1.0 else "pile", "n": 4}
 
     rows = [row("posteriori k=1", 0.01, 1e-12), row("posteriori k=1", 0.1, 1e-4), row("posteriori k=1", 1.0, 0.5, 3),
             row("posteriori k=1", 0.05, 1e-2, e=0.5)]
@@ -101,6 +101,10 @@ def test_summary_thresholds_on_synthetic_rows():
     assert report.thresholds(rows, "posteriori k=1", 1.0, where=elastic)[0] == math.inf
     assert report.miss_threshold(rows, "posteriori k=1", where=elastic) == (1.0, 3)
     assert report.thresholds(rows, "posteriori k=1", 1e-3)[0] == 0.05  # the inelastic run counts without a filter
+    # an error within exact's own spread on that scene (the floor) is a tie, not a violation
+    assert report.thresholds(rows, "posteriori k=1", 1e-6, where=elastic, floor={("gas", 4): 1e-3})[0] == 1.0
+    floor = report.floors(rows + [{**row("exact", 0.1, 3e-7), "scene": "gas"}])
+    assert floor == {("gas", 4): 3e-7, ("pile", 4): report.ROUND_OFF}
 
 
 def test_readme_block_replaced_only_between_markers(tmp_path):
