@@ -26,14 +26,16 @@ def _rate(make, steps):
         env.reset(seed=0)
         env.action_space.seed(0)
         actions = [env.action_space.sample() for _ in range(min(steps, 256))]
-        for k in range(min(20, steps)):  # warm-up
-            env.step(actions[k % len(actions)])
+        def run(n):
+            for k in range(n):
+                out = env.step(actions[k % len(actions)])
+                term, trunc = out[2], out[3]
+                if not hasattr(term, "__len__") and (term or trunc):  # vector envs reset themselves
+                    env.reset()
+
+        run(min(20, steps))  # warm-up
         t0 = time.perf_counter()
-        for k in range(steps):
-            out = env.step(actions[k % len(actions)])
-            term, trunc = out[2], out[3]
-            if not hasattr(term, "__len__") and (term or trunc):
-                env.reset()
+        run(steps)
         return time.perf_counter() - t0
     finally:
         env.close()

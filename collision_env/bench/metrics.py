@@ -103,9 +103,10 @@ def match_impacts(run, ref, window: float, neighbours: int = 4) -> Match:
     Two impacts can pair only if they have the same key (:func:`impact_keys`) and their times
     differ by at most ``window``. Among the allowed pairs, the closest in time is taken first
     (ties: lower reference index, then lower run index), then the next closest among the
-    impacts still free, and so on (greedy nearest-time matching). Only the ``neighbours``
-    nearest reference impacts on each side of a run impact's time are considered, which keeps
-    the cost linear for long runs of one pair (the pi billiard).
+    impacts still free, and so on (greedy nearest-time matching). For a key with very many
+    impacts in both runs (more than 200 000 candidate pairs: the pi billiard), only the
+    ``neighbours`` nearest reference impacts on each side of a run impact's time are considered
+    (widened to all impacts as close as the farthest of them), which keeps the cost near linear.
     """
     run = as_impacts(run)
     ref = as_impacts(ref)
@@ -120,32 +121,56 @@ def match_impacts(run, ref, window: float, neighbours: int = 4) -> Match:
     for k, key in enumerate(run_keys):
         by_key_run.setdefault(key, []).append(k)
 
-    cand = []  # (|dt|, ref index, run index)
+    d_all, j_all, i_all = [], [], []  # candidate pairs: |dt|, reference index, run index
     for key, run_idx in by_key_run.items():
         ref_idx = by_key_ref.get(key)
         if not ref_idx:
             continue
         ref_idx = np.array(ref_idx)
-        order = np.argsort(ref["time"][ref_idx], kind="stable")
-        ref_idx = ref_idx[order]
+        ref_idx = ref_idx[np.argsort(ref["time"][ref_idx], kind="stable")]
         ref_t = ref["time"][ref_idx]
-        for i in run_idx:
-            t = run["time"][i]
-            pos = int(np.searchsorted(ref_t, t))
-            for q in range(max(0, pos - neighbours), min(len(ref_t), pos + neighbours)):
-                d = abs(ref_t[q] - t)
-                if d <= window:
-                    cand.append((d, int(ref_idx[q]), i))
-    cand.sort()
-    run_used = np.zeros(len(run), dtype=bool)
-    ref_used = np.zeros(len(ref), dtype=bool)
-    pr, pf = [], []
-    for _, j, i in cand:
-        if run_used[i] or ref_used[j]:
+        run_idx = np.array(run_idx)
+        t = run["time"][run_idx]
+        if len(run_idx) * len(ref_idx) <= 200_000:  # every reference impact of the key within the window
+            reach = np.full(len(t), window)
+        else:  # the nearest few, widened to all as close as the farthest of them (ties at one instant)
+            pos = np.searchsorted(ref_t, t)
+            lo = np.maximum(pos - neighbours, 0)
+            hi = np.minimum(pos + neighbours, len(ref_t)) - 1
+            reach = np.minimum(window, np.maximum(np.abs(ref_t[lo] - t), np.abs(ref_t[hi] - t)))
+        lo = np.searchsorted(ref_t, t - reach, side="left")
+        hi = np.searchsorted(ref_t, t + reach, side="right")
+        count = hi - lo
+        if not count.sum():
             continue
-        run_used[i] = ref_used[j] = True
-        pr.append(i)
-        pf.append(j)
+        which = np.repeat(np.arange(len(t)), count)
+        offset = np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)
+        q = lo[which] + offset
+        d = np.abs(ref_t[q] - t[which])
+        keep = d <= window
+        d_all.append(d[keep])
+        j_all.append(ref_idx[q[keep]])
+        i_all.append(run_idx[which[keep]])
+    pr, pf = [], []
+    if d_all:
+        d = np.concatenate(d_all)
+        j = np.concatenate(j_all)
+        i = np.concatenate(i_all)
+        order = np.lexsort((i, j, d))
+        run_used = np.zeros(len(run), dtype=bool)
+        ref_used = np.zeros(len(ref), dtype=bool)
+        most = min(len(run), len(ref))
+        for jj, ii in zip(j[order].tolist(), i[order].tolist(), strict=True):
+            if run_used[ii] or ref_used[jj]:
+                continue
+            run_used[ii] = ref_used[jj] = True
+            pr.append(ii)
+            pf.append(jj)
+            if len(pr) == most:
+                break
+    else:
+        run_used = np.zeros(len(run), dtype=bool)
+        ref_used = np.zeros(len(ref), dtype=bool)
     pr = np.array(pr, dtype=np.int64)
     pf = np.array(pf, dtype=np.int64)
     time_error = np.abs(run["time"][pr] - ref["time"][pf])

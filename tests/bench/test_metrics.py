@@ -52,6 +52,20 @@ def test_match_is_one_to_one_and_nearest_first():
     assert m.tunnelled == []
 
 
+def test_match_many_impacts_of_one_pair_at_one_instant():
+    # a contact group resolved at one instant reports the same pair several times at the same time,
+    # and in a different order in another run: all must pair up
+    ref = _imp([(0.5, 0, 1, None)] * 6 + [(0.5, 1, 2, None)] * 6 + [(0.7, 0, 1, None)])
+    run = _imp([(0.5, 1, 2, None)] * 6 + [(0.5, 1, 0, None)] * 6 + [(0.7, 0, 1, None)])
+    m = M.match_impacts(run, ref, window=1.0, neighbours=2)
+    assert m.matched == 13 and len(m.missed) == len(m.spurious) == 0
+    # times that differ by round-off, interleaved: still one to one, nothing left over
+    ref = _imp([(t, 44, 45, None) for t in (0.513477, 0.513477, 0.513993, 0.514317, 0.514885, 1.78)])
+    run = _imp([(t, 44, 45, None) for t in (0.513186, 0.513186, 0.513697, 0.514014, 0.514576, 1.78)])
+    m = M.match_impacts(run, ref, window=0.2)
+    assert m.matched == 6 and m.time_error.max() < 2e-3
+
+
 def test_match_keys_walls_apart():
     # the same ball at the same time on two different walls (a corner) are two impacts
     ref = _imp([(1.0, 0, None, "right"), (1.0, 0, None, "top")])
