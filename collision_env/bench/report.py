@@ -448,6 +448,22 @@ def summary_markdown(rows, extreme_rows, stat_rows, quick, meta) -> str:
             miss = ("never misses or invents an impact" if math.isinf(y_miss)
                     else f"first misses or invents an impact at s = {y_miss:.2g}")
             lines.append(f"- **{f}**: " + "; ".join(parts) + f"; {miss}.")
+    # typical errors by tunnelling scale
+    edges = (0.0, 0.01, 0.1, 1.0, math.inf)
+    names = ("s < 0.01", "0.01–0.1", "0.1–1", "s ≥ 1")
+    for title, where in (ELASTIC, INELASTIC):
+        fr_all = [r for r in ok if where(r)]
+        if not fr_all:
+            continue
+        lines += ["", f"Median (worst) final-state error in radii on {title}, by s:", "",
+                  "| engine / mode | " + " | ".join(names) + " |", "|---|" + "---:|" * len(names)]
+        for f in fams:
+            cells = []
+            for lo, hi in zip(edges[:-1], edges[1:], strict=True):
+                errs = [_err(r) for r in fr_all if r["family"] == f and lo <= r["speed_dt_over_r"] < hi]
+                cells.append(f"{_fmt(_median(errs))} ({_fmt(max(errs))})" if errs else "")
+            if any(cells):
+                lines.append(f"| {f} | " + " | ".join(cells) + " |")
     # cost
     med, mx, k = cost_ratios(ok, "exact", "naive")
     lines += ["", "Cost, measured in the same run (per control step, same scene, ball count and dt):", ""]
