@@ -88,17 +88,15 @@ def main(argv=None):
         rows, missing = run_sweep(quick, scenes=scenes, peers=not args.no_peers, log=_stderr)
         report.write_csv(out / "sweep.csv", rows)
         extreme_rows, stat_rows, env_rows = [], [], None
+        budget = 5.0 if quick else 30.0
         if "extremes" not in skip:
             _stderr("extremes ...")
-            budget = 5.0 if quick else 30.0
             extreme_rows = run_extremes(quick, budget, log=_stderr)
             report.write_csv(out / "extremes.csv", extreme_rows, EXTREME_FIELDS)
-            (out / "extremes.md").write_text(extremes_markdown(extreme_rows, quick, budget))
         if "stats" not in skip:
             _stderr("long-run statistics ...")
             stat_rows = gas_statistics(quick, log=_stderr)
             report.write_csv(out / "stats.csv", stat_rows, STAT_FIELDS)
-            (out / "stats.md").write_text(stats_markdown(stat_rows))
         envs_note = None
         if "envs" not in skip:
             _stderr("environment steps per second ...")
@@ -115,7 +113,7 @@ def main(argv=None):
             cpus = os.cpu_count()
         meta = {"quick": quick, "date": time.strftime("%Y-%m-%d %H:%M"), "machine": f"{platform.machine()} "
                 f"{platform.system()}", "cpus": cpus, "versions": _versions(), "missing": missing,
-                "envs_note": envs_note, "duration_s": time.perf_counter() - t0}
+                "envs_note": envs_note, "budget": budget, "duration_s": time.perf_counter() - t0}
         (out / "meta.json").write_text(json.dumps(meta, indent=1))
 
     meta_text = _meta_text(meta)
@@ -123,9 +121,9 @@ def main(argv=None):
     plots = report.plot_all(rows, out)
     summary = report.summary_markdown(rows, extreme_rows, stat_rows, quick, meta_text)
     (out / "summary.md").write_text(summary)
-    if extreme_rows and not (out / "extremes.md").exists():
-        (out / "extremes.md").write_text(extremes_markdown(extreme_rows, quick, 5.0 if quick else 30.0))
-    if stat_rows and not (out / "stats.md").exists():
+    if extreme_rows:
+        (out / "extremes.md").write_text(extremes_markdown(extreme_rows, quick, meta.get("budget", 30.0)))
+    if stat_rows:
         (out / "stats.md").write_text(stats_markdown(stat_rows))
 
     print(summary)

@@ -553,7 +553,8 @@ def extremes_markdown(rows: list[dict], quick: bool, budget: float) -> str:
     lines += [""]
     if exact_fail:
         lines += ["**Exact mode fails cells** (an engine problem to fix, not a trade):", ""]
-        lines += [f"- {r['cell']}: {r['status']} ({r['detail']})" for r in exact_fail]
+        lines += [f"- {r['cell']}: {r['status']} ({r['detail']}); replay it with "
+                  f"`python -m collision_env.bench.extremes --repro '{r['cell']}'`" for r in exact_fail]
     else:
         lines.append("Exact mode passes every cell.")
     lines.append("")
