@@ -16,11 +16,16 @@ except ImportError:  # pragma: no cover - exercised by the no-numba CI job
 HAVE_NUMBA = _numba is not None and not _numba.config.DISABLE_JIT
 
 
-def njit(func):
-    """Compile ``func`` with numba in nopython mode (cached), or return it unchanged."""
+def njit(func=None, **options):
+    """Compile ``func`` with numba in nopython mode (cached), or return it unchanged.
+
+    Use bare (``@njit``) or with extra numba options (``@njit(inline="always")``).
+    """
+    if func is None:
+        return lambda f: njit(f, **options)
     if _numba is None:
         return func
-    return _numba.njit(cache=True, nogil=True)(func)
+    return _numba.njit(cache=True, nogil=True, **options)(func)
 
 
 BACKEND = "numba" if HAVE_NUMBA else "python"

@@ -31,6 +31,7 @@ import numpy as np
 from ._jit import njit
 from .motion import advance_all, body_kinematics, has_rotation
 from .response import ball_ball, ball_wall, elastic_threshold, merge_bodies, stop_body
+from .ldp import least_distance
 from .toi import INF, ca_pair, ca_wall, toi_pair, toi_wall
 
 # counters: 0 pair predictions, 1 wall predictions, 2 events, 3 rotating-cluster predictions
@@ -39,8 +40,9 @@ PAIR_TESTS, WALL_TESTS, EVENTS, CLUSTER_TESTS = 0, 1, 2, 3
 #: Contact tolerance (relative to the length scale): re-verifying a cluster event, and which
 #: balls touch in a contact group.
 _CONTACT_TOL = 1e-9
-#: Cap on sweeps over a contact group in one instant (the regulariser ends cascades long before).
-_MAX_SWEEPS = 100_000
+#: Sweeps over a contact group in one instant before the cascade is replaced by its limit (see
+#: ``_settle_contact_group``). Cascades among comparable masses end within a few dozen sweeps.
+_MAX_SWEEPS = 1000
 
 
 @njit
@@ -92,11 +94,23 @@ def snap_to_wall(i, wall, pos, radius, bounds):
         pos[i, 1] = bounds[3] - radius[i]
 
 
+@njit(inline="always")
+def _straight_pair(i, k, now, pos, vel, radius, body, counters):
+    """``_predict_pair`` when nothing rotates: inlined into the loops, which call it O(N) times per
+    event (a call that numba does not inline costs as much as the time-of-impact kernel itself)."""
+    if body[i] == body[k]:
+        return INF
+    counters[PAIR_TESTS] += 1
+    return now + toi_pair(
+        pos[k, 0] - pos[i, 0], pos[k, 1] - pos[i, 1], vel[k, 0] - vel[i, 0], vel[k, 1] - vel[i, 1],
+        radius[i] + radius[k],
+    )
+
+
 @njit
 def _predict_pair(i, k, now, horizon, pos, vel, mass, radius, body, omega, rot, ki, kj, counters):
     if body[i] == body[k]:
         return INF
-    sigma = radius[i] + radius[k]
     if rot and (omega[body[i]] != 0.0 or omega[body[k]] != 0.0):
         counters[CLUSTER_TESTS] += 1
         a = body_kinematics(i, pos, vel, mass, body, omega)
@@ -104,11 +118,8 @@ def _predict_pair(i, k, now, horizon, pos, vel, mass, radius, body, omega, rot, 
         for q in range(7):
             ki[q] = a[q]
             kj[q] = c[q]
-        return now + ca_pair(ki, kj, sigma, horizon)
-    counters[PAIR_TESTS] += 1
-    return now + toi_pair(
-        pos[k, 0] - pos[i, 0], pos[k, 1] - pos[i, 1], vel[k, 0] - vel[i, 0], vel[k, 1] - vel[i, 1], sigma
-    )
+        return now + ca_pair(ki, kj, radius[i] + radius[k], horizon)
+    return _straight_pair(i, k, now, pos, vel, radius, body, counters)
 
 
 @njit
@@ -157,9 +168,10 @@ def _resolve_contact_group(
     cascade of ever smaller impulses at the same instant: sequential impulses converge to the
     limit geometrically. This runs that cascade here: sweeps over the group's contacts in a fixed
     order apply the same pairwise impulses as the event loop would, one after another, without
-    re-predicting every ball after each; the collapse regulariser ends it. Contacts are gaps
-    within ``_CONTACT_TOL`` of zero. Every contact that takes an impulse is reported once.
-    Returns the group size (its balls are in ``group``).
+    re-predicting every ball after each; the collapse regulariser ends it. A cascade still running
+    after ``_MAX_SWEEPS`` sweeps (its convergence rate is set by a mass ratio) is finished by
+    ``_settle_contact_group``. Contacts are gaps within ``_CONTACT_TOL`` of zero. Every contact
+    that takes an impulse is reported once. Returns the group size (its balls are in ``group``).
     """
     n = pos.shape[0]
     for k in range(n):
@@ -200,6 +212,7 @@ def _resolve_contact_group(
                     c_b[n_contacts] = -1 - wall
                     c_hit[n_contacts] = False
                     n_contacts += 1
+    changed = True
     for _ in range(_MAX_SWEEPS):
         changed = False
         for c in range(n_contacts):
@@ -212,20 +225,113 @@ def _resolve_contact_group(
             if speed > 0.0:
                 changed = True
                 counters[EVENTS] += 1
-                if not c_hit[c]:
-                    c_hit[c] = True
-                    if b >= 0:
-                        dx = pos[b, 0] - pos[a, 0]
-                        dy = pos[b, 1] - pos[a, 1]
-                        d = math.sqrt(dx * dx + dy * dy)
-                        record(imp, n_imp, sc, t_abs, a, b, -1, pos[a, 0] + radius[a] * dx / d,
-                               pos[a, 1] + radius[a] * dy / d, speed)
-                    else:
-                        x, y = wall_point(a, -1 - b, pos, radius, bounds)
-                        record(imp, n_imp, sc, t_abs, a, -1, -1 - b, x, y, speed)
+                _record_contact(sc, t_abs, c, c_a, c_b, c_hit, pos, radius, bounds, speed, imp, n_imp)
         if not changed:
             break
+    if changed:
+        _settle_contact_group(
+            sc, t_abs, pos, vel, inv_mass, radius, bounds, u_min, imp, n_imp, counters, group, size,
+            c_a, c_b, c_hit, n_contacts,
+        )
     return size
+
+
+@njit
+def _record_contact(sc, t_abs, c, c_a, c_b, c_hit, pos, radius, bounds, speed, imp, n_imp):
+    """Report contact ``c`` of a group the first time it takes an impulse."""
+    if c_hit[c]:
+        return
+    c_hit[c] = True
+    a = c_a[c]
+    b = c_b[c]
+    if b >= 0:
+        dx = pos[b, 0] - pos[a, 0]
+        dy = pos[b, 1] - pos[a, 1]
+        d = math.sqrt(dx * dx + dy * dy)
+        record(imp, n_imp, sc, t_abs, a, b, -1, pos[a, 0] + radius[a] * dx / d, pos[a, 1] + radius[a] * dy / d,
+               speed)
+    else:
+        x, y = wall_point(a, -1 - b, pos, radius, bounds)
+        record(imp, n_imp, sc, t_abs, a, -1, -1 - b, x, y, speed)
+
+
+@njit
+def _contact_normal(c, c_a, c_b, pos):
+    """Unit normal of contact ``c``, pointing from ball ``c_a[c]`` to its partner (ball or wall)."""
+    a = c_a[c]
+    b = c_b[c]
+    if b >= 0:
+        dx = pos[b, 0] - pos[a, 0]
+        dy = pos[b, 1] - pos[a, 1]
+        d = math.sqrt(dx * dx + dy * dy)
+        return dx / d, dy / d
+    wall = -1 - b
+    if wall == 0:
+        return -1.0, 0.0
+    if wall == 1:
+        return 1.0, 0.0
+    if wall == 2:
+        return 0.0, -1.0
+    return 0.0, 1.0
+
+
+@njit
+def _settle_contact_group(
+    sc, t_abs, pos, vel, inv_mass, radius, bounds, u_min, imp, n_imp, counters, group, size, c_a, c_b, c_hit,
+    n_contacts,
+):
+    """End a contact cascade that sequential impulses would need unboundedly many sweeps for.
+
+    With e < 1 a cascade that does not stop converges: each impulse dissipates a fixed fraction of
+    its contact's closing energy, so the contacts that keep firing close ever more slowly, and in
+    the limit the group moves with every contact at rest or separating. A light ball pressed
+    between a wall and a ball ``M/m`` times heavier gets there only after about ``M/m`` sweeps.
+    This jumps to that limit, regularised as everywhere else: the velocities closest to the
+    current ones in the kinetic-energy metric at which every contact of the group separates at
+    ``u_min`` or faster (a least-distance problem in mass-weighted velocities, solved exactly by
+    Lawson & Hanson's NNLS). Momentum is conserved by ball-ball impulses and energy does not grow
+    by more than the regulariser's ``u_min`` allowance. Where no velocities separate every contact
+    (a chain wedged between opposite walls), the contacts are brought to rest instead, which is
+    always possible.
+    """
+    dof = 2 * size
+    g_mat = np.zeros((n_contacts, dof))
+    h = np.empty(n_contacts)
+    slot = np.full(pos.shape[0], -1, dtype=np.int64)
+    root_w = np.empty(size)
+    for q in range(size):
+        slot[group[q]] = q
+        root_w[q] = math.sqrt(inv_mass[group[q]])
+    closing = np.empty(n_contacts)
+    for c in range(n_contacts):
+        a = c_a[c]
+        b = c_b[c]
+        nx, ny = _contact_normal(c, c_a, c_b, pos)
+        # separation speed of the contact = G_c . y with y = sqrt(m) v (mass-weighted velocities)
+        qa = slot[a]
+        g_mat[c, 2 * qa] = -nx * root_w[qa]
+        g_mat[c, 2 * qa + 1] = -ny * root_w[qa]
+        sep = -(vel[a, 0] * nx + vel[a, 1] * ny)
+        if b >= 0:
+            qb = slot[b]
+            g_mat[c, 2 * qb] = nx * root_w[qb]
+            g_mat[c, 2 * qb + 1] = ny * root_w[qb]
+            sep += vel[b, 0] * nx + vel[b, 1] * ny
+        closing[c] = -sep
+        h[c] = u_min - sep
+    x, feasible = least_distance(g_mat, h)
+    if not feasible:
+        for c in range(n_contacts):
+            h[c] -= u_min
+        x, feasible = least_distance(g_mat, h)
+    for q in range(size):
+        i = group[q]
+        vel[i, 0] += x[2 * q] * root_w[q]
+        vel[i, 1] += x[2 * q + 1] * root_w[q]
+    for c in range(n_contacts):
+        if closing[c] > 0.0:
+            counters[EVENTS] += 1
+            _record_contact(sc, t_abs, c, c_a, c_b, c_hit, pos, radius, bounds, closing[c], imp, n_imp)
 
 
 @njit
@@ -259,7 +365,11 @@ def _scene(
     if pairs:
         for i in range(n):
             for k in range(i + 1, n):
-                v = _predict_pair(i, k, now, horizon_end, pos, vel, mass, radius, body, omega, rot, ki, kj, counters)
+                if rot:
+                    v = _predict_pair(i, k, now, horizon_end, pos, vel, mass, radius, body, omega, rot, ki, kj,
+                                      counters)
+                else:
+                    v = _straight_pair(i, k, now, pos, vel, radius, body, counters)
                 pt[i, k] = v
                 pt[k, i] = v
         for i in range(n):
@@ -379,9 +489,13 @@ def _scene(
                 i = involved[q]
                 for k in range(n):
                     if k != i and not (flag[k] and k < i):
-                        v = _predict_pair(
-                            i, k, now, horizon_end - now, pos, vel, mass, radius, body, omega, rot, ki, kj, counters
-                        )
+                        if rot:
+                            v = _predict_pair(
+                                i, k, now, horizon_end - now, pos, vel, mass, radius, body, omega, rot, ki, kj,
+                                counters,
+                            )
+                        else:
+                            v = _straight_pair(i, k, now, pos, vel, radius, body, counters)
                         pt[i, k] = v
                         pt[k, i] = v
             for q in range(n_inv):

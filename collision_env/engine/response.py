@@ -25,6 +25,10 @@ velocities) and
   round-off left closing after a plastic impact is set apart at once instead of being resolved
   again and again at the same instant.
 
+A cascade that the rule does not end quickly because it converges at a rate set by a mass ratio
+(a light ball pressed between a wall and a far heavier ball) is replaced by its limit after a
+fixed number of sweeps: see ``exact._settle_contact_group``.
+
 The rule can add at most ``1/2 mu u_min^2`` of energy to a collision whose closing speed
 was below ``u_min`` (1e-18 of the kinetic energy with the default ratio), which is below the
 round-off of the energy itself. Elastic scenes are otherwise unaffected.

@@ -156,6 +156,42 @@ def test_three_ball_collapse_with_wall_is_bounded():
     _valid(sim)
 
 
+@pytest.mark.parametrize("ratio", [1e8, 1e12])
+def test_light_ball_pressed_by_a_far_heavier_one_settles_at_once(ratio):
+    # A light ball between a wall and a ball M/m times heavier: sequential impulses would need
+    # about M/m sweeps at one instant; the cascade is replaced by its limit (the heavy ball stops).
+    scene = Scene(bounds=(-2.0, -0.55, 1e4, 0.55), elasticity=0.05, dimension=1)
+    sim = Simulator(scene, [[-1.0, 0.0], [0.0, 0.0]], [[0.0, 0.0], [-1.0, 0.0]], [1.0, ratio], radii=[0.1, 0.1],
+                    max_events=10_000)
+    energy = sim.kinetic_energy()
+    start = time.perf_counter()
+    for _ in range(200):
+        sim.step(0.01)
+        assert not sim.cap_reached
+        _valid(sim)
+        assert sim.kinetic_energy() <= energy * (1 + 1e-12)
+    assert time.perf_counter() - start < 5.0
+    assert np.allclose(sim.positions[:, 0], [-1.9, -1.7])  # pressed against the wall, touching
+    assert np.all(np.abs(sim.velocities) < 1e-6)  # at rest: the wall took the heavy ball's momentum
+
+
+def test_corner_pile_with_a_heavy_ball_settles_at_once_2d():
+    # Two light balls in a corner, a 1e10 times heavier ball driven diagonally into them.
+    r = 0.1
+    pos = [[-2 + r, -1 + r], [-2 + r, -1 + 3 * r], [-1.0, -0.5]]
+    sim = Simulator(Scene(elasticity=0.05), pos, [[0, 0], [0, 0], [-1.2, -0.6]], [1.0, 2.0, 1e10],
+                    radii=[r] * 3, max_events=10_000)
+    energy = sim.kinetic_energy()
+    start = time.perf_counter()
+    for _ in range(120):
+        sim.step(1 / 60)
+        assert not sim.cap_reached
+        _valid(sim)
+        assert sim.kinetic_energy() <= energy * (1 + 1e-12)
+        energy = sim.kinetic_energy()
+    assert time.perf_counter() - start < 5.0
+
+
 def test_event_cap_is_reported_and_leaves_a_valid_state():
     scene = Scene(bounds=(0.0, -1.0, 1e9, 1.0), dimension=1)
     sim = Simulator(scene, [[1.0, 0.0], [2.0, 0.0]], [[0.0, 0.0], [-1.0, 0.0]], [1.0, 1e6], radii=[0.1, 0.1],
