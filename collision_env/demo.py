@@ -27,8 +27,9 @@ def pi_billiard(digits=5):
     start = time.perf_counter()
     count = sum(len(sim.step(100.0)) for _ in range(20))
     seconds = time.perf_counter() - start
+    energy_error = sim.kinetic_energy() / (0.5 * 100.0 ** (digits - 1)) - 1
     print(f"Galperin's pi billiard, mass ratio 100^{digits - 1}: {count} collisions "
-          f"({count / seconds:,.0f} events/s), energy error {sim.kinetic_energy() / (0.5 * 100.0 ** (digits - 1)) - 1:+.1e}")
+          f"({count / seconds:,.0f} events/s), energy error {energy_error:+.1e}")
 
 
 def modes():

@@ -29,9 +29,9 @@ import math
 import numpy as np
 
 from ._jit import njit
+from .ldp import least_distance
 from .motion import advance_all, body_kinematics, has_rotation
 from .response import ball_ball, ball_wall, elastic_threshold, merge_bodies, stop_body
-from .ldp import least_distance
 from .toi import INF, ca_pair, ca_wall, toi_pair, toi_wall
 
 # counters: 0 pair predictions, 1 wall predictions, 2 events, 3 rotating-cluster predictions

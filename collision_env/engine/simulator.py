@@ -293,7 +293,8 @@ class BatchSimulator:
             raise ValueError(f"dt: must be finite, got {dt}")
         e = self.scene.elasticity
         if dt < 0.0 and e == 0.0:
-            raise ValueError("dt: cannot step backwards with elasticity 0 (a perfectly inelastic collision has no inverse)")
+            raise ValueError("dt: cannot step backwards with elasticity 0 "
+                             "(a perfectly inelastic collision has no inverse)")
         if dt == 0.0:
             self._capped[:] = False
             return np.zeros(0, dtype=IMPACT_DTYPE)
@@ -426,20 +427,22 @@ class BatchSimulator:
         return (self._mass[..., None] * self._vel).sum(1)
 
     # ------------------------------------------------------------------ changing the state
-    def nudge(self, dv):
+    def nudge(self, dv, check=True):
         """Change every ball's velocity by ``dv`` (``(B, N, 2)``), as an impulse ``m dv``.
 
         A member of a stuck cluster passes the impulse to the whole cluster (linear and angular).
+        ``check=False`` skips validation, for callers that build ``dv`` as a float64 array of the
+        right shape with finite values (and zero y in 1D) themselves: the envs do, every control
+        step, where the checks would cost more than the nudge.
         """
-        dv = _as_array(dv, (self._n_scenes, self._n, 2), "nudge", "")
-        bad = np.argwhere(~np.isfinite(dv).all(-1))
-        if len(bad):
-            s, i = bad[0]
-            raise ValueError(f"{self._label(s, i)}nudge must be finite, got {tuple(dv[s, i])}")
-        if self.scene.dimension == 1:
-            bad = np.argwhere(dv[..., 1] != 0.0)
-            if len(bad):
-                s, i = bad[0]
+        if check:
+            dv = _as_array(dv, (self._n_scenes, self._n, 2), "nudge", "")
+            # one cheap test on the common path; find the culprit only when there is one
+            if not np.isfinite(dv).all():
+                s, i = np.argwhere(~np.isfinite(dv).all(-1))[0]
+                raise ValueError(f"{self._label(s, i)}nudge must be finite, got {tuple(dv[s, i])}")
+            if self.scene.dimension == 1 and dv[..., 1].any():
+                s, i = np.argwhere(dv[..., 1] != 0.0)[0]
                 raise ValueError(f"{self._label(s, i)}nudge y must be 0 in a 1D scene, got {dv[s, i, 1]}")
         if self.scene.sticky:
             _apply_impulses(self._pos, self._vel, self._mass, self._body, self._omega, dv)

@@ -17,17 +17,7 @@ import math
 
 import numpy as np
 
-try:
-    import numba as _numba
-except ImportError:  # pragma: no cover - the no-numba install
-    _numba = None
-
-
-def _njit(func):
-    if _numba is None:
-        return func
-    return _numba.njit(cache=True, nogil=True)(func)
-
+from collision_env.engine._jit import njit
 
 # indices into the float parameter vector P
 P_XMIN, P_YMIN, P_XMAX, P_YMAX = 0, 1, 2, 3
@@ -40,7 +30,7 @@ Q_SEQ, Q_CLUSTER, Q_DIM, Q_NSTEPS = 0, 1, 2, 3
 Q_LEN = 4
 
 
-@_njit
+@njit
 def nudge_kernel(actions, active, vel, ctrl, P, Q, dv, cost):  # pragma: no cover - numba
     """Scale actions to velocity changes ``dv`` (B, N, 2) and their cost (B,).
 
@@ -92,7 +82,7 @@ def nudge_kernel(actions, active, vel, ctrl, P, Q, dv, cost):  # pragma: no cove
     return -1
 
 
-@_njit
+@njit
 def _segment(P, wall, centre, hw):  # pragma: no cover - numba
     """End points (x0, y0, x1, y1) of a target segment on a wall."""
     if wall == 0:
@@ -104,12 +94,12 @@ def _segment(P, wall, centre, hw):  # pragma: no cover - numba
     return centre - hw, P[P_YMAX], centre + hw, P[P_YMAX]
 
 
-@_njit
+@njit
 def _clip1(v):  # pragma: no cover - numba
     return min(max(v, -1.0), 1.0)
 
 
-@_njit
+@njit
 def _in_cluster(body, b, i):  # pragma: no cover - numba
     root = body[b, i]
     for k in range(body.shape[1]):
@@ -118,7 +108,7 @@ def _in_cluster(body, b, i):  # pragma: no cover - numba
     return False
 
 
-@_njit
+@njit
 def task_kernel(flags, imp, t_wall, t_geo, t_status, cur, qual, body, clusters, pos, vel, masses,
                 radii, sim_time, steps, cost, phi, P, Q, obs, reward, terminated, truncated, success,
                 n_hit, energy):  # pragma: no cover - numba
@@ -360,7 +350,7 @@ def block_size(n_balls: int, n_targets: int, tries: int) -> int:
     return 3 * n_balls + 3 * n_targets + 2 * n_balls * tries
 
 
-@_njit
+@njit
 def build_episodes(U, ctrl_mask, walls, E, F, pos, vel, masses, radii, t_wall, t_geo, ok):  # pragma: no cover
     """Turn one block of uniforms per row of ``U`` into an episode's start state.
 

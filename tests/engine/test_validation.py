@@ -100,6 +100,21 @@ def test_rejected_nudge_and_set_leave_state_untouched():
         np.testing.assert_array_equal(value, before[key])
 
 
+def test_unchecked_nudge_equals_the_checked_one():
+    pos = np.array([[[-1.0, 0.0], [1.0, 0.0]]] * 2)
+    dv = np.array([[[0.1, -0.2], [0.0, 0.3]], [[0.0, 0.0], [-0.4, 0.0]]])
+    checked = BatchSimulator(Scene(), pos, np.zeros((2, 2, 2)), np.ones(2))
+    unchecked = BatchSimulator(Scene(), pos, np.zeros((2, 2, 2)), np.ones(2))
+    checked.nudge(dv)
+    unchecked.nudge(dv, check=False)
+    np.testing.assert_array_equal(checked.velocities, unchecked.velocities)
+    line = BatchSimulator(Scene(dimension=1, bounds=(-2.0, -0.5, 2.0, 0.5)), pos, np.zeros((2, 2, 2)), np.ones(2))
+    dv = np.zeros((2, 2, 2))
+    dv[1, 0, 1] = 1.0
+    with pytest.raises(ValueError, match="scene 1, ball 0: nudge y must be 0 in a 1D scene"):
+        line.nudge(dv)
+
+
 def test_batch_errors_name_the_scene():
     pos = np.array([[[-1.0, 0.0], [1.0, 0.0]]] * 3)
     vel = np.zeros((3, 2, 2))
