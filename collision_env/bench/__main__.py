@@ -24,6 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
+from collision_env._readme import write_block
+
 from . import report
 from .envrates import ENV_FIELDS, env_rates
 from .extremes import EXTREME_FIELDS, extremes_markdown, run_extremes
@@ -135,10 +137,7 @@ def main(argv=None):
     if args.readme:
         rel = os.path.relpath(out.resolve(), Path(args.readme).resolve().parent)
         block = report.readme_block(rows, plots, rel.replace(os.sep, "/"), quick)
-        if report.update_readme(args.readme, block):
-            print(f"Updated the study block of {args.readme}")
-        else:
-            print(f"{args.readme} has no {report.README_START} ... {report.README_END} markers: left unchanged")
+        write_block(args.readme, report.README_BLOCK, block)
     exact_fail = [r for r in extreme_rows if r["mode"] == "exact" and r["status"] != "pass"]
     return 1 if exact_fail else 0
 

@@ -21,8 +21,8 @@ ROUND_OFF = 1e-9
 #: Error levels (in radii) the summary's rules are stated for.
 LEVELS = (1e-6, 1e-3, 1e-1)
 PLOT_FLOOR = 1e-16
-README_START = "<!-- bench:study:start -->"
-README_END = "<!-- bench:study:end -->"
+#: the README block this study rewrites (see ``collision_env._readme``)
+README_BLOCK = "bench:study"
 
 
 # --------------------------------------------------------------------------- CSV
@@ -597,16 +597,3 @@ def readme_block(rows, plots, out_rel: str, quick) -> str:
         )
     lines += [""] + [f"![{p}]({out_rel}/{p})" for p in plots] + [""]
     return "\n".join(lines)
-
-
-def update_readme(path, block: str) -> bool:
-    """Replace the text between the README markers with ``block``; False if the markers are missing."""
-    p = Path(path)
-    text = p.read_text()
-    start = text.find(README_START)
-    end = text.find(README_END)
-    if start < 0 or end < 0 or end < start:
-        return False
-    new = text[: start + len(README_START)] + "\n" + block.rstrip("\n") + "\n" + text[end:]
-    p.write_text(new)
-    return True

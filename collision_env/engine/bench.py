@@ -42,6 +42,8 @@ import time
 
 import numpy as np
 
+from collision_env._readme import write_block
+
 from . import BACKEND, PLAY_AREA_2D, BatchSimulator, Scene, Simulator
 
 GAS_CASES = ((50, 20.0),)  # (disks, horizon in s); the full run adds GAS_CASES_FULL
@@ -546,6 +548,7 @@ def main(argv=None):
     parser.add_argument("--quick", action="store_true", help="fewer repeats: about 30 s instead of a few minutes")
     parser.add_argument("--json", metavar="PATH", help="write the raw figures to PATH")
     parser.add_argument("--markdown", metavar="PATH", help="write the tables to PATH")
+    parser.add_argument("--readme", metavar="PATH", help="replace the README block between the bench:engine markers")
     parser.add_argument("--render", metavar="JSON", help="do not measure: render the tables of a --json file")
     parser.add_argument("--only", choices=("gas", "per_step", "batch"), action="append",
                         help="run only this part (repeatable)")
@@ -565,6 +568,10 @@ def main(argv=None):
     if args.markdown:
         with open(args.markdown, "w") as fh:
             fh.write(text + "\n")
+    if args.readme:
+        # the README has its own section heading: drop ours, nest the tables under it
+        body = text.split("\n", 2)[2].replace("\n### ", "\n#### ")
+        write_block(args.readme, "bench:engine", body)
     return 0
 
 

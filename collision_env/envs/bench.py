@@ -2,7 +2,8 @@
 
     python -m collision_env.envs.bench [--seconds 1.0] [--num-envs 1024] [--modes exact naive posteriori]
 
-Prints two tables (ratios, not pass/fail tests):
+Prints two Markdown tables (ratios, not pass/fail tests); ``--readme README.md`` also puts them in the
+README's ``bench:envs`` block:
 
 * single env via ``gym.make`` (all default wrappers, random actions, resets included), in us per
   step and as a multiple of ``CartPole-v1`` via ``gym.make`` (goal: <= 2x);
@@ -25,6 +26,7 @@ import gymnasium as gym
 import numpy as np
 
 import collision_env
+from collision_env._readme import write_block
 
 REPEATS = 5  # each figure is the best of this many equal slices of --seconds (robust to a busy machine)
 
@@ -83,7 +85,7 @@ def _engine_us(core, seconds: float, steps: int = 200) -> float:
         sim.set_state(state)
         t0 = time.perf_counter()
         for _ in range(steps):
-            sim.nudge(dv)
+            sim.nudge(dv, check=False)  # as the env does
             sim.step(dt)
         elapsed = time.perf_counter() - t0
         total += elapsed
@@ -102,35 +104,29 @@ def main(argv=None) -> None:
     parser.add_argument("--modes", nargs="+", default=["exact"], choices=["exact", "posteriori", "naive"],
                         help="engine modes to time the envs in")
     parser.add_argument("--ids", nargs="+", default=list(collision_env.ENV_IDS), help="env ids")
+    parser.add_argument("--markdown", metavar="PATH", help="also write the tables to PATH")
+    parser.add_argument("--readme", metavar="PATH", help="replace the README block between the bench:envs markers")
     args = parser.parse_args(argv)
 
     from collision_env.engine import BACKEND
 
-    print(f"collision_env {collision_env.__version__} env benchmark | gymnasium {gym.__version__}, numpy "
-          f"{np.__version__}, engine backend {BACKEND} | python {platform.python_version()}, "
-          f"{os.cpu_count()} CPUs | {args.seconds:g} s per figure")
-    print(f"All figures from this run (each the best of {REPEATS} slices); ratios are what to compare.\n")
-
+    started = time.perf_counter()
     cart = _single_us(gym.make("CartPole-v1"), args.seconds)
     cart = min(cart, _single_us(gym.make("CartPole-v1"), args.seconds))  # twice: the first may warm the CPU
-    print("Single env via gym.make (default wrappers, random actions, resets included)")
-    print(f"{'id':40s} {'mode':>10s} {'us/step':>9s} {'engine':>8s} {'x CartPole':>11s}  goal <= 2x")
-    print(f"{'CartPole-v1':40s} {'':>10s} {cart:9.2f} {'':>8s} {1.0:11.2f}")
+    single = [f"| `CartPole-v1` | | {cart:.2f} | | 1.00 | |"]
     for env_id in args.ids:
         for mode in args.modes:
             env = gym.make(env_id, mode=mode)
             us = _single_us(env, args.seconds)
             eng = _engine_us(env.unwrapped.core, args.seconds / 2)
             ratio = us / cart
-            print(f"{env_id:40s} {mode:>10s} {us:9.2f} {eng:8.2f} {ratio:11.2f}  {'met' if ratio <= 2 else 'not met'}")
+            single.append(f"| `{env_id}` | {mode} | {us:.2f} | {eng:.2f} | {ratio:.2f} | "
+                          f"{'met' if ratio <= 2 else 'not met'} |")
             env.close()
 
     n = args.num_envs
     cart_vec = _vector_sps(gym.make_vec("CartPole-v1", n, vectorization_mode="vector_entry_point"), args.seconds)
-    print(f"\nNative vector env, {n} sub-envs (next-step autoreset, random actions)")
-    print(f"{'id':40s} {'mode':>10s} {'env-steps/s':>12s} {'engine':>8s} {'x CartPoleVec':>14s}  "
-          "goal >= 1 M and >= 0.1x")
-    print(f"{'CartPoleVectorEnv':40s} {'':>10s} {_fmt_rate(cart_vec):>12s} {'':>8s} {1.0:14.3f}")
+    vector = [f"| `CartPoleVectorEnv` | | {_fmt_rate(cart_vec)} | | 1.000 | |"]
     for env_id in args.ids:
         for mode in args.modes:
             venv = gym.make_vec(env_id, n, vectorization_mode="vector_entry_point", mode=mode)
@@ -139,10 +135,36 @@ def main(argv=None) -> None:
             share = eng / (n / sps * 1e6)
             ratio = sps / cart_vec
             ok = sps >= 1e6 and ratio >= 0.1
-            print(f"{env_id:40s} {mode:>10s} {_fmt_rate(sps):>12s} {share:7.0%}  {ratio:14.3f}  "
-                  f"{'met' if ok else 'not met'}")
+            vector.append(f"| `{env_id}` | {mode} | {_fmt_rate(sps)} | {share:.0%} | {ratio:.3f} | "
+                          f"{'met' if ok else 'not met'} |")
             venv.close()
-    print("\nengine: single env, us per step in the engine's nudge + step; vector env, that share of the step.")
+
+    text = "\n".join([
+        f"`python -m collision_env.envs.bench` on {platform.machine()} {platform.system()}, {os.cpu_count()} CPUs, "
+        f"Python {platform.python_version()}, gymnasium {gym.__version__}, numpy {np.__version__}, engine backend "
+        f"`{BACKEND}`; {time.strftime('%Y-%m-%d %H:%M')}, {time.perf_counter() - started:.0f} s. Each figure is the "
+        f"best of {REPEATS} slices of {args.seconds:g} s, measured in the same run as CartPole: compare the ratios.",
+        "",
+        "Single env via `gym.make` (default wrappers, random actions, resets included); *engine* is the part "
+        "spent in the engine's `nudge` + `step`:",
+        "",
+        "| id | mode | µs per step | engine µs | × CartPole-v1 | goal ≤ 2× |",
+        "|---|---|---:|---:|---:|---|",
+        *single,
+        "",
+        f"Native vector env, {n} sub-envs (next-step autoreset, random actions); *engine* is the engine's share "
+        "of the step:",
+        "",
+        "| id | mode | env-steps/s | engine | × CartPoleVectorEnv | goal ≥ 1 M and ≥ 0.1× |",
+        "|---|---|---:|---:|---:|---|",
+        *vector,
+    ])
+    print(text)
+    if args.markdown:
+        with open(args.markdown, "w") as fh:
+            fh.write(text + "\n")
+    if args.readme:
+        write_block(args.readme, "bench:envs", text)
 
 
 if __name__ == "__main__":

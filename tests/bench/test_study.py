@@ -107,17 +107,6 @@ def test_summary_thresholds_on_synthetic_rows():
     assert floor == {("gas", 4): 3e-7, ("pile", 4): report.ROUND_OFF}
 
 
-def test_readme_block_replaced_only_between_markers(tmp_path):
-    readme = tmp_path / "README.md"
-    readme.write_text(f"intro\n{report.README_START}\nold\n{report.README_END}\noutro\n")
-    assert report.update_readme(readme, "new table\n")
-    assert readme.read_text() == f"intro\n{report.README_START}\nnew table\n{report.README_END}\noutro\n"
-    plain = tmp_path / "plain.md"
-    plain.write_text("no markers\n")
-    assert not report.update_readme(plain, "x")
-    assert plain.read_text() == "no markers\n"
-
-
 def test_csv_round_trip(tmp_path):
     rows = [{"scene": "intro", "n": np.int64(2), "dt": np.float64(0.01), "cap_reached": np.bool_(False),
              "note": "", "pos_err": float("nan")}]
