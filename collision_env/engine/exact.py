@@ -237,25 +237,6 @@ def _resolve_contact_group(
 
 
 @njit
-def _record_contact(sc, t_abs, c, c_a, c_b, c_hit, pos, radius, bounds, speed, imp, n_imp):
-    """Report contact ``c`` of a group the first time it takes an impulse."""
-    if c_hit[c]:
-        return
-    c_hit[c] = True
-    a = c_a[c]
-    b = c_b[c]
-    if b >= 0:
-        dx = pos[b, 0] - pos[a, 0]
-        dy = pos[b, 1] - pos[a, 1]
-        d = math.sqrt(dx * dx + dy * dy)
-        record(imp, n_imp, sc, t_abs, a, b, -1, pos[a, 0] + radius[a] * dx / d, pos[a, 1] + radius[a] * dy / d,
-               speed)
-    else:
-        x, y = wall_point(a, -1 - b, pos, radius, bounds)
-        record(imp, n_imp, sc, t_abs, a, -1, -1 - b, x, y, speed)
-
-
-@njit
 def _contact_normal(c, c_a, c_b, pos):
     """Unit normal of contact ``c``, pointing from ball ``c_a[c]`` to its partner (ball or wall)."""
     a = c_a[c]
@@ -273,6 +254,22 @@ def _contact_normal(c, c_a, c_b, pos):
     if wall == 2:
         return 0.0, -1.0
     return 0.0, 1.0
+
+
+@njit
+def _record_contact(sc, t_abs, c, c_a, c_b, c_hit, pos, radius, bounds, speed, imp, n_imp):
+    """Report contact ``c`` of a group the first time it takes an impulse."""
+    if c_hit[c]:
+        return
+    c_hit[c] = True
+    a = c_a[c]
+    b = c_b[c]
+    if b >= 0:
+        nx, ny = _contact_normal(c, c_a, c_b, pos)
+        record(imp, n_imp, sc, t_abs, a, b, -1, pos[a, 0] + radius[a] * nx, pos[a, 1] + radius[a] * ny, speed)
+    else:
+        x, y = wall_point(a, -1 - b, pos, radius, bounds)
+        record(imp, n_imp, sc, t_abs, a, -1, -1 - b, x, y, speed)
 
 
 @njit
