@@ -4,7 +4,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: main test bench clean-cache
+.PHONY: main test bench figures agents-study clean-cache
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -14,14 +14,27 @@ $(STAMP): pyproject.toml
 	$(PY) -m pip install --quiet -e ".[all]"
 	touch $(STAMP)
 
+# Train PPO on the default env and evaluate it (prints where the model, logs and GIF went).
 main: $(STAMP)
-	$(PY) -m collision_env.demo
+	$(PY) -m agents.main
 
 test: $(STAMP)
 	$(PY) -m pytest -n 2
 
+# A quick look at the engine's speed against its peers (~30 s; writes nothing).
 bench: $(STAMP)
 	$(PY) -m collision_env.engine.bench --quick
+
+# Re-measure every figure of the README and docs/ (about 10 minutes; the agents study is separate).
+figures: $(STAMP)
+	$(PY) -m collision_env.bench --readme README.md
+	$(PY) -m collision_env.engine.bench --markdown docs/bench/engine.md --readme README.md
+	$(PY) -m collision_env.envs.bench --markdown docs/bench/envs_bench.md --readme README.md
+	$(PY) scripts/render_presets.py
+
+# Train cheap, evaluate exact: PPO under every engine mode and seed, then every preset (long).
+agents-study: $(STAMP)
+	$(PY) -m agents.study --readme README.md
 
 # numba caches compiled kernels next to the sources and does not notice edits to a kernel's
 # callees in other files: clear the cache after editing the engine.
