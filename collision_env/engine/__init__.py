@@ -18,7 +18,7 @@ from .scene import (
     Scene,
     radius_from_mass,
 )
-from .simulator import IMPACT_DTYPE, MODES, BatchSimulator, EventCapWarning, Impact, Simulator
+from .simulator import IMPACT_DTYPE, MODES, BatchSimulator, EventCapWarning, Impact, Simulator, warm_up
 
 __all__ = [
     "BACKEND",
@@ -35,4 +35,5 @@ __all__ = [
     "Scene",
     "Simulator",
     "radius_from_mass",
+    "warm_up",
 ]

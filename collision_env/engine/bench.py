@@ -44,7 +44,7 @@ import numpy as np
 
 from collision_env._readme import write_block
 
-from . import BACKEND, PLAY_AREA_2D, BatchSimulator, Scene, Simulator
+from . import BACKEND, PLAY_AREA_2D, BatchSimulator, Scene, Simulator, warm_up
 
 GAS_CASES = ((50, 20.0),)  # (disks, horizon in s); the full run adds GAS_CASES_FULL
 GAS_CASES_FULL = ((200, 5.0),)  # the research note's second gas (billiards: ~0.7 k events/s)
@@ -107,18 +107,6 @@ def _versions():
             continue
         out[name] = str(getattr(module, "__version__", getattr(module, "version", "?")))
     return out
-
-
-def _warm_up():
-    """Compile (or load from cache) every kernel the benchmark times, outside the timings."""
-    rng = np.random.default_rng(0)
-    for n in (1, 2, 4):
-        pos, vel = random_balls(rng, n, PLAY_AREA_2D, STEP_RADIUS)
-        for mode, k in MODE_CONFIGS:
-            sim = Simulator(Scene(), pos, vel, np.ones(n), radii=np.full(n, STEP_RADIUS), mode=mode, substeps=k)
-            for _ in range(5):
-                sim.step(FRAME)
-            sim.step(10.0)
 
 
 # ---------------------------------------------------------------------------------------- 1. gas
@@ -497,7 +485,7 @@ def run(quick=False, parts=("gas", "per_step", "batch"), log=print):
     """Run the benchmark; returns the raw figures as a JSON-ready dict."""
     t0 = time.perf_counter()
     log("warming up the kernels (numba compile or cache load) ...")
-    _warm_up()
+    warm_up()
     results = {}
     if "gas" in parts:
         results["gas"] = []

@@ -1,0 +1,11 @@
+"""Engine test fixtures."""
+
+import pytest
+
+from collision_env.engine import warm_up
+
+
+@pytest.fixture(scope="session", autouse=True)
+def compiled_kernels():
+    """Compile the kernels before any test runs: tests that bound a step's time must not time numba."""
+    warm_up()
