@@ -222,6 +222,7 @@ class TaskCore:
         self.time = np.zeros(B)
         # scratch: the nudge and its cost (rewritten every step)
         self._dv = np.zeros((B, N, 2))
+        self.nudge = np.zeros(B)  # requested |dv| of the last step, m/s (read by the envs' infos)
         self._cost = np.zeros(B)
 
         # A placeholder layout drawn from a fixed seed builds the engine now, so that bad engine
@@ -258,9 +259,10 @@ class TaskCore:
         """Nudge (actions (B, A) float64; inactive rows get none) and step the engine by dt.
 
         Returns the engine's impact records and the action cost per scene (a scratch array,
-        valid until the next call). An action with NaN raises ValueError and changes nothing.
+        valid until the next call); ``self.nudge`` holds the requested |dv| per scene (m/s).
+        An action with NaN raises ValueError and changes nothing.
         """
-        bad = K.nudge_kernel(actions, active, self.vel, self.ctrl, self.P, self.Q, self._dv, self._cost)
+        bad = K.nudge_kernel(actions, active, self.vel, self.ctrl, self.P, self.Q, self._dv, self.nudge, self._cost)
         if bad >= 0:
             where = f"sub-env {bad}: " if self.num_scenes > 1 else ""
             raise ValueError(f"{where}action contains NaN: {actions[bad].tolist()}")

@@ -31,14 +31,15 @@ Q_LEN = 4
 
 
 @njit
-def nudge_kernel(actions, active, vel, ctrl, P, Q, dv, cost):  # pragma: no cover - numba
-    """Scale actions to velocity changes ``dv`` (B, N, 2) and their cost (B,).
+def nudge_kernel(actions, active, vel, ctrl, P, Q, dv, nudge, cost):  # pragma: no cover - numba
+    """Scale actions to velocity changes ``dv`` (B, N, 2), their size ``nudge`` (B,) and cost (B,).
 
     Returns -1, or the first active row holding a NaN (then nothing is written). Only the controlled
     balls' entries of ``dv`` are written (the others must be zero).
     Each action component is clipped to [-1, 1] and multiplied by ``max_dv``. The nudge never
-    raises a ball's speed above max(max_speed, current speed); the cost is ``action_cost`` times
-    the requested |dv| (after clipping). Rows with ``active`` False get no nudge and no cost.
+    raises a ball's speed above max(max_speed, current speed). ``nudge`` is the requested |dv|
+    (after clipping), summed over the controlled balls, in m/s; the cost is ``action_cost`` times it.
+    Rows with ``active`` False get no nudge and no cost.
     """
     B = actions.shape[0]
     for b in range(B):
@@ -78,6 +79,7 @@ def nudge_kernel(actions, active, vel, ctrl, P, Q, dv, cost):  # pragma: no cove
                     ny *= f
                 dv[b, i, 0] = nx - vx
                 dv[b, i, 1] = ny - vy
+        nudge[b] = c_total
         cost[b] = cost_per * c_total
     return -1
 

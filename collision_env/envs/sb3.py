@@ -29,7 +29,7 @@ class CollisionSB3VecEnv(VecEnv):
 
     Give it a registered id (``env_id``, with ``n_envs`` and env kwargs) or an existing native
     vector env (``venv``; it must use ``AutoresetMode.SAME_STEP``). Per-step infos carry
-    ``is_success``, ``targets_hit`` and ``TimeLimit.truncated``; add ``VecMonitor`` for episode
+    ``is_success``, ``targets_hit``, ``nudge`` and ``TimeLimit.truncated``; add ``VecMonitor`` for episode
     statistics (``make_sb3_vec_env`` does).
     """
 
@@ -77,20 +77,23 @@ class CollisionSB3VecEnv(VecEnv):
             fin = info["final_info"]
             success = np.where(dones, fin["is_success"], info["is_success"]).tolist()
             hits = np.where(dones, fin["targets_hit"], info["targets_hit"]).tolist()
+            nudge = np.where(dones, fin["nudge"], info["nudge"]).tolist()
         else:
             success = info["is_success"].tolist()
             hits = info["targets_hit"].tolist()
-        infos = [{"is_success": success[i], "targets_hit": hits[i], "TimeLimit.truncated": limit[i]} for i in range(n)]
+            nudge = info["nudge"].tolist()
+        infos = [{"is_success": success[i], "targets_hit": hits[i], "nudge": nudge[i], "TimeLimit.truncated": limit[i]}
+                 for i in range(n)]
         if dones.any():
             final_obs = info["final_obs"]
             for i in np.flatnonzero(dones):
                 infos[i]["terminal_observation"] = final_obs[i]
-                self.reset_infos[i] = {"is_success": False, "targets_hit": 0}
+                self.reset_infos[i] = {"is_success": False, "targets_hit": 0, "nudge": 0.0}
         return obs, reward.astype(np.float32), dones, infos
 
     @staticmethod
     def _split(info: dict, mask: np.ndarray) -> list:
-        keys = [k for k in ("is_success", "targets_hit", "energy", "time", "event_cap") if k in info]
+        keys = [k for k in ("is_success", "targets_hit", "nudge", "energy", "time", "event_cap") if k in info]
         return [{k: info[k][i].item() for k in keys} for i in range(len(mask))]
 
     def close(self) -> None:

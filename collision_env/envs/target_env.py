@@ -86,7 +86,9 @@ class CollisionTargetEnv(gym.Env):
     ## Info
 
     `impacts` (`Impacts`: every wall and ball-ball impact of the step, exact time, balls, wall and
-    contact point), `event_cap` (the engine's per-step event cap stopped the step early),
+    contact point), `event_cap` (the engine's per-step event cap stopped the step early), `nudge`
+    (the step's requested velocity change, m/s, summed over the controlled balls; its cost is
+    `action_cost * nudge`),
     `energy` (kinetic energy, J), `time` (simulated time, s), `targets_hit` (so far),
     `is_success`. Fresh objects on every call.
 
@@ -137,7 +139,7 @@ class CollisionTargetEnv(gym.Env):
         core.reset_scenes(np.zeros(1, dtype=np.int64), [self.np_random])
         imp = core.empty_impacts()
         obs, _, _, _, _, n_hit, energy = core.finish(self._reset_flag, imp, self._zero_cost, out=self._out())
-        info = {"impacts": Impacts(imp), "event_cap": False, "energy": float(energy[0]),
+        info = {"impacts": Impacts(imp), "event_cap": False, "nudge": 0.0, "energy": float(energy[0]),
                 "time": float(core.time[0]), "targets_hit": int(n_hit[0]), "is_success": False}
         if self.render_mode is not None:
             self._get_renderer().start()  # trails and flashes are recorded from the episode start
@@ -153,8 +155,8 @@ class CollisionTargetEnv(gym.Env):
         imp, cost = core.advance(a.reshape(1, self._adim), self._ones, self._dt)  # raises on NaN
         obs, reward, term, trunc, success, n_hit, energy = core.finish(self._step_flag, imp, cost, out=self._out())
         info = {"impacts": Impacts(imp), "event_cap": bool(core.batch.cap_reached[0]),
-                "energy": float(energy[0]), "time": float(core.time[0]), "targets_hit": int(n_hit[0]),
-                "is_success": bool(success[0])}
+                "nudge": float(core.nudge[0]), "energy": float(energy[0]), "time": float(core.time[0]),
+                "targets_hit": int(n_hit[0]), "is_success": bool(success[0])}
         if self._renderer is not None:
             self._renderer.record(core, 0, imp)
         if self.render_mode == "human":

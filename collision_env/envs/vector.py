@@ -25,7 +25,7 @@ from collision_env.envs._config import TaskConfig, make_config
 from collision_env.envs._core import Impacts, TaskCore
 
 _CLASS_PRESET = "__class_preset__"
-_SCALAR_KEYS = ("event_cap", "energy", "time", "targets_hit", "is_success")
+_SCALAR_KEYS = ("event_cap", "nudge", "energy", "time", "targets_hit", "is_success")
 
 
 class CollisionTargetVectorEnv(VectorEnv):
@@ -102,11 +102,11 @@ class CollisionTargetVectorEnv(VectorEnv):
         if isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
             self._np_random, self._np_random_seed = seeding.np_random(int(seed))
 
-    def _info(self, energy, event_cap, success, n_hit, imp) -> dict:
+    def _info(self, energy, event_cap, nudge, success, n_hit, imp) -> dict:
         n = self.num_envs
         info = {"impacts": Impacts(imp), "_impacts": np.ones(n, dtype=bool)}
-        for key, value in (("event_cap", event_cap), ("energy", energy), ("time", self._core.time.copy()),
-                           ("targets_hit", n_hit), ("is_success", success)):
+        for key, value in (("event_cap", event_cap), ("nudge", nudge), ("energy", energy),
+                           ("time", self._core.time.copy()), ("targets_hit", n_hit), ("is_success", success)):
             info[key] = value
             info["_" + key] = np.ones(n, dtype=bool)
         return info
@@ -133,7 +133,7 @@ class CollisionTargetVectorEnv(VectorEnv):
             renderers = self._get_renderers()
             for i in idx:
                 renderers[i].start()
-        info = self._info(energy, np.zeros(self.num_envs, dtype=bool), success, n_hit, imp)
+        info = self._info(energy, np.zeros(self.num_envs, dtype=bool), np.zeros(self.num_envs), success, n_hit, imp)
         if not mask.all():  # a partial reset reports (and masks) only the sub-envs it reset
             for key in _SCALAR_KEYS:
                 info[key] = np.where(mask, info[key], np.zeros_like(info[key]))
@@ -173,7 +173,7 @@ class CollisionTargetVectorEnv(VectorEnv):
             if cap_limit is not None:
                 trunc |= (core.steps >= cap_limit) & active
             self._autoreset = term | trunc
-            info = self._info(energy, event_cap, success, n_hit, imp)
+            info = self._info(energy, event_cap, core.nudge.copy(), success, n_hit, imp)
             if self._renderers is not None:
                 self._record(imp, resetting if any_reset else None)
             return obs, reward, term, trunc, info
@@ -189,7 +189,7 @@ class CollisionTargetVectorEnv(VectorEnv):
         if self._renderers is not None:
             self._record(imp, None)
         if not done.any():
-            return obs, reward, term, trunc, self._info(energy, event_cap, success, n_hit, imp)
+            return obs, reward, term, trunc, self._info(energy, event_cap, core.nudge.copy(), success, n_hit, imp)
         idx = np.flatnonzero(done)
         in_done = done[imp["scene"]]
         final_obs = np.full(B, None, dtype=object)
@@ -197,7 +197,8 @@ class CollisionTargetVectorEnv(VectorEnv):
             final_obs[i] = obs[i].copy()
         final_info = {"impacts": Impacts(imp[in_done]), "_impacts": done.copy()}
         time_now = core.time.copy()
-        for key, value in (("event_cap", event_cap), ("energy", energy), ("time", time_now),
+        nudge = core.nudge.copy()
+        for key, value in (("event_cap", event_cap), ("nudge", nudge), ("energy", energy), ("time", time_now),
                            ("targets_hit", n_hit), ("is_success", success)):
             v = np.zeros_like(value)
             v[done] = value[done]
@@ -212,7 +213,7 @@ class CollisionTargetVectorEnv(VectorEnv):
         energy = np.where(done, r_energy, energy)
         success = success & ~done
         n_hit = np.where(done, r_hit, n_hit)
-        info = self._info(energy, event_cap, success, n_hit, imp[~in_done])
+        info = self._info(energy, event_cap, np.where(done, 0.0, nudge), success, n_hit, imp[~in_done])
         info["final_obs"] = final_obs
         info["_final_obs"] = done.copy()
         info["final_info"] = final_info

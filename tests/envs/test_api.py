@@ -173,6 +173,19 @@ def test_out_of_range_actions_are_clipped():
         assert data_equivalence(ra, rb, exact=True)
 
 
+def test_info_nudge_is_the_requested_velocity_change_and_its_cost_is_charged():
+    # shaping off and a ball far from the walls: the reward is -action_cost * |requested dv| exactly
+    env = gym.make("CollisionEnv/OneBallTarget-v0", shaping=0.0, speed_range=(0.0, 0.0)).unwrapped
+    _, info = env.reset(seed=2)
+    assert info["nudge"] == 0.0
+    cfg = env.config
+    for action, size in (([1.0, 0.0], cfg.max_dv), ([3.0, 0.0], cfg.max_dv), ([-1.0, 1.0], cfg.max_dv * 2**0.5),
+                         ([0.0, 0.0], 0.0)):
+        _, reward, _, _, info = env.step(np.array(action, np.float32))
+        assert type(info["nudge"]) is float and info["nudge"] == pytest.approx(size, rel=1e-6)
+        assert reward == pytest.approx(-cfg.action_cost * size, rel=1e-6) and len(info["impacts"]) == 0
+
+
 def test_kwargs_reach_the_engine():
     env = gym.make("CollisionEnv/Billiards-v0", mode="posteriori", substeps=3, dt=0.1, max_events=77).unwrapped
     sim = env.simulator

@@ -165,7 +165,7 @@ def test_sb3_adapter_matches_dummy_vec_env():
         assert np.array_equal(o1, o2) and np.array_equal(r1, r2) and np.array_equal(d1, d2)
         assert r1.dtype == r2.dtype == np.float32
         for x, y in zip(inf1, inf2, strict=True):
-            assert x["is_success"] == y["is_success"]
+            assert x["is_success"] == y["is_success"] and x["nudge"] == y["nudge"]
             assert x["TimeLimit.truncated"] == y["TimeLimit.truncated"]
             assert ("terminal_observation" in x) == ("terminal_observation" in y)
             if "terminal_observation" in x:
