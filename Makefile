@@ -34,7 +34,7 @@ figures: $(STAMP)
 
 # Train cheap, evaluate exact: PPO under every engine mode and seed, then every preset (long).
 agents-study: $(STAMP)
-	$(PY) -m agents.study --readme README.md
+	$(PY) -m agents.study --jobs 2 --readme README.md
 
 # numba caches compiled kernels next to the sources and does not notice edits to a kernel's
 # callees in other files: clear the cache after editing the engine.

@@ -1,0 +1,212 @@
+"""Hyperparameter files, run folders and the command-line plumbing shared by the agent scripts.
+
+A hyperparameter file is RL-Zoo style YAML keyed by env id (``agents/hyperparams/ppo.yml``); an
+entry's keys are ``n_envs``, ``n_timesteps``, ``policy``, ``normalize`` (VecNormalize settings),
+``env_kwargs``, ``policy_kwargs`` and any ``PPO`` keyword, with ``lin_<x>`` for a linear schedule.
+A run folder holds ``config.yml``: the fully resolved settings of the run, enough to rebuild its
+envs and to retrain it (``train_ppo --hyperparams runs/<run>/config.yml`` reads it back).
+"""
+
+from __future__ import annotations
+
+import ast
+import difflib
+import math
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+HYPERPARAMS = Path(__file__).with_name("hyperparams") / "ppo.yml"
+CONFIG_FILE = "config.yml"
+MODEL_FILE = "model.zip"
+VECNORMALIZE_FILE = "vecnormalize.pkl"
+
+#: Keys of a hyperparameter entry that are not PPO keywords.
+RUN_KEYS = ("n_envs", "n_timesteps", "policy", "normalize", "env_kwargs")
+
+
+class UsageError(Exception):
+    """A mistake in what the user asked for: reported as one line, without a traceback."""
+
+
+def run_cli(main: Callable[[list[str] | None], Any], argv: list[str] | None = None, prog: str = "agents") -> Any:
+    """Run ``main(argv)``; a :class:`UsageError` (or a bad env argument) becomes a one-line error, exit 2."""
+    try:
+        return main(argv)
+    except UsageError as err:
+        print(f"{prog}: error: {err}", file=sys.stderr)
+        raise SystemExit(2) from None
+
+
+# --------------------------------------------------------------------------------------- env ids
+def check_env_id(env_id: str) -> str:
+    """``env_id`` if Gymnasium knows it (after ``import collision_env``), else a UsageError."""
+    import gymnasium as gym
+
+    import collision_env
+
+    if env_id in gym.registry:
+        return env_id
+    close = difflib.get_close_matches(env_id, collision_env.ENV_IDS, n=1, cutoff=0.4)
+    hint = f"; did you mean {close[0]!r}?" if close else ""
+    raise UsageError(f"unknown env id {env_id!r}{hint} (registered: {', '.join(collision_env.ENV_IDS)})")
+
+
+def parse_env_kwargs(pairs: list[str] | None) -> dict:
+    """``["mode=naive", "dt=0.1"]`` -> ``{"mode": "naive", "dt": 0.1}`` (values read as YAML scalars)."""
+    import yaml
+
+    out = {}
+    for pair in pairs or []:
+        key, sep, value = pair.partition("=")
+        if not sep or not key:
+            raise UsageError(f"--env-kwargs: expected key=value, got {pair!r}")
+        out[key.strip()] = yaml.safe_load(value)
+    return out
+
+
+def episode_steps(env_id: str, env_kwargs: dict) -> int:
+    """Control steps per episode of ``env_id`` under ``env_kwargs`` (validates the kwargs)."""
+    import gymnasium as gym
+
+    try:
+        env = gym.make(env_id, **env_kwargs)
+    except (TypeError, ValueError) as err:
+        raise UsageError(f"{env_id}: {err}") from None
+    try:
+        return int(env.unwrapped.config.n_steps)
+    finally:
+        env.close()
+
+
+# ------------------------------------------------------------------------------ hyperparameters
+def load_yaml(path: str | Path) -> dict:
+    import yaml
+
+    path = Path(path)
+    if not path.is_file():
+        raise UsageError(f"no such file: {path}")
+    with path.open() as fh:
+        data = yaml.safe_load(fh)
+    if not isinstance(data, dict):
+        raise UsageError(f"{path}: expected a mapping of env ids to hyperparameters")
+    return data
+
+
+def hyperparams_for(env_id: str, path: str | Path = HYPERPARAMS) -> dict:
+    """The entry of ``env_id`` in the file at ``path`` (or its ``default``), as a fresh dict.
+
+    A run folder's ``config.yml`` is accepted too: its ``hyperparams`` are used whatever the id.
+    """
+    data = load_yaml(path)
+    if "hyperparams" in data and "env_id" in data:  # a run folder's resolved config
+        entry = data["hyperparams"]
+    elif env_id in data:
+        entry = data[env_id]
+    elif "default" in data:
+        entry = data["default"]
+    else:
+        raise UsageError(f"{path}: no entry for {env_id!r} and no 'default' entry")
+    if not isinstance(entry, dict):
+        raise UsageError(f"{path}: the entry for {env_id!r} is not a mapping")
+    return dict(entry)
+
+
+def linear_schedule(start: float) -> Callable[[float], float]:
+    """SB3 schedule from ``start`` (progress_remaining = 1) down to 0 (at the end of training)."""
+
+    def schedule(progress_remaining: float) -> float:
+        return progress_remaining * start
+
+    return schedule
+
+
+def _schedule_or_number(key: str, value: Any):
+    if isinstance(value, str) and value.startswith("lin_"):
+        try:
+            return linear_schedule(float(value[4:]))
+        except ValueError:
+            raise UsageError(f"{key}: bad schedule {value!r} (expected lin_<number>)") from None
+    return value
+
+
+def _policy_kwargs(value: Any) -> dict:
+    """A mapping, or RL Zoo's ``"dict(net_arch=[64, 64], activation_fn=nn.Tanh)"`` string."""
+    import torch.nn as nn
+
+    if value is None:
+        return {}
+    if isinstance(value, str):
+        try:
+            value = eval(value, {"__builtins__": {}}, {"dict": dict, "nn": nn})  # RL Zoo's format
+        except Exception as err:  # noqa: BLE001 - any failure is the user's string
+            raise UsageError(f"policy_kwargs: cannot read {value!r}: {err}") from None
+    if not isinstance(value, dict):
+        raise UsageError(f"policy_kwargs: expected a mapping, got {value!r}")
+    out = dict(value)
+    act = out.get("activation_fn")
+    if isinstance(act, str):  # "tanh", "relu", "nn.ReLU", ...
+        name = act.removeprefix("nn.")
+        lookup = {cls.lower(): cls for cls in ("Tanh", "ReLU", "ELU", "LeakyReLU", "GELU", "SiLU")}
+        if name.lower() not in lookup:
+            raise UsageError(f"policy_kwargs.activation_fn: unknown activation {act!r}")
+        out["activation_fn"] = getattr(nn, lookup[name.lower()])
+    return out
+
+
+def normalize_settings(value: Any) -> dict | None:
+    """VecNormalize keywords from ``normalize`` (bool, mapping or RL Zoo's string), or None for none."""
+    if isinstance(value, str):
+        try:
+            value = ast.literal_eval(value)
+        except (ValueError, SyntaxError):
+            raise UsageError(f"normalize: cannot read {value!r}") from None
+    if value is None or value is False:
+        return None
+    if value is True:
+        return {"norm_obs": True, "norm_reward": True}
+    if not isinstance(value, dict):
+        raise UsageError(f"normalize: expected true/false or a mapping, got {value!r}")
+    return dict(value)
+
+
+def ppo_kwargs(hp: dict) -> dict:
+    """PPO's keyword arguments from a hyperparameter entry (schedules and policy_kwargs resolved)."""
+    out = {}
+    for key, value in hp.items():
+        if key in RUN_KEYS:
+            continue
+        if key == "policy_kwargs":
+            out[key] = _policy_kwargs(value)
+        else:
+            out[key] = _schedule_or_number(key, value)
+    return out
+
+
+def as_positive_int(name: str, value: Any) -> int:
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise UsageError(f"{name}: expected a positive integer, got {value!r}") from None
+    if not math.isfinite(number) or number < 1 or number != int(number):
+        raise UsageError(f"{name}: expected a positive integer, got {value!r}")
+    return int(number)
+
+
+# ----------------------------------------------------------------------------------- run folders
+def read_run(run_dir: str | Path) -> dict:
+    """The resolved config of a run folder (UsageError if it is not one)."""
+    run_dir = Path(run_dir)
+    if not run_dir.is_dir():
+        raise UsageError(f"run folder not found: {run_dir}")
+    if not (run_dir / CONFIG_FILE).is_file() or not (run_dir / MODEL_FILE).is_file():
+        raise UsageError(f"{run_dir} is not a training run folder (it needs {CONFIG_FILE} and {MODEL_FILE})")
+    return load_yaml(run_dir / CONFIG_FILE)
+
+
+def write_yaml(path: Path, data: dict) -> None:
+    import yaml
+
+    with path.open("w") as fh:
+        yaml.safe_dump(data, fh, sort_keys=False)

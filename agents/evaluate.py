@@ -1,0 +1,279 @@
+"""Evaluate a trained run beside a random and a scripted baseline, all measured in the same run.
+
+    python -m agents.evaluate runs/<run>                      # 100 deterministic episodes, trained mode
+    python -m agents.evaluate runs/<run> --mode exact         # evaluate under another engine mode
+    python -m agents.evaluate runs/<run> --gif                # also record runs/<run>/episodes.gif
+    python -m agents.evaluate runs/<run> --video out.mp4 --record-episodes 3
+
+Every policy plays the same episodes (episode i starts from ``reset(seed=seed + i)``); the trained
+policy acts deterministically. The baselines are a **random** policy (uniform actions, seeded per
+episode) and a **scripted** policy that aims with the engine's exact prediction
+(``collision_env.envs.scripted``; not every task has one). Reported per policy: success rate (with a
+95 % Wilson interval), mean return, mean nudge (the requested velocity change summed over the
+episode, m/s) and its cost in reward units, mean targets hit and mean episode length. The table is
+printed and written as JSON to ``<run>/eval-<mode>.json`` (or ``--json``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from agents.config import (
+    MODEL_FILE,
+    VECNORMALIZE_FILE,
+    UsageError,
+    as_positive_int,
+    check_env_id,
+    episode_steps,
+    read_run,
+    run_cli,
+)
+
+EVAL_SEED = 1_000_000  # evaluation episodes start far from the training and EvalCallback seeds
+BASELINES = ("random", "scripted")
+
+#: A policy factory: called after each reset with (unwrapped env, episode index); returns obs -> action.
+PolicyFactory = Callable[[object, int], Callable[[np.ndarray], np.ndarray]]
+
+
+def wilson_interval(successes: int, n: int, z: float = 1.96) -> tuple[float, float]:
+    """95 % Wilson score interval of a success rate (well behaved at 0 and 1)."""
+    if n == 0:
+        return (0.0, 1.0)
+    p = successes / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return (max(0.0, centre - half), min(1.0, centre + half))
+
+
+# ------------------------------------------------------------------------------------- policies
+def trained_policy(run_dir: str | Path, which: str = "final") -> PolicyFactory:
+    """The run's PPO policy (``final`` = model.zip, ``best`` = EvalCallback's best_model.zip), deterministic.
+
+    Observations pass through the run's VecNormalize statistics when it normalised observations.
+    """
+    from stable_baselines3 import PPO
+
+    run_dir = Path(run_dir)
+    path = run_dir / (MODEL_FILE if which == "final" else "best_model.zip")
+    if not path.is_file():
+        raise UsageError(f"{path} not found")
+    model = PPO.load(path, device="cpu")
+    obs_rms, clip, eps = None, None, None
+    stats = run_dir / VECNORMALIZE_FILE
+    if stats.is_file():
+        import pickle
+
+        with stats.open("rb") as fh:
+            vecnorm = pickle.load(fh)  # VecNormalize.save pickles the wrapper without its venv
+        if vecnorm.norm_obs:
+            obs_rms, clip, eps = vecnorm.obs_rms, vecnorm.clip_obs, vecnorm.epsilon
+
+    def factory(env, episode):
+        def act(obs):
+            if obs_rms is not None:
+                obs = np.clip((obs - obs_rms.mean) / np.sqrt(obs_rms.var + eps), -clip, clip).astype(np.float32)
+            return model.predict(obs, deterministic=True)[0]
+
+        return act
+
+    return factory
+
+
+def random_policy(seed: int = 0) -> PolicyFactory:
+    """Uniform actions in the action box, from a generator seeded with ``seed + episode``."""
+
+    def factory(env, episode):
+        rng = np.random.default_rng(seed + episode)
+        space = env.action_space
+        return lambda obs: rng.uniform(space.low, space.high).astype(np.float32)
+
+    return factory
+
+
+def scripted_baseline() -> PolicyFactory | None:
+    """The task's scripted exact-aiming policy (``collision_env.envs.scripted.scripted_policy``)."""
+    from collision_env.envs.scripted import scripted_policy
+
+    def factory(env, episode):
+        policy = scripted_policy(env)
+        if policy is None:
+            raise LookupError("no scripted policy for this task")
+        return policy
+
+    return factory
+
+
+# ---------------------------------------------------------------------------------------- play
+def play(env, factory: PolicyFactory, episodes: int, seed: int, frames: list | None = None) -> dict:
+    """Play ``episodes`` episodes (episode i from ``reset(seed=seed + i)``); return the summary.
+
+    With ``frames`` (a list) the env must render ``rgb_array``; every frame is appended to it.
+    """
+    cost_per = env.unwrapped.config.action_cost
+    rows = []
+    start = time.perf_counter()
+    for i in range(episodes):
+        obs, info = env.reset(seed=seed + i)
+        act = factory(env.unwrapped, i)
+        if frames is not None:
+            frames.append(env.render())
+        ret, nudge, steps, done = 0.0, 0.0, 0, False
+        while not done:
+            obs, reward, term, trunc, info = env.step(act(obs))
+            ret += reward
+            nudge += info["nudge"]
+            steps += 1
+            done = term or trunc
+            if frames is not None:
+                frames.append(env.render())
+        rows.append((bool(info["is_success"]), ret, nudge, int(info["targets_hit"]), steps))
+    success = [r[0] for r in rows]
+    lo, hi = wilson_interval(sum(success), len(success))
+    mean = lambda k: float(np.mean([r[k] for r in rows]))  # noqa: E731
+    return {"episodes": episodes, "success_rate": float(np.mean(success)), "success_ci95": [lo, hi],
+            "mean_return": mean(1), "mean_nudge": mean(2), "mean_nudge_cost": cost_per * mean(2),
+            "mean_targets_hit": mean(3), "mean_length": mean(4),
+            "seconds": round(time.perf_counter() - start, 2)}
+
+
+def make_env(env_id: str, env_kwargs: dict, render_mode: str | None = None):
+    import gymnasium as gym
+
+    import collision_env  # noqa: F401
+
+    return gym.make(env_id, max_episode_steps=episode_steps(env_id, env_kwargs), render_mode=render_mode,
+                    **env_kwargs)
+
+
+def eval_kwargs(run: dict, mode: str | None, substeps: int | None) -> dict:
+    """The run's env kwargs with the engine mode replaced (a new mode starts from substeps = 1)."""
+    kwargs = dict(run.get("env_kwargs") or {})
+    if mode is not None:
+        kwargs["mode"] = mode
+        kwargs["substeps"] = 1 if substeps is None else substeps
+    elif substeps is not None:
+        kwargs["substeps"] = substeps
+    return kwargs
+
+
+def evaluate(run_dir: str | Path, *, episodes: int = 100, mode: str | None = None, substeps: int | None = None,
+             seed: int = EVAL_SEED, baselines: tuple = BASELINES, model: str = "final", log=print) -> dict:
+    """Evaluate the run (and the baselines) on the same episodes; returns the results dict."""
+    run = read_run(run_dir)
+    env_id = check_env_id(run["env_id"])
+    episodes = as_positive_int("episodes", episodes)
+    kwargs = eval_kwargs(run, mode, substeps)
+    env = make_env(env_id, kwargs)
+    policies = {"ppo": trained_policy(run_dir, model)}
+    if "random" in baselines:
+        policies["random"] = random_policy(seed)
+    if "scripted" in baselines:
+        policies["scripted"] = scripted_baseline()
+    trained = run.get("env_kwargs") or {}
+    results = {"env_id": env_id, "run": str(run_dir), "model": model, "train_mode": trained.get("mode", "exact"),
+               "train_substeps": int(trained.get("substeps", 1)), "mode": kwargs.get("mode", "exact"),
+               "substeps": int(kwargs.get("substeps", 1)), "episodes": episodes, "seed": seed, "policies": {}}
+    for name, factory in policies.items():
+        try:
+            results["policies"][name] = play(env, factory, episodes, seed)
+        except LookupError:
+            results["policies"][name] = None  # this task has no scripted policy
+    env.close()
+    return results
+
+
+def record(run_dir: str | Path, path: str | Path, *, episodes: int = 1, mode: str | None = None,
+           substeps: int | None = None, seed: int = EVAL_SEED, model: str = "final") -> Path:
+    """Record the trained policy's first ``episodes`` evaluation episodes as a GIF or MP4 (by suffix)."""
+    import imageio.v2 as imageio
+
+    run = read_run(run_dir)
+    path = Path(path)
+    if path.suffix.lower() not in (".gif", ".mp4"):
+        raise UsageError(f"video: expected a .gif or .mp4 path, got {path}")
+    env = make_env(check_env_id(run["env_id"]), eval_kwargs(run, mode, substeps), render_mode="rgb_array")
+    frames: list = []
+    play(env, trained_policy(run_dir, model), episodes, seed, frames=frames)
+    fps = env.unwrapped.metadata["render_fps"]
+    env.close()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if path.suffix.lower() == ".gif":
+        imageio.mimsave(path, frames, duration=1000.0 / fps, loop=0)
+    else:
+        try:
+            imageio.mimsave(path, frames, fps=fps, macro_block_size=1)
+        except (ImportError, ValueError) as err:
+            raise UsageError(f"writing MP4 needs imageio-ffmpeg (the 'video' extra): {err}") from None
+    return path
+
+
+# ----------------------------------------------------------------------------------------- report
+def _pct(x: float) -> str:
+    return f"{100 * x:.0f} %"
+
+
+def markdown(results: dict) -> str:
+    """The results as a Markdown table, one row per policy."""
+    mode = results["mode"] + (f" k={results['substeps']}" if results["substeps"] != 1 else "")
+    train = results["train_mode"] + (f" k={results['train_substeps']}" if results["train_substeps"] != 1 else "")
+    lines = [f"{results['env_id']}: {results['episodes']} episodes (seeds {results['seed']}...), "
+             f"evaluated in {mode} mode, trained in {train} mode",
+             "",
+             "| policy | success (95 % CI) | mean return | mean nudge (m/s) | nudge cost | targets hit | steps |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
+    names = {"ppo": "PPO (this run, deterministic)", "random": "random", "scripted": "scripted (exact aim)"}
+    for key, r in results["policies"].items():
+        if r is None:
+            lines.append(f"| {names.get(key, key)} | n/a | | | | | |")
+            continue
+        lo, hi = r["success_ci95"]
+        lines.append(f"| {names.get(key, key)} | {_pct(r['success_rate'])} ({_pct(lo)}–{_pct(hi)}) | "
+                     f"{r['mean_return']:.3f} | {r['mean_nudge']:.2f} | {r['mean_nudge_cost']:.3f} | "
+                     f"{r['mean_targets_hit']:.2f} | {r['mean_length']:.0f} |")
+    return "\n".join(lines)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python -m agents.evaluate", description=__doc__.split("\n\n")[0],
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("run", help="a run folder written by agents.train_ppo")
+    p.add_argument("--episodes", type=int, default=100)
+    p.add_argument("--mode", choices=("exact", "posteriori", "naive"), help="engine mode (default: the run's)")
+    p.add_argument("--substeps", type=int, help="sub-steps for naive/posteriori (default 1 with --mode)")
+    p.add_argument("--seed", type=int, default=EVAL_SEED, help="episode i starts from seed + i")
+    p.add_argument("--model", choices=("final", "best"), default="final")
+    p.add_argument("--no-baselines", action="store_true", help="evaluate the trained policy only")
+    p.add_argument("--json", help="write the results here (default: <run>/eval-<mode>.json)")
+    p.add_argument("--gif", nargs="?", const="", metavar="PATH", help="record a GIF (default: <run>/episodes.gif)")
+    p.add_argument("--video", metavar="PATH.mp4|PATH.gif", help="record a video (MP4 needs imageio-ffmpeg)")
+    p.add_argument("--record-episodes", type=int, default=1, help="episodes to record (default 1)")
+    return p
+
+
+def main(argv: list[str] | None = None) -> dict:
+    args = build_parser().parse_args(argv)
+    results = evaluate(args.run, episodes=args.episodes, mode=args.mode, substeps=args.substeps, seed=args.seed,
+                       baselines=() if args.no_baselines else BASELINES, model=args.model)
+    print(markdown(results))
+    suffix = results["mode"] + (str(results["substeps"]) if results["substeps"] != 1 else "")
+    out = Path(args.json) if args.json else Path(args.run) / f"eval-{suffix}.json"
+    out.write_text(json.dumps(results, indent=1))
+    print(f"results: {out}")
+    for video in ([args.video] if args.video else []) + ([args.gif or Path(args.run) / "episodes.gif"]
+                                                        if args.gif is not None else []):
+        path = record(args.run, video, episodes=args.record_episodes, mode=args.mode, substeps=args.substeps,
+                      seed=args.seed, model=args.model)
+        print(f"video:   {path}")
+    return results
+
+
+if __name__ == "__main__":
+    run_cli(main, prog="evaluate")

@@ -1,0 +1,340 @@
+"""Train cheap, evaluate exact: what the engine's fidelity mode costs and buys a PPO agent.
+
+    python -m agents.study --jobs 2 --readme README.md   # both parts, 3 seeds each (under an hour on 2 cores)
+    python -m agents.study --part modes --envs CollisionEnv/Line1D-v0 --modes naive:1 exact:1 --seeds 0
+
+Part **modes**: each preset of ``--envs`` (default ``OneBallTarget``, where only wall impacts
+matter, and ``Line1D``, where ball-ball impacts and time windows make timing matter) is trained
+with the shipped hyperparameters under each engine mode (``mode:substeps``), over several seeds;
+every policy is then evaluated deterministically in **exact** mode (and in its own training mode)
+on the same 100 episodes. The table gives success per seed, its mean and spread, and the wall-clock
+training time, so the trade is read off directly: is a policy trained on a cheaper, less exact
+engine as good when the impacts are exact, and how much training time did the cheaper engine save?
+
+Part **presets**: every registered preset is trained in exact mode over the same seeds and set
+beside the random and the scripted (exact-aim) baselines on the same evaluation episodes.
+
+Writes ``study.json`` (every figure), ``modes.md``, ``presets.md`` and ``modes.png`` into
+``--docs`` (default ``docs/agents``), and with ``--readme`` the tables into the README's
+``agents:study`` block. Training runs go to ``--output`` (default ``runs/study``). With ``--jobs 2``
+two runs train at once (one core each), as every figure in the README was measured.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import statistics
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+from agents.config import UsageError, check_env_id, hyperparams_for, read_run, run_cli
+
+DEFAULT_ENVS = ("CollisionEnv/OneBallTarget-v0", "CollisionEnv/Line1D-v0")
+DEFAULT_MODES = ("naive:1", "naive:4", "posteriori:1", "posteriori:4", "exact:1")
+DEFAULT_SEEDS = (0, 1, 2)
+README_BLOCK = "agents:study"
+
+
+def parse_mode(spec: str) -> tuple[str, int]:
+    mode, _, k = spec.partition(":")
+    if mode not in ("naive", "posteriori", "exact"):
+        raise UsageError(f"--modes: expected mode:substeps with mode naive|posteriori|exact, got {spec!r}")
+    try:
+        substeps = int(k or 1)
+    except ValueError:
+        raise UsageError(f"--modes: bad substeps in {spec!r}") from None
+    if substeps < 1 or (mode == "exact" and substeps != 1):
+        raise UsageError(f"--modes: substeps must be >= 1 (and 1 for exact), got {spec!r}")
+    return mode, substeps
+
+
+def _label(mode: str, substeps: int) -> str:
+    return mode if mode == "exact" else f"{mode} k={substeps}"
+
+
+# ------------------------------------------------------------------------------------ the work
+def train_and_evaluate(task: dict) -> dict:
+    """One study cell: train (no eval or checkpoint callbacks, so the time is training only), then
+    evaluate in exact mode and, if different, in the training mode. Runs in a worker process."""
+    import torch
+
+    from agents.evaluate import evaluate
+    from agents.train_ppo import run_label, train
+
+    torch.set_num_threads(1)
+    name = run_label(task["env_id"], task["mode"], task["substeps"], task["seed"])
+    run_dir = train(task["env_id"], timesteps=task["timesteps"], seed=task["seed"], mode=task["mode"],
+                    substeps=task["substeps"], output=task["output"], run_name=name, eval_freq=0, save_freq=0,
+                    overwrite=True, log=lambda *a: None)
+    run = read_run(run_dir)
+    out = {**task, "run": str(run_dir), "train_seconds": run["train_seconds"], "timesteps_done": run["timesteps_done"]}
+    exact = evaluate(run_dir, episodes=task["episodes"], mode="exact", baselines=())
+    out["exact"] = exact["policies"]["ppo"]
+    if task["mode"] != "exact":
+        own = evaluate(run_dir, episodes=task["episodes"], mode=task["mode"], substeps=task["substeps"], baselines=())
+        out["own"] = own["policies"]["ppo"]
+    else:
+        out["own"] = out["exact"]
+    return out
+
+
+def baselines(task: dict) -> dict:
+    """Random and scripted baselines of one preset in exact mode, on the study's evaluation episodes."""
+    import gymnasium as gym
+
+    import collision_env  # noqa: F401
+    from agents.evaluate import EVAL_SEED, play, random_policy, scripted_baseline
+
+    env = gym.make(task["env_id"])
+    out = {"env_id": task["env_id"], "random": play(env, random_policy(EVAL_SEED), task["episodes"], EVAL_SEED)}
+    try:
+        out["scripted"] = play(env, scripted_baseline(), task["episodes"], EVAL_SEED)
+    except LookupError:
+        out["scripted"] = None
+    env.close()
+    return out
+
+
+def _run_all(fn, tasks: list, jobs: int, log) -> list:
+    results = []
+    if jobs <= 1:
+        for i, task in enumerate(tasks):
+            results.append(fn(task))
+            log(f"  [{i + 1}/{len(tasks)}] {_describe(task)} done")
+        return results
+    with ProcessPoolExecutor(max_workers=jobs) as pool:
+        for i, result in enumerate(pool.map(fn, tasks)):
+            results.append(result)
+            log(f"  [{i + 1}/{len(tasks)}] {_describe(tasks[i])} done")
+    return results
+
+
+def _describe(task: dict) -> str:
+    what = task["env_id"]
+    if "mode" in task:
+        what += f" {_label(task['mode'], task['substeps'])} seed {task['seed']}"
+    return what
+
+
+# ------------------------------------------------------------------------------------- tables
+def _pct(x: float) -> str:
+    return f"{100 * x:.0f} %"
+
+
+def _spread(values: list) -> str:
+    mean = statistics.fmean(values)
+    if len(values) < 2:
+        return _pct(mean)
+    return f"{_pct(mean)} ± {100 * statistics.stdev(values):.0f}"
+
+
+def _by_env_and_mode(rows: list) -> dict:
+    """{env_id: {(mode, substeps): [rows sorted by seed]}} for the modes part, in run order."""
+    out: dict = {}
+    for r in rows:
+        if r["part"] == "modes":
+            out.setdefault(r["env_id"], {}).setdefault((r["mode"], r["substeps"]), []).append(r)
+    for groups in out.values():
+        for rs in groups.values():
+            rs.sort(key=lambda r: r["seed"])
+    return out
+
+
+def modes_table(rows: list) -> str:
+    tables = []
+    for env_id, groups in _by_env_and_mode(rows).items():
+        first = next(iter(groups.values()))[0]
+        lines = [f"**`{env_id}`**: PPO with the shipped hyperparameters ({first['timesteps_done']:,} steps), "
+                 f"trained under each engine mode, evaluated deterministically on the same {first['episodes']} "
+                 "episodes. Success: mean ± standard deviation over seeds, then each seed's figure.",
+                 "",
+                 "| trained in | success, evaluated exact | per seed | success in its own mode | "
+                 "training time (s) | ÷ exact's |",
+                 "|---|---:|---:|---:|---:|---:|"]
+        exact_rows = groups.get(("exact", 1))
+        exact_time = statistics.fmean(r["train_seconds"] for r in exact_rows) if exact_rows else None
+        for (mode, k), rs in groups.items():
+            exact = [r["exact"]["success_rate"] for r in rs]
+            own = [r["own"]["success_rate"] for r in rs]
+            secs = statistics.fmean(r["train_seconds"] for r in rs)
+            ratio = f"{secs / exact_time:.2f}" if exact_time else "n/a"
+            lines.append(f"| {_label(mode, k)} | {_spread(exact)} | {' / '.join(_pct(x) for x in exact)} | "
+                         f"{_spread(own)} | {secs:.0f} | {ratio} |")
+        tables.append("\n".join(lines))
+    return "\n\n".join(tables)
+
+
+def presets_table(rows: list, base: list) -> str:
+    rows = [r for r in rows if r["part"] == "presets"]
+    if not rows:
+        return ""
+    by_env = {b["env_id"]: b for b in base}
+    episodes = rows[0]["episodes"]
+    lines = [f"Every preset, PPO in exact mode with the shipped hyperparameters, beside the baselines on the same "
+             f"{episodes} evaluation episodes (success rate; mean return in brackets). PPO: mean ± standard "
+             "deviation over seeds, then each seed.",
+             "",
+             "| env | steps | PPO success | per seed | PPO return | random | scripted (exact aim) "
+             "| training time (s) |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|"]
+    order = [b["env_id"] for b in base]  # the presets in the order they were asked for
+    groups: dict = {}
+    for r in sorted(rows, key=lambda r: order.index(r["env_id"]) if r["env_id"] in order else len(order)):
+        groups.setdefault(r["env_id"], []).append(r)
+    for env_id, rs in groups.items():
+        rs = sorted(rs, key=lambda r: r["seed"])
+        succ = [r["exact"]["success_rate"] for r in rs]
+        ret = statistics.fmean(r["exact"]["mean_return"] for r in rs)
+        b = by_env.get(env_id, {})
+        fmt = lambda p: "n/a" if p is None else f"{_pct(p['success_rate'])} ({p['mean_return']:.2f})"  # noqa: E731
+        lines.append(f"| `{env_id}` | {rs[0]['timesteps_done']:,} | {_spread(succ)} | "
+                     f"{' / '.join(_pct(x) for x in succ)} | {ret:.2f} | {fmt(b.get('random'))} | "
+                     f"{fmt(b.get('scripted'))} | {statistics.fmean(r['train_seconds'] for r in rs):.0f} |")
+    return "\n".join(lines)
+
+
+def plot(rows: list, path: Path) -> Path | None:
+    """Per env: success evaluated exact and in its own mode (bars: means, dots: seeds), and training time."""
+    envs = _by_env_and_mode(rows)
+    if not envs:
+        return None
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(len(envs), 2, figsize=(10, 3.4 * len(envs)), squeeze=False)
+    for (env_id, groups), (ax1, ax2) in zip(envs.items(), axes, strict=True):
+        labels = [_label(m, k) for m, k in groups]
+        for i, rs in enumerate(groups.values()):
+            exact = [100 * r["exact"]["success_rate"] for r in rs]
+            own = [100 * r["own"]["success_rate"] for r in rs]
+            ax1.bar(i - 0.2, statistics.fmean(exact), 0.4, color="tab:blue",
+                    label="evaluated exact" if i == 0 else None)
+            ax1.bar(i + 0.2, statistics.fmean(own), 0.4, color="tab:gray",
+                    label="evaluated in its own mode" if i == 0 else None)
+            ax1.plot([i - 0.2] * len(exact), exact, "k.", ms=6)
+            ax1.plot([i + 0.2] * len(own), own, "k.", ms=6)
+            ax2.bar(i, statistics.fmean(r["train_seconds"] for r in rs), 0.6, color="tab:orange")
+            ax2.plot([i] * len(rs), [r["train_seconds"] for r in rs], "k.", ms=6)
+        for ax in (ax1, ax2):
+            ax.set_xticks(range(len(labels)), labels, rotation=15)
+        ax1.set_ylabel("success rate (%)")
+        ax1.set_ylim(0, 105)
+        ax1.legend(loc="lower right", fontsize=8)
+        ax1.set_title(f"{env_id}: success (dots: seeds)", fontsize=9)
+        ax2.set_ylabel("training wall-clock (s)")
+        steps = next(iter(groups.values()))[0]["timesteps_done"]
+        ax2.set_title(f"{env_id}: training time for {steps:,} steps", fontsize=9)
+    axes[-1, 0].set_xlabel("trained in")
+    axes[-1, 1].set_xlabel("trained in")
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def render(data: dict, docs: Path, readme: Path | None) -> None:
+    """Write the tables (and plot) from the study's JSON, and the README block."""
+    from collision_env._readme import write_block
+
+    docs.mkdir(parents=True, exist_ok=True)
+    meta = data["meta"]
+    stamp = (f"Generated by `python -m agents.study` ({meta['date']}, {meta['machine']}, {meta['cpus']} CPUs, "
+             f"{meta['jobs']} run(s) at a time, {meta['minutes']:.0f} min); do not edit by hand.")
+    modes = modes_table(data["rows"])
+    presets = presets_table(data["rows"], data["baselines"])
+    png = plot(data["rows"], docs / "modes.png")
+    if modes:
+        (docs / "modes.md").write_text(f"# Train cheap, evaluate exact\n\n{stamp}\n\n{modes}\n")
+    if presets:
+        (docs / "presets.md").write_text(f"# Every preset against the baselines\n\n{stamp}\n\n{presets}\n")
+    if readme is not None:
+        parts = [stamp]
+        if modes:
+            parts.append(modes)
+        if png is not None:
+            parts.append(f"![success and training time per training mode]({os.path.relpath(png, readme.parent)})")
+        if presets:
+            parts.append(presets)
+        write_block(readme, README_BLOCK, "\n\n".join(parts))
+
+
+# --------------------------------------------------------------------------------------- main
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python -m agents.study", description=__doc__.split("\n\n")[0],
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--part", choices=("modes", "presets", "both"), default="both")
+    p.add_argument("--envs", nargs="+", default=list(DEFAULT_ENVS), help="presets of the modes part")
+    p.add_argument("--modes", nargs="+", default=list(DEFAULT_MODES), metavar="MODE:K")
+    p.add_argument("--presets", nargs="+", help="ids of the presets part (default: every preset)")
+    p.add_argument("--seeds", nargs="+", type=int, default=list(DEFAULT_SEEDS))
+    p.add_argument("--timesteps", type=float, help="override every entry's n_timesteps (quick looks)")
+    p.add_argument("--episodes", type=int, default=100)
+    p.add_argument("--jobs", type=int, default=1, help="runs trained at once (one core each)")
+    p.add_argument("--output", default="runs/study")
+    p.add_argument("--docs", default="docs/agents")
+    p.add_argument("--readme", help="write the tables into this README's agents:study block")
+    p.add_argument("--render", action="store_true", help="only rewrite tables and plot from <docs>/study.json")
+    return p
+
+
+def main(argv: list[str] | None = None) -> dict:
+    args = build_parser().parse_args(argv)
+    docs = Path(args.docs)
+    readme = Path(args.readme) if args.readme else None
+    if args.render:
+        path = docs / "study.json"
+        if not path.is_file():
+            raise UsageError(f"{path} not found: run the study first")
+        data = json.loads(path.read_text())
+        render(data, docs, readme)
+        return data
+
+    from collision_env.envs import PRESET_IDS
+
+    modes = [parse_mode(m) for m in args.modes]
+    presets = [check_env_id(e) for e in (args.presets or PRESET_IDS.values())]
+    envs = [check_env_id(e) for e in args.envs]
+    steps = lambda env_id: args.timesteps or hyperparams_for(env_id)["n_timesteps"]  # noqa: E731
+    common = {"episodes": args.episodes, "output": args.output}
+    tasks = []
+    if args.part in ("modes", "both"):
+        tasks += [{"part": "modes", "env_id": e, "mode": m, "substeps": k, "seed": s, "timesteps": steps(e),
+                   **common} for e in envs for m, k in modes for s in args.seeds]
+    if args.part in ("presets", "both"):
+        for env_id in presets:
+            if args.part == "both" and env_id in envs and ("exact", 1) in modes:
+                continue  # the modes part trains this preset in exact mode over the same seeds already
+            tasks += [{"part": "presets", "env_id": env_id, "mode": "exact", "substeps": 1, "seed": s,
+                       "timesteps": steps(env_id), **common} for s in args.seeds]
+    start = time.perf_counter()
+    print(f"{len(tasks)} training runs, {args.jobs} at a time ...")
+    rows = _run_all(train_and_evaluate, tasks, args.jobs, print)
+    if args.part == "both":  # the shared runs count for the presets table too
+        rows += [{**r, "part": "presets"} for r in rows
+                 if r["part"] == "modes" and r["mode"] == "exact" and r["env_id"] in presets]
+    base = []
+    if args.part in ("presets", "both"):
+        print("baselines ...")
+        base = _run_all(baselines, [{"env_id": e, "episodes": args.episodes} for e in presets], args.jobs, print)
+    data = {"meta": {"date": time.strftime("%Y-%m-%d %H:%M"), "machine": f"{platform.machine()} {platform.system()}",
+                     "cpus": os.cpu_count(), "jobs": args.jobs, "minutes": (time.perf_counter() - start) / 60,
+                     "python": platform.python_version()},
+            "rows": rows, "baselines": base}
+    docs.mkdir(parents=True, exist_ok=True)
+    (docs / "study.json").write_text(json.dumps(data, indent=1))
+    render(data, docs, readme)
+    print(modes_table(rows))
+    print()
+    print(presets_table(rows, base))
+    return data
+
+
+if __name__ == "__main__":
+    run_cli(main, prog="agents.study")

@@ -1,0 +1,252 @@
+"""Train PPO (stable-baselines3) on a collision_env id and write one run folder.
+
+    python -m agents.train_ppo --env CollisionEnv/OneBallTarget-v0
+    python -m agents.train_ppo --env CollisionEnv/Billiards-v0 --timesteps 5e5 --mode posteriori --substeps 4
+    python -m agents.train_ppo --env CollisionEnv/Line1D-v0 --env-kwargs dt=0.1 window=3.0 --vec-env subproc
+
+Hyperparameters come from an RL-Zoo style YAML keyed by env id (``--hyperparams``, default
+``agents/hyperparams/ppo.yml``); command-line options override its ``n_envs`` and ``n_timesteps``.
+By default the agent trains on the native batched vector env through the SB3 adapter
+(``collision_env.envs.sb3``); ``--vec-env dummy`` or ``subproc`` use SB3's own vector envs over
+``gym.make`` instead (same episodes for the same seed, slower).
+
+The run folder (``--output``/``--run-name``) holds:
+
+| file | what |
+|---|---|
+| ``config.yml`` | the resolved settings: env id and kwargs, hyperparameters, seed, versions, training time |
+| ``model.zip`` | the final policy (``PPO.load``) |
+| ``vecnormalize.pkl`` | VecNormalize statistics (when the entry normalises) |
+| ``best_model.zip``, ``eval/evaluations.npz`` | EvalCallback's best policy and its evaluation log |
+| ``checkpoints/`` | CheckpointCallback's periodic saves (with the VecNormalize statistics) |
+| ``tb/`` | TensorBoard logs (``tensorboard --logdir <run>/tb``) |
+| ``monitor.csv`` | per-episode return, length and success |
+
+Evaluation and checkpoint frequencies count env steps (all sub-envs together), not callback calls.
+"""
+
+from __future__ import annotations
+
+import argparse
+import platform
+import sys
+import time
+from pathlib import Path
+
+from agents.config import (
+    CONFIG_FILE,
+    HYPERPARAMS,
+    MODEL_FILE,
+    VECNORMALIZE_FILE,
+    UsageError,
+    as_positive_int,
+    check_env_id,
+    episode_steps,
+    hyperparams_for,
+    normalize_settings,
+    parse_env_kwargs,
+    ppo_kwargs,
+    run_cli,
+    write_yaml,
+)
+
+VEC_ENVS = ("native", "dummy", "subproc")
+EVAL_SEED_OFFSET = 100_000  # evaluation episodes never share seeds with training episodes
+
+
+def make_vec_env(env_id: str, n_envs: int, seed: int, env_kwargs: dict, vec_env: str = "native",
+                 monitor_dir: Path | None = None):
+    """An SB3 ``VecEnv`` of ``n_envs`` sub-envs (sub-env i seeded ``seed + i``), monitored.
+
+    ``native``: the batched env through :class:`collision_env.envs.sb3.CollisionSB3VecEnv` (one
+    ``VecMonitor``); ``dummy`` / ``subproc``: SB3's ``make_vec_env`` over ``gym.make`` (one
+    ``Monitor`` per sub-env). Episodes last the env's own number of control steps whatever ``dt``
+    is (``max_episode_steps`` follows the task config).
+    """
+    kwargs = {**env_kwargs, "max_episode_steps": episode_steps(env_id, env_kwargs)}
+    if vec_env == "native":
+        from stable_baselines3.common.vec_env import VecMonitor
+
+        from collision_env.envs.sb3 import CollisionSB3VecEnv
+
+        venv = CollisionSB3VecEnv(env_id, n_envs, **kwargs)
+        venv.seed(seed)
+        filename = None if monitor_dir is None else str(monitor_dir / "monitor.csv")
+        return VecMonitor(venv, filename=filename, info_keywords=("is_success",))
+    from stable_baselines3.common.env_util import make_vec_env as sb3_make_vec_env
+    from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
+
+    # "module:id" makes gym.make import collision_env first, in a subprocess too
+    return sb3_make_vec_env(
+        f"collision_env:{env_id}", n_envs=n_envs, seed=seed, env_kwargs=kwargs,
+        vec_env_cls=DummyVecEnv if vec_env == "dummy" else SubprocVecEnv,
+        monitor_dir=None if monitor_dir is None else str(monitor_dir),
+        monitor_kwargs={"info_keywords": ("is_success",)},
+    )
+
+
+def _wrap_normalize(venv, settings: dict | None, gamma: float, training: bool):
+    if settings is None:
+        return venv
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    if training:
+        return VecNormalize(venv, gamma=gamma, **settings)
+    return VecNormalize(venv, training=False, norm_obs=settings.get("norm_obs", True), norm_reward=False,
+                        gamma=gamma)
+
+
+def _versions() -> dict:
+    import gymnasium
+    import numpy
+    import stable_baselines3
+    import torch
+
+    import collision_env
+    from collision_env.engine import BACKEND
+
+    versions = {"python": platform.python_version(), "numpy": numpy.__version__, "gymnasium": gymnasium.__version__,
+                "stable_baselines3": stable_baselines3.__version__, "torch": torch.__version__,
+                "collision_env": collision_env.__version__, "engine_backend": BACKEND}
+    return {name: str(v) for name, v in versions.items()}  # torch's version is a str subclass
+
+
+def run_label(env_id: str, mode: str, substeps: int, seed: int) -> str:
+    """``oneballtarget-posteriori4-s0``: what a run folder's name starts with."""
+    name = env_id.split("/")[-1].rsplit("-v", 1)[0].lower()
+    knob = f"{mode}{substeps}" if substeps != 1 else mode
+    return f"{name}-{knob}-s{seed}"
+
+
+def default_run_name(env_id: str, mode: str, substeps: int, seed: int) -> str:
+    return f"{run_label(env_id, mode, substeps, seed)}-{time.strftime('%Y%m%d-%H%M%S')}"
+
+
+def train(env_id: str, *, timesteps: float | None = None, n_envs: int | None = None, seed: int = 0,
+          mode: str | None = None, substeps: int | None = None, env_kwargs: dict | None = None,
+          output: str | Path = "runs", run_name: str | None = None, hyperparams: str | Path = HYPERPARAMS,
+          vec_env: str = "native", eval_freq: int = 50_000, eval_episodes: int = 20, save_freq: int = 250_000,
+          progress: bool = False, threads: int = 1, overwrite: bool = False, verbose: int = 0,
+          log=print) -> Path:
+    """Train PPO on ``env_id`` and write the run folder; returns its path.
+
+    ``mode``/``substeps`` set the engine's fidelity (they override ``env_kwargs``, which override
+    the hyperparameter entry's ``env_kwargs``). ``eval_freq`` / ``save_freq`` are in env steps;
+    0 turns the EvalCallback / CheckpointCallback off.
+    """
+    check_env_id(env_id)
+    if vec_env not in VEC_ENVS:
+        raise UsageError(f"--vec-env: expected one of {VEC_ENVS}, got {vec_env!r}")
+    hp = hyperparams_for(env_id, hyperparams)
+    n_envs = as_positive_int("n_envs", n_envs if n_envs is not None else hp.get("n_envs", 8))
+    timesteps = as_positive_int("timesteps", timesteps if timesteps is not None else hp.get("n_timesteps", 1e6))
+    kwargs = {**(hp.get("env_kwargs") or {}), **(env_kwargs or {})}
+    if mode is not None:
+        kwargs["mode"] = mode
+    if substeps is not None:
+        kwargs["substeps"] = substeps
+    steps = episode_steps(env_id, kwargs)  # validates every env kwarg before anything is written
+    mode = kwargs.get("mode", "exact")
+    substeps = int(kwargs.get("substeps", 1))
+    norm = normalize_settings(hp.get("normalize"))
+    algo_kwargs = ppo_kwargs(hp)
+    policy = hp.get("policy", "MlpPolicy")
+
+    run_dir = Path(output) / (run_name or default_run_name(env_id, mode, substeps, seed))
+    if run_dir.exists() and any(run_dir.iterdir()) and not overwrite:
+        raise UsageError(f"run folder {run_dir} exists and is not empty (pass --overwrite to reuse it)")
+    run_dir.mkdir(parents=True, exist_ok=True)
+
+    import torch
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.callbacks import CheckpointCallback, EvalCallback
+
+    torch.set_num_threads(threads)
+    config = {
+        "env_id": env_id, "env_kwargs": kwargs, "episode_steps": steps, "seed": seed, "n_envs": n_envs,
+        "n_timesteps": timesteps, "vec_env": vec_env,
+        "hyperparams": {**hp, "n_envs": n_envs, "n_timesteps": timesteps, "env_kwargs": dict(kwargs)},
+        "hyperparams_file": str(hyperparams), "versions": _versions(),
+    }
+    write_yaml(run_dir / CONFIG_FILE, config)
+
+    gamma = float(algo_kwargs.get("gamma", 0.99))
+    venv = _wrap_normalize(make_vec_env(env_id, n_envs, seed, kwargs, vec_env, monitor_dir=run_dir), norm, gamma,
+                           training=True)
+    callbacks = []
+    eval_env = None
+    if eval_freq:
+        eval_envs = min(eval_episodes, 4)
+        eval_env = _wrap_normalize(make_vec_env(env_id, eval_envs, seed + EVAL_SEED_OFFSET, kwargs, vec_env), norm,
+                                   gamma, training=False)
+        callbacks.append(EvalCallback(eval_env, n_eval_episodes=eval_episodes, eval_freq=max(eval_freq // n_envs, 1),
+                                      best_model_save_path=str(run_dir), log_path=str(run_dir / "eval"),
+                                      deterministic=True, verbose=0))
+    if save_freq:
+        callbacks.append(CheckpointCallback(save_freq=max(save_freq // n_envs, 1),
+                                            save_path=str(run_dir / "checkpoints"), name_prefix="model",
+                                            save_vecnormalize=norm is not None))
+    model = PPO(policy, venv, seed=seed, device="cpu", tensorboard_log=str(run_dir / "tb"), verbose=verbose,
+                **algo_kwargs)
+    log(f"training PPO on {env_id} (mode={mode}, substeps={substeps}) for {timesteps:,} steps, "
+        f"{n_envs} envs ({vec_env}), seed {seed} -> {run_dir}")
+    start = time.perf_counter()
+    model.learn(total_timesteps=timesteps, callback=callbacks, progress_bar=progress, tb_log_name="ppo")
+    seconds = time.perf_counter() - start
+    model.save(run_dir / MODEL_FILE)
+    if norm is not None:
+        venv.save(str(run_dir / VECNORMALIZE_FILE))
+    config["train_seconds"] = round(seconds, 2)
+    config["timesteps_done"] = int(model.num_timesteps)
+    write_yaml(run_dir / CONFIG_FILE, config)
+    venv.close()
+    if eval_env is not None:
+        eval_env.close()
+    log(f"trained {model.num_timesteps:,} steps in {seconds:.0f} s ({model.num_timesteps / seconds:,.0f} steps/s)")
+    return run_dir
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python -m agents.train_ppo", description=__doc__.split("\n\n")[0],
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--env", default="CollisionEnv/OneBallTarget-v0", help="registered env id (default: %(default)s)")
+    p.add_argument("--timesteps", type=float, help="total env steps (default: the entry's n_timesteps)")
+    p.add_argument("--n-envs", type=int, help="parallel sub-envs (default: the entry's n_envs)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--mode", choices=("exact", "posteriori", "naive"), help="engine fidelity mode (default: exact)")
+    p.add_argument("--substeps", type=int, help="sub-steps per control step for naive/posteriori")
+    p.add_argument("--env-kwargs", nargs="*", metavar="KEY=VALUE", help="more env keywords, e.g. dt=0.1")
+    p.add_argument("--output", default="runs", help="folder for run folders (default: %(default)s)")
+    p.add_argument("--run-name", help="run folder name (default: <env>-<mode>-s<seed>-<time>)")
+    p.add_argument("--overwrite", action="store_true", help="reuse an existing run folder")
+    p.add_argument("--hyperparams", default=str(HYPERPARAMS), help="hyperparameter YAML (default: the shipped one)")
+    p.add_argument("--vec-env", choices=VEC_ENVS, default="native",
+                   help="native batched env (default), or SB3's dummy/subproc over gym.make")
+    p.add_argument("--eval-freq", type=int, default=50_000, help="env steps between evaluations (0: none)")
+    p.add_argument("--eval-episodes", type=int, default=20)
+    p.add_argument("--save-freq", type=int, default=250_000, help="env steps between checkpoints (0: none)")
+    p.add_argument("--threads", type=int, default=1, help="torch threads (default: %(default)s)")
+    bar = p.add_mutually_exclusive_group()
+    bar.add_argument("--progress", dest="progress", action="store_true", default=None, help="progress bar")
+    bar.add_argument("--no-progress", dest="progress", action="store_false")
+    p.add_argument("-v", "--verbose", type=int, default=0, help="SB3 verbosity (1: print training statistics)")
+    return p
+
+
+def main(argv: list[str] | None = None) -> Path:
+    args = build_parser().parse_args(argv)
+    progress = sys.stdout.isatty() if args.progress is None else args.progress
+    run_dir = train(args.env, timesteps=args.timesteps, n_envs=args.n_envs, seed=args.seed, mode=args.mode,
+                    substeps=args.substeps, env_kwargs=parse_env_kwargs(args.env_kwargs), output=args.output,
+                    run_name=args.run_name, hyperparams=args.hyperparams, vec_env=args.vec_env,
+                    eval_freq=args.eval_freq, eval_episodes=args.eval_episodes, save_freq=args.save_freq,
+                    progress=progress, threads=args.threads, overwrite=args.overwrite, verbose=args.verbose)
+    print(f"model:       {run_dir / MODEL_FILE}")
+    print(f"config:      {run_dir / CONFIG_FILE}")
+    print(f"tensorboard: tensorboard --logdir {run_dir / 'tb'}")
+    print(f"evaluate:    python -m agents.evaluate {run_dir}")
+    return run_dir
+
+
+if __name__ == "__main__":
+    run_cli(main, prog="train_ppo")

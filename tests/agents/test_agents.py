@@ -1,0 +1,176 @@
+"""The sample agents: hyperparameter file, train -> save -> reload -> evaluate, the main job, the study, bad input."""
+
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("stable_baselines3")
+pytest.importorskip("yaml")
+
+import collision_env  # noqa: E402
+from agents import config, evaluate, study, train_ppo  # noqa: E402
+from agents import main as main_job  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+TINY = ["--timesteps", "2048", "--n-envs", "4", "--no-progress"]
+
+
+def _finite(results):
+    for name, r in results["policies"].items():
+        if r is None:
+            continue
+        for key in ("success_rate", "mean_return", "mean_nudge", "mean_nudge_cost", "mean_targets_hit", "mean_length"):
+            assert math.isfinite(r[key]), (name, key)
+        assert 0.0 <= r["success_rate"] <= 1.0 and r["mean_nudge"] >= 0.0
+        lo, hi = r["success_ci95"]
+        assert 0.0 <= lo <= r["success_rate"] <= hi <= 1.0
+
+
+# --------------------------------------------------------------------------------- hyperparameters
+@pytest.mark.parametrize("env_id", collision_env.ENV_IDS)
+def test_hyperparams_have_a_tuned_entry_that_builds_ppo_for_every_id(env_id):
+    from stable_baselines3 import PPO
+
+    raw = config.load_yaml(config.HYPERPARAMS)
+    assert env_id in raw  # an entry of its own, not just the default
+    hp = config.hyperparams_for(env_id)
+    assert hp["n_timesteps"] >= 1e5 and hp["n_envs"] >= 1
+    kwargs = config.ppo_kwargs(hp)
+    assert set(kwargs).isdisjoint(config.RUN_KEYS)
+    venv = train_ppo.make_vec_env(env_id, hp["n_envs"], 0, hp.get("env_kwargs") or {})
+    model = PPO(hp["policy"], venv, device="cpu", **kwargs)
+    assert model.n_steps == hp["n_steps"] and model.batch_size == hp["batch_size"]
+    assert config.normalize_settings(hp["normalize"]) is not None
+    venv.close()
+
+
+def test_rl_zoo_style_values_are_understood():
+    import torch.nn as nn
+
+    sched = config.ppo_kwargs({"learning_rate": "lin_0.001", "clip_range": 0.2})
+    assert sched["learning_rate"](1.0) == pytest.approx(1e-3) and sched["learning_rate"](0.25) == pytest.approx(2.5e-4)
+    pk = config.ppo_kwargs({"policy_kwargs": "dict(net_arch=[32], activation_fn=nn.ReLU)"})["policy_kwargs"]
+    assert pk == {"net_arch": [32], "activation_fn": nn.ReLU}
+    assert config.ppo_kwargs({"policy_kwargs": {"activation_fn": "tanh"}})["policy_kwargs"]["activation_fn"] is nn.Tanh
+    assert config.normalize_settings("{'norm_obs': True, 'norm_reward': False}") == {"norm_obs": True,
+                                                                                      "norm_reward": False}
+    assert config.normalize_settings(False) is None
+    assert config.parse_env_kwargs(["mode=naive", "dt=0.1", "substeps=4"]) == {"mode": "naive", "dt": 0.1,
+                                                                               "substeps": 4}
+    for bad in ({"learning_rate": "lin_x"}, {"policy_kwargs": "open('x')"}, {"policy_kwargs": {"activation_fn": "no"}}):
+        with pytest.raises(config.UsageError):
+            config.ppo_kwargs(bad)
+
+
+def test_native_and_sb3_vector_envs_start_the_same_episodes():
+    kwargs = {"mode": "posteriori", "substeps": 2, "dt": 0.1}
+    native = train_ppo.make_vec_env("CollisionEnv/Billiards-v0", 3, 5, kwargs, "native")
+    dummy = train_ppo.make_vec_env("CollisionEnv/Billiards-v0", 3, 5, kwargs, "dummy")
+    assert np.array_equal(native.reset(), dummy.reset())
+    actions = np.full((3, 2), 0.5, np.float32)
+    for _ in range(5):
+        assert np.array_equal(native.step(actions)[0], dummy.step(actions)[0])
+
+
+# --------------------------------------------------------------------------- train, save, evaluate
+def test_train_save_reload_evaluate_and_record(tmp_path):
+    run = train_ppo.main(TINY + ["--output", str(tmp_path), "--run-name", "smoke", "--eval-freq", "1024",
+                                 "--save-freq", "1024", "--eval-episodes", "2", "--env-kwargs", "time_limit=2.0"])
+    files = ("config.yml", "model.zip", "vecnormalize.pkl", "best_model.zip", "monitor.csv", "eval/evaluations.npz")
+    for name in files:
+        assert (run / name).is_file(), name
+    assert list((run / "checkpoints").glob("model_*_steps.zip")) and list((run / "tb").rglob("events.out.tfevents.*"))
+    cfg = config.read_run(run)
+    assert cfg["env_id"] == "CollisionEnv/OneBallTarget-v0" and cfg["timesteps_done"] >= 2048
+    assert cfg["env_kwargs"] == {"time_limit": 2.0} and cfg["episode_steps"] == 40 and cfg["train_seconds"] > 0
+
+    results = evaluate.main([str(run), "--episodes", "3", "--gif"])
+    _finite(results)
+    assert set(results["policies"]) == {"ppo", "random", "scripted"}
+    assert results["mode"] == "exact" and results["policies"]["ppo"]["mean_length"] <= 40
+    assert json.loads((run / "eval-exact.json").read_text())["episodes"] == 3
+    assert (run / "episodes.gif").stat().st_size > 1000
+
+    # the same policy under another engine mode (train in one, evaluate in another)
+    other = evaluate.evaluate(run, episodes=2, mode="posteriori", substeps=4, baselines=())
+    assert (other["mode"], other["substeps"], other["train_mode"]) == ("posteriori", 4, "exact")
+    _finite(other)
+    # deterministic: the same episodes give the same figures
+    again = evaluate.evaluate(run, episodes=3, baselines=())
+    assert again["policies"]["ppo"]["mean_return"] == results["policies"]["ppo"]["mean_return"]
+
+
+def test_record_mp4(tmp_path):
+    pytest.importorskip("imageio_ffmpeg")
+    run = train_ppo.main(TINY + ["--output", str(tmp_path), "--run-name", "r", "--eval-freq", "0", "--save-freq", "0",
+                                 "--env-kwargs", "time_limit=1.0"])
+    path = evaluate.record(run, tmp_path / "ep.mp4", episodes=2)
+    assert path.stat().st_size > 1000
+
+
+def test_training_on_sb3_dummy_vec_env_and_other_mode(tmp_path):
+    run = train_ppo.train("CollisionEnv/Line1D-v0", timesteps=1024, n_envs=4, mode="naive", substeps=2,
+                          output=tmp_path, run_name="d", vec_env="dummy", eval_freq=0, save_freq=0, log=lambda *a: None)
+    cfg = config.read_run(run)
+    assert cfg["env_kwargs"] == {"mode": "naive", "substeps": 2} and cfg["vec_env"] == "dummy"
+    _finite(evaluate.evaluate(run, episodes=2, mode="exact"))
+
+
+def test_main_job_trains_evaluates_and_records(tmp_path, capsys):
+    run = main_job.main(["--timesteps", "2048", "--episodes", "2", "--output", str(tmp_path), "--no-progress"])
+    out = capsys.readouterr().out
+    for path in (run / "model.zip", run / "episodes.gif", run / "eval-exact.json"):
+        assert path.is_file() and str(path) in out
+    assert "| random |" in out and "| scripted (exact aim) |" in out and "tensorboard --logdir" in out
+
+
+def test_study_writes_tables_plot_and_readme_block(tmp_path):
+    readme = tmp_path / "README.md"
+    readme.write_text("x\n<!-- agents:study:start -->\nold\n<!-- agents:study:end -->\ny\n")
+    docs = tmp_path / "docs"
+    data = study.main(["--envs", "CollisionEnv/OneBallTarget-v0", "--modes", "naive:1", "exact:1", "--seeds", "0", "1",
+                       "--presets", "CollisionEnv/Line1D-v0", "CollisionEnv/OneBallTarget-v0", "--timesteps", "1024",
+                       "--episodes", "2", "--output", str(tmp_path / "runs"), "--docs", str(docs),
+                       "--readme", str(readme)])
+    modes = [r for r in data["rows"] if r["part"] == "modes"]
+    assert {(r["mode"], r["seed"]) for r in modes} == {("naive", 0), ("naive", 1), ("exact", 0), ("exact", 1)}
+    presets = {r["env_id"] for r in data["rows"] if r["part"] == "presets"}
+    assert presets == {"CollisionEnv/Line1D-v0", "CollisionEnv/OneBallTarget-v0"}  # exact runs shared
+    for name in ("study.json", "modes.md", "presets.md", "modes.png"):
+        assert (docs / name).is_file(), name
+    text = readme.read_text()
+    assert "old" not in text and "| naive k=1 |" in text and "`CollisionEnv/Line1D-v0`" in text
+    assert text.startswith("x\n") and text.endswith("y\n")
+    # --render rebuilds the same tables from the JSON alone
+    before = (docs / "modes.md").read_text()
+    (docs / "modes.md").unlink()
+    study.main(["--render", "--docs", str(docs)])
+    assert (docs / "modes.md").read_text() == before
+
+
+# --------------------------------------------------------------------------------------- bad input
+@pytest.mark.parametrize("module, args, message", [
+    ("agents.train_ppo", ["--env", "CollisionEnv/OneBalTarget-v0"], "unknown env id"),
+    ("agents.train_ppo", ["--env-kwargs", "elasticity=2"], "elasticity"),
+    ("agents.evaluate", ["/no/such/run"], "run folder not found"),
+    ("agents.main", ["--env", "Nope-v0"], "unknown env id"),
+])
+def test_bad_input_is_a_one_line_error_without_traceback(module, args, message):
+    proc = subprocess.run([sys.executable, "-m", module, *args], capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert proc.returncode == 2
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0] and "Traceback" not in proc.stderr
+
+
+def test_a_folder_that_is_not_a_run_is_rejected(tmp_path):
+    with pytest.raises(config.UsageError, match="not a training run folder"):
+        evaluate.evaluate(tmp_path)
+    with pytest.raises(config.UsageError, match="exists and is not empty"):
+        (tmp_path / "x").mkdir()
+        (tmp_path / "x" / "f").write_text("")
+        train_ppo.train("CollisionEnv/OneBallTarget-v0", timesteps=10, output=tmp_path, run_name="x")
