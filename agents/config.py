@@ -31,7 +31,7 @@ class UsageError(Exception):
 
 
 def run_cli(main: Callable[[list[str] | None], Any], argv: list[str] | None = None, prog: str = "agents") -> Any:
-    """Run ``main(argv)``; a :class:`UsageError` (or a bad env argument) becomes a one-line error, exit 2."""
+    """Run ``main(argv)``; a :class:`UsageError` becomes one line on stderr and exit status 2."""
     try:
         return main(argv)
     except UsageError as err:
@@ -41,16 +41,25 @@ def run_cli(main: Callable[[list[str] | None], Any], argv: list[str] | None = No
 
 # --------------------------------------------------------------------------------------- env ids
 def check_env_id(env_id: str) -> str:
-    """``env_id`` if Gymnasium knows it (after ``import collision_env``), else a UsageError."""
-    import gymnasium as gym
-
+    """``env_id`` if it is one of collision_env's registered ids, else a UsageError."""
     import collision_env
 
-    if env_id in gym.registry:
+    if env_id in collision_env.ENV_IDS:
         return env_id
-    close = difflib.get_close_matches(env_id, collision_env.ENV_IDS, n=1, cutoff=0.4)
+    close = difflib.get_close_matches(str(env_id), collision_env.ENV_IDS, n=1, cutoff=0.4)
     hint = f"; did you mean {close[0]!r}?" if close else ""
     raise UsageError(f"unknown env id {env_id!r}{hint} (registered: {', '.join(collision_env.ENV_IDS)})")
+
+
+#: gym.make keywords the agent scripts set themselves (not task fields).
+RESERVED_ENV_KWARGS = ("render_mode", "max_episode_steps", "disable_env_checker")
+
+
+def check_env_kwargs(env_kwargs: dict) -> dict:
+    clash = sorted(set(env_kwargs) & set(RESERVED_ENV_KWARGS))
+    if clash:
+        raise UsageError(f"env kwargs: {', '.join(clash)} cannot be set here (the agent scripts set them)")
+    return env_kwargs
 
 
 def parse_env_kwargs(pairs: list[str] | None) -> dict:
@@ -60,16 +69,22 @@ def parse_env_kwargs(pairs: list[str] | None) -> dict:
     out = {}
     for pair in pairs or []:
         key, sep, value = pair.partition("=")
-        if not sep or not key:
+        if not sep or not key.strip():
             raise UsageError(f"--env-kwargs: expected key=value, got {pair!r}")
-        out[key.strip()] = yaml.safe_load(value)
-    return out
+        try:
+            out[key.strip()] = yaml.safe_load(value)
+        except yaml.YAMLError:
+            raise UsageError(f"--env-kwargs: cannot read the value of {pair!r}") from None
+    return check_env_kwargs(out)
 
 
 def episode_steps(env_id: str, env_kwargs: dict) -> int:
     """Control steps per episode of ``env_id`` under ``env_kwargs`` (validates the kwargs)."""
     import gymnasium as gym
 
+    import collision_env  # noqa: F401  (registers the ids)
+
+    check_env_kwargs(env_kwargs)
     try:
         env = gym.make(env_id, **env_kwargs)
     except (TypeError, ValueError) as err:
@@ -87,20 +102,31 @@ def load_yaml(path: str | Path) -> dict:
     path = Path(path)
     if not path.is_file():
         raise UsageError(f"no such file: {path}")
-    with path.open() as fh:
-        data = yaml.safe_load(fh)
+    try:
+        with path.open() as fh:
+            data = yaml.safe_load(fh)
+    except yaml.YAMLError as err:
+        where = getattr(err, "problem_mark", None)
+        raise UsageError(f"{path}: not valid YAML{f' (line {where.line + 1})' if where else ''}") from None
     if not isinstance(data, dict):
         raise UsageError(f"{path}: expected a mapping of env ids to hyperparameters")
     return data
 
 
+def is_run_config(data: dict) -> bool:
+    """Is this mapping a run folder's resolved ``config.yml`` (rather than a hyperparameter file)?"""
+    return isinstance(data.get("hyperparams"), dict) and "env_id" in data
+
+
 def hyperparams_for(env_id: str, path: str | Path = HYPERPARAMS) -> dict:
     """The entry of ``env_id`` in the file at ``path`` (or its ``default``), as a fresh dict.
 
-    A run folder's ``config.yml`` is accepted too: its ``hyperparams`` are used whatever the id.
+    A run folder's ``config.yml`` is accepted too, for its own env id only.
     """
     data = load_yaml(path)
-    if "hyperparams" in data and "env_id" in data:  # a run folder's resolved config
+    if is_run_config(data):
+        if data["env_id"] != env_id:
+            raise UsageError(f"{path} is the config of a {data['env_id']} run, not of {env_id}")
         entry = data["hyperparams"]
     elif env_id in data:
         entry = data[env_id]
@@ -128,6 +154,11 @@ def _schedule_or_number(key: str, value: Any):
             return linear_schedule(float(value[4:]))
         except ValueError:
             raise UsageError(f"{key}: bad schedule {value!r} (expected lin_<number>)") from None
+    if isinstance(value, str):
+        try:  # YAML 1.1 reads 3e-4 (no dot) as a string
+            return float(value)
+        except ValueError:
+            pass
     return value
 
 
@@ -168,11 +199,31 @@ def normalize_settings(value: Any) -> dict | None:
         return {"norm_obs": True, "norm_reward": True}
     if not isinstance(value, dict):
         raise UsageError(f"normalize: expected true/false or a mapping, got {value!r}")
+    allowed = ("norm_obs", "norm_reward", "clip_obs", "clip_reward", "epsilon")
+    unknown = sorted(set(value) - set(allowed))
+    if unknown:
+        raise UsageError(f"normalize: unknown key(s) {unknown}; VecNormalize takes {list(allowed)}")
     return dict(value)
 
 
 def ppo_kwargs(hp: dict) -> dict:
-    """PPO's keyword arguments from a hyperparameter entry (schedules and policy_kwargs resolved)."""
+    """PPO's keyword arguments from a hyperparameter entry (schedules and policy_kwargs resolved).
+
+    Unknown keys are a UsageError, so a typo in the file fails before any training starts.
+    """
+    import inspect
+
+    from stable_baselines3 import PPO
+
+    known = set(inspect.signature(PPO.__init__).parameters) - {"self", "policy", "env", "seed", "device",
+                                                                "tensorboard_log", "verbose", "_init_setup_model"}
+    unknown = sorted(set(hp) - known - set(RUN_KEYS))
+    if unknown:
+        raise UsageError(f"hyperparameters: unknown key(s) {unknown}; PPO takes {sorted(known)} "
+                         f"and the file also {list(RUN_KEYS)}")
+    policy = hp.get("policy", "MlpPolicy")
+    if policy not in PPO.policy_aliases:
+        raise UsageError(f"policy: expected one of {sorted(PPO.policy_aliases)}, got {policy!r}")
     out = {}
     for key, value in hp.items():
         if key in RUN_KEYS:
@@ -184,14 +235,28 @@ def ppo_kwargs(hp: dict) -> dict:
     return out
 
 
-def as_positive_int(name: str, value: Any) -> int:
+def as_int(name: str, value: Any, low: int = 1) -> int:
+    """``value`` as an int >= ``low`` (floats such as 1e6 allowed when whole), else a UsageError."""
+    what = "a positive integer" if low == 1 else f"an integer >= {low}"
     try:
         number = float(value)
     except (TypeError, ValueError):
-        raise UsageError(f"{name}: expected a positive integer, got {value!r}") from None
-    if not math.isfinite(number) or number < 1 or number != int(number):
-        raise UsageError(f"{name}: expected a positive integer, got {value!r}")
+        raise UsageError(f"{name}: expected {what}, got {value!r}") from None
+    if not math.isfinite(number) or number < low or number != int(number):
+        raise UsageError(f"{name}: expected {what}, got {value!r}")
     return int(number)
+
+
+def add_progress_flags(parser) -> None:
+    """``--progress`` / ``--no-progress`` (default: a progress bar when stdout is a terminal)."""
+    bar = parser.add_mutually_exclusive_group()
+    bar.add_argument("--progress", dest="progress", action="store_true", default=None,
+                     help="show SB3's progress bar (default: when stdout is a terminal)")
+    bar.add_argument("--no-progress", dest="progress", action="store_false")
+
+
+def wants_progress(flag: bool | None) -> bool:
+    return sys.stdout.isatty() if flag is None else flag
 
 
 # ----------------------------------------------------------------------------------- run folders
@@ -202,7 +267,10 @@ def read_run(run_dir: str | Path) -> dict:
         raise UsageError(f"run folder not found: {run_dir}")
     if not (run_dir / CONFIG_FILE).is_file() or not (run_dir / MODEL_FILE).is_file():
         raise UsageError(f"{run_dir} is not a training run folder (it needs {CONFIG_FILE} and {MODEL_FILE})")
-    return load_yaml(run_dir / CONFIG_FILE)
+    data = load_yaml(run_dir / CONFIG_FILE)
+    if not is_run_config(data):
+        raise UsageError(f"{run_dir / CONFIG_FILE} is not a run config (no env_id or hyperparams)")
+    return data
 
 
 def write_yaml(path: Path, data: dict) -> None:

@@ -11,7 +11,10 @@ episode) and a **scripted** policy that aims with the engine's exact prediction
 (``collision_env.envs.scripted``; not every task has one). Reported per policy: success rate (with a
 95 % Wilson interval), mean return, mean nudge (the requested velocity change summed over the
 episode, m/s) and its cost in reward units, mean targets hit and mean episode length. The table is
-printed and written as JSON to ``<run>/eval-<mode>.json`` (or ``--json``).
+printed and written as JSON to ``<run>/eval-<mode>[<substeps>].json`` (or ``--json``).
+
+The scripted baseline predicts with the engine it plays in: under ``--mode naive`` it aims with
+naive mode's (wrong) impacts, which is part of what such an evaluation measures.
 """
 
 from __future__ import annotations
@@ -29,15 +32,17 @@ from agents.config import (
     MODEL_FILE,
     VECNORMALIZE_FILE,
     UsageError,
-    as_positive_int,
+    as_int,
     check_env_id,
     episode_steps,
+    normalize_settings,
     read_run,
     run_cli,
 )
 
 EVAL_SEED = 1_000_000  # evaluation episodes start far from the training and EvalCallback seeds
 BASELINES = ("random", "scripted")
+SCRIPTED_LABEL = "scripted (aims with the engine's prediction)"
 
 #: A policy factory: called after each reset with (unwrapped env, episode index); returns obs -> action.
 PolicyFactory = Callable[[object, int], Callable[[np.ndarray], np.ndarray]]
@@ -57,24 +62,30 @@ def wilson_interval(successes: int, n: int, z: float = 1.96) -> tuple[float, flo
 def trained_policy(run_dir: str | Path, which: str = "final") -> PolicyFactory:
     """The run's PPO policy (``final`` = model.zip, ``best`` = EvalCallback's best_model.zip), deterministic.
 
-    Observations pass through the run's VecNormalize statistics when it normalised observations.
+    When the run normalised observations, they pass through the VecNormalize statistics saved with
+    that model (``vecnormalize.pkl``, or ``best_vecnormalize.pkl`` for the best model).
     """
     from stable_baselines3 import PPO
 
+    from agents.train_ppo import BEST_VECNORMALIZE_FILE
+
     run_dir = Path(run_dir)
-    path = run_dir / (MODEL_FILE if which == "final" else "best_model.zip")
-    if not path.is_file():
-        raise UsageError(f"{path} not found")
-    model = PPO.load(path, device="cpu")
+    run = read_run(run_dir)
+    model_path = run_dir / (MODEL_FILE if which == "final" else "best_model.zip")
+    if not model_path.is_file():
+        raise UsageError(f"{model_path} not found")
+    model = PPO.load(model_path, device="cpu")
     obs_rms, clip, eps = None, None, None
-    stats = run_dir / VECNORMALIZE_FILE
-    if stats.is_file():
+    norm = normalize_settings(run["hyperparams"].get("normalize"))
+    if norm is not None and norm.get("norm_obs", True):
+        stats = run_dir / (VECNORMALIZE_FILE if which == "final" else BEST_VECNORMALIZE_FILE)
+        if not stats.is_file():
+            raise UsageError(f"{stats} not found: the run normalised observations and needs its statistics")
         import pickle
 
         with stats.open("rb") as fh:
             vecnorm = pickle.load(fh)  # VecNormalize.save pickles the wrapper without its venv
-        if vecnorm.norm_obs:
-            obs_rms, clip, eps = vecnorm.obs_rms, vecnorm.clip_obs, vecnorm.epsilon
+        obs_rms, clip, eps = vecnorm.obs_rms, vecnorm.clip_obs, vecnorm.epsilon
 
     def factory(env, episode):
         def act(obs):
@@ -98,17 +109,14 @@ def random_policy(seed: int = 0) -> PolicyFactory:
     return factory
 
 
-def scripted_baseline() -> PolicyFactory | None:
-    """The task's scripted exact-aiming policy (``collision_env.envs.scripted.scripted_policy``)."""
+def scripted_baseline(env) -> PolicyFactory | None:
+    """The task's scripted aiming policy (``collision_env.envs.scripted.scripted_policy``), or None
+    if the task of ``env`` has none."""
     from collision_env.envs.scripted import scripted_policy
 
-    def factory(env, episode):
-        policy = scripted_policy(env)
-        if policy is None:
-            raise LookupError("no scripted policy for this task")
-        return policy
-
-    return factory
+    if scripted_policy(env.unwrapped) is None:
+        return None
+    return lambda env, episode: scripted_policy(env)
 
 
 # ---------------------------------------------------------------------------------------- play
@@ -154,40 +162,50 @@ def make_env(env_id: str, env_kwargs: dict, render_mode: str | None = None):
 
 
 def eval_kwargs(run: dict, mode: str | None, substeps: int | None) -> dict:
-    """The run's env kwargs with the engine mode replaced (a new mode starts from substeps = 1)."""
+    """The run's env kwargs with the engine mode replaced (another mode starts from substeps = 1)."""
     kwargs = dict(run.get("env_kwargs") or {})
-    if mode is not None:
+    if mode is not None and mode != kwargs.get("mode", "exact"):
         kwargs["mode"] = mode
-        kwargs["substeps"] = 1 if substeps is None else substeps
-    elif substeps is not None:
+        kwargs["substeps"] = 1
+    if substeps is not None:
         kwargs["substeps"] = substeps
     return kwargs
 
 
 def evaluate(run_dir: str | Path, *, episodes: int = 100, mode: str | None = None, substeps: int | None = None,
-             seed: int = EVAL_SEED, baselines: tuple = BASELINES, model: str = "final", log=print) -> dict:
+             seed: int = EVAL_SEED, baselines: tuple = BASELINES, model: str = "final") -> dict:
     """Evaluate the run (and the baselines) on the same episodes; returns the results dict."""
     run = read_run(run_dir)
     env_id = check_env_id(run["env_id"])
-    episodes = as_positive_int("episodes", episodes)
+    episodes = as_int("episodes", episodes)
+    seed = as_int("seed", seed, low=0)
     kwargs = eval_kwargs(run, mode, substeps)
     env = make_env(env_id, kwargs)
     policies = {"ppo": trained_policy(run_dir, model)}
     if "random" in baselines:
         policies["random"] = random_policy(seed)
     if "scripted" in baselines:
-        policies["scripted"] = scripted_baseline()
+        policies["scripted"] = scripted_baseline(env)
     trained = run.get("env_kwargs") or {}
     results = {"env_id": env_id, "run": str(run_dir), "model": model, "train_mode": trained.get("mode", "exact"),
                "train_substeps": int(trained.get("substeps", 1)), "mode": kwargs.get("mode", "exact"),
                "substeps": int(kwargs.get("substeps", 1)), "episodes": episodes, "seed": seed, "policies": {}}
     for name, factory in policies.items():
-        try:
-            results["policies"][name] = play(env, factory, episodes, seed)
-        except LookupError:
-            results["policies"][name] = None  # this task has no scripted policy
+        results["policies"][name] = None if factory is None else play(env, factory, episodes, seed)
     env.close()
     return results
+
+
+def check_video_path(path: str | Path) -> Path:
+    path = Path(path)
+    if path.suffix.lower() not in (".gif", ".mp4"):
+        raise UsageError(f"video: expected a .gif or .mp4 path, got {path}")
+    if path.suffix.lower() == ".mp4":
+        import importlib.util
+
+        if importlib.util.find_spec("imageio_ffmpeg") is None:
+            raise UsageError("writing MP4 needs imageio-ffmpeg (the 'video' extra); a .gif needs nothing more")
+    return path
 
 
 def record(run_dir: str | Path, path: str | Path, *, episodes: int = 1, mode: str | None = None,
@@ -196,9 +214,8 @@ def record(run_dir: str | Path, path: str | Path, *, episodes: int = 1, mode: st
     import imageio.v2 as imageio
 
     run = read_run(run_dir)
-    path = Path(path)
-    if path.suffix.lower() not in (".gif", ".mp4"):
-        raise UsageError(f"video: expected a .gif or .mp4 path, got {path}")
+    path = check_video_path(path)
+    episodes = as_int("record episodes", episodes)
     env = make_env(check_env_id(run["env_id"]), eval_kwargs(run, mode, substeps), render_mode="rgb_array")
     frames: list = []
     play(env, trained_policy(run_dir, model), episodes, seed, frames=frames)
@@ -208,15 +225,12 @@ def record(run_dir: str | Path, path: str | Path, *, episodes: int = 1, mode: st
     if path.suffix.lower() == ".gif":
         imageio.mimsave(path, frames, duration=1000.0 / fps, loop=0)
     else:
-        try:
-            imageio.mimsave(path, frames, fps=fps, macro_block_size=1)
-        except (ImportError, ValueError) as err:
-            raise UsageError(f"writing MP4 needs imageio-ffmpeg (the 'video' extra): {err}") from None
+        imageio.mimsave(path, frames, fps=fps, macro_block_size=1)
     return path
 
 
 # ----------------------------------------------------------------------------------------- report
-def _pct(x: float) -> str:
+def pct(x: float) -> str:
     return f"{100 * x:.0f} %"
 
 
@@ -229,13 +243,13 @@ def markdown(results: dict) -> str:
              "",
              "| policy | success (95 % CI) | mean return | mean nudge (m/s) | nudge cost | targets hit | steps |",
              "|---|---:|---:|---:|---:|---:|---:|"]
-    names = {"ppo": "PPO (this run, deterministic)", "random": "random", "scripted": "scripted (exact aim)"}
+    names = {"ppo": "PPO (this run, deterministic)", "random": "random", "scripted": SCRIPTED_LABEL}
     for key, r in results["policies"].items():
         if r is None:
             lines.append(f"| {names.get(key, key)} | n/a | | | | | |")
             continue
         lo, hi = r["success_ci95"]
-        lines.append(f"| {names.get(key, key)} | {_pct(r['success_rate'])} ({_pct(lo)}–{_pct(hi)}) | "
+        lines.append(f"| {names.get(key, key)} | {pct(r['success_rate'])} ({pct(lo)}–{pct(hi)}) | "
                      f"{r['mean_return']:.3f} | {r['mean_nudge']:.2f} | {r['mean_nudge_cost']:.3f} | "
                      f"{r['mean_targets_hit']:.2f} | {r['mean_length']:.0f} |")
     return "\n".join(lines)
@@ -260,15 +274,20 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> dict:
     args = build_parser().parse_args(argv)
+    videos = ([args.video] if args.video else []) + ([args.gif or Path(args.run) / "episodes.gif"]
+                                                     if args.gif is not None else [])
+    for video in videos:  # fail on a bad path before the evaluation, not after it
+        check_video_path(video)
+    as_int("record episodes", args.record_episodes)
     results = evaluate(args.run, episodes=args.episodes, mode=args.mode, substeps=args.substeps, seed=args.seed,
                        baselines=() if args.no_baselines else BASELINES, model=args.model)
     print(markdown(results))
     suffix = results["mode"] + (str(results["substeps"]) if results["substeps"] != 1 else "")
     out = Path(args.json) if args.json else Path(args.run) / f"eval-{suffix}.json"
+    out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(results, indent=1))
     print(f"results: {out}")
-    for video in ([args.video] if args.video else []) + ([args.gif or Path(args.run) / "episodes.gif"]
-                                                        if args.gif is not None else []):
+    for video in videos:
         path = record(args.run, video, episodes=args.record_episodes, mode=args.mode, substeps=args.substeps,
                       seed=args.seed, model=args.model)
         print(f"video:   {path}")

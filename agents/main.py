@@ -12,10 +12,9 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 from pathlib import Path
 
-from agents.config import CONFIG_FILE, MODEL_FILE, run_cli
+from agents.config import CONFIG_FILE, MODEL_FILE, add_progress_flags, as_int, run_cli, wants_progress
 from agents.evaluate import evaluate, markdown, record
 from agents.train_ppo import train
 
@@ -27,18 +26,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--episodes", type=int, default=100, help="evaluation episodes (default %(default)s)")
     p.add_argument("--output", default="runs")
-    bar = p.add_mutually_exclusive_group()
-    bar.add_argument("--progress", dest="progress", action="store_true", default=None)
-    bar.add_argument("--no-progress", dest="progress", action="store_false")
+    add_progress_flags(p)
     return p
 
 
 def main(argv: list[str] | None = None) -> Path:
     args = build_parser().parse_args(argv)
-    progress = sys.stdout.isatty() if args.progress is None else args.progress
-    run_dir = train(args.env, timesteps=args.timesteps, seed=args.seed, output=args.output, progress=progress)
-    print(f"evaluating over {args.episodes} episodes in exact mode, beside the random and scripted baselines ...")
-    results = evaluate(run_dir, episodes=args.episodes, mode="exact")
+    episodes = as_int("episodes", args.episodes)  # checked before training, not after it
+    run_dir = train(args.env, timesteps=args.timesteps, seed=args.seed, output=args.output,
+                    progress=wants_progress(args.progress))
+    print(f"evaluating over {episodes} episodes in exact mode, beside the random and scripted baselines ...")
+    results = evaluate(run_dir, episodes=episodes, mode="exact")
     (run_dir / "eval-exact.json").write_text(json.dumps(results, indent=1))
     print()
     print(markdown(results))

@@ -31,7 +31,8 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-from agents.config import UsageError, check_env_id, hyperparams_for, read_run, run_cli
+from agents.config import UsageError, as_int, check_env_id, hyperparams_for, read_run, run_cli
+from agents.evaluate import pct
 
 DEFAULT_ENVS = ("CollisionEnv/OneBallTarget-v0", "CollisionEnv/Line1D-v0")
 DEFAULT_MODES = ("naive:1", "naive:4", "posteriori:1", "posteriori:4", "exact:1")
@@ -91,10 +92,8 @@ def baselines(task: dict) -> dict:
 
     env = gym.make(task["env_id"])
     out = {"env_id": task["env_id"], "random": play(env, random_policy(EVAL_SEED), task["episodes"], EVAL_SEED)}
-    try:
-        out["scripted"] = play(env, scripted_baseline(), task["episodes"], EVAL_SEED)
-    except LookupError:
-        out["scripted"] = None
+    scripted = scripted_baseline(env)
+    out["scripted"] = None if scripted is None else play(env, scripted, task["episodes"], EVAL_SEED)
     env.close()
     return out
 
@@ -121,15 +120,11 @@ def _describe(task: dict) -> str:
 
 
 # ------------------------------------------------------------------------------------- tables
-def _pct(x: float) -> str:
-    return f"{100 * x:.0f} %"
-
-
 def _spread(values: list) -> str:
     mean = statistics.fmean(values)
     if len(values) < 2:
-        return _pct(mean)
-    return f"{_pct(mean)} ± {100 * statistics.stdev(values):.0f}"
+        return pct(mean)
+    return f"{pct(mean)} ± {100 * statistics.stdev(values):.0f}"
 
 
 def _by_env_and_mode(rows: list) -> dict:
@@ -162,7 +157,7 @@ def modes_table(rows: list) -> str:
             own = [r["own"]["success_rate"] for r in rs]
             secs = statistics.fmean(r["train_seconds"] for r in rs)
             ratio = f"{secs / exact_time:.2f}" if exact_time else "n/a"
-            lines.append(f"| {_label(mode, k)} | {_spread(exact)} | {' / '.join(_pct(x) for x in exact)} | "
+            lines.append(f"| {_label(mode, k)} | {_spread(exact)} | {' / '.join(pct(x) for x in exact)} | "
                          f"{_spread(own)} | {secs:.0f} | {ratio} |")
         tables.append("\n".join(lines))
     return "\n\n".join(tables)
@@ -190,9 +185,9 @@ def presets_table(rows: list, base: list) -> str:
         succ = [r["exact"]["success_rate"] for r in rs]
         ret = statistics.fmean(r["exact"]["mean_return"] for r in rs)
         b = by_env.get(env_id, {})
-        fmt = lambda p: "n/a" if p is None else f"{_pct(p['success_rate'])} ({p['mean_return']:.2f})"  # noqa: E731
+        fmt = lambda p: "n/a" if p is None else f"{pct(p['success_rate'])} ({p['mean_return']:.2f})"  # noqa: E731
         lines.append(f"| `{env_id}` | {rs[0]['timesteps_done']:,} | {_spread(succ)} | "
-                     f"{' / '.join(_pct(x) for x in succ)} | {ret:.2f} | {fmt(b.get('random'))} | "
+                     f"{' / '.join(pct(x) for x in succ)} | {ret:.2f} | {fmt(b.get('random'))} | "
                      f"{fmt(b.get('scripted'))} | {statistics.fmean(r['train_seconds'] for r in rs):.0f} |")
     return "\n".join(lines)
 
@@ -292,27 +287,38 @@ def main(argv: list[str] | None = None) -> dict:
         path = docs / "study.json"
         if not path.is_file():
             raise UsageError(f"{path} not found: run the study first")
-        data = json.loads(path.read_text())
-        render(data, docs, readme)
+        try:
+            data = json.loads(path.read_text())
+            render(data, docs, readme)
+        except (ValueError, KeyError, TypeError) as err:
+            raise UsageError(f"{path} is not a study result ({type(err).__name__}: {err})") from None
         return data
 
     from collision_env.envs import PRESET_IDS
 
-    modes = [parse_mode(m) for m in args.modes]
-    presets = [check_env_id(e) for e in (args.presets or PRESET_IDS.values())]
-    envs = [check_env_id(e) for e in args.envs]
-    steps = lambda env_id: args.timesteps or hyperparams_for(env_id)["n_timesteps"]  # noqa: E731
-    common = {"episodes": args.episodes, "output": args.output}
+    unique = lambda items: list(dict.fromkeys(items))  # noqa: E731  (a repeated cell would train twice)
+    modes = unique(parse_mode(m) for m in args.modes)
+    presets = unique(check_env_id(e) for e in (args.presets or PRESET_IDS.values()))
+    envs = unique(check_env_id(e) for e in args.envs)
+    seeds = unique(as_int("seeds", s, low=0) for s in args.seeds)
+    as_int("jobs", args.jobs)
+    if args.timesteps is not None:
+        as_int("timesteps", args.timesteps)
+
+    def steps(env_id):
+        return args.timesteps if args.timesteps is not None else hyperparams_for(env_id)["n_timesteps"]
+
+    common = {"episodes": as_int("episodes", args.episodes), "output": args.output}
     tasks = []
     if args.part in ("modes", "both"):
         tasks += [{"part": "modes", "env_id": e, "mode": m, "substeps": k, "seed": s, "timesteps": steps(e),
-                   **common} for e in envs for m, k in modes for s in args.seeds]
+                   **common} for e in envs for m, k in modes for s in seeds]
     if args.part in ("presets", "both"):
         for env_id in presets:
             if args.part == "both" and env_id in envs and ("exact", 1) in modes:
                 continue  # the modes part trains this preset in exact mode over the same seeds already
             tasks += [{"part": "presets", "env_id": env_id, "mode": "exact", "substeps": 1, "seed": s,
-                       "timesteps": steps(env_id), **common} for s in args.seeds]
+                       "timesteps": steps(env_id), **common} for s in seeds]
     start = time.perf_counter()
     print(f"{len(tasks)} training runs, {args.jobs} at a time ...")
     rows = _run_all(train_and_evaluate, tasks, args.jobs, print)

@@ -20,16 +20,20 @@ The run folder (``--output``/``--run-name``) holds:
 | ``best_model.zip``, ``eval/evaluations.npz`` | EvalCallback's best policy and its evaluation log |
 | ``checkpoints/`` | CheckpointCallback's periodic saves (with the VecNormalize statistics) |
 | ``tb/`` | TensorBoard logs (``tensorboard --logdir <run>/tb``) |
-| ``monitor.csv`` | per-episode return, length and success |
+| ``monitor.csv`` | per-episode return, length and success (``<i>.monitor.csv`` per sub-env with dummy/subproc) |
 
 Evaluation and checkpoint frequencies count env steps (all sub-envs together), not callback calls.
+Every evaluation replays the same episodes (the evaluation env is reseeded first), so the best
+model is picked on one fixed set, and ``best_vecnormalize.pkl`` keeps the statistics it was
+evaluated with. ``--hyperparams <run>/config.yml`` repeats a run: its env id, seed, vector env and
+callback settings are the defaults then (options given on the command line still win).
 """
 
 from __future__ import annotations
 
 import argparse
 import platform
-import sys
+import shutil
 import time
 from pathlib import Path
 
@@ -39,40 +43,46 @@ from agents.config import (
     MODEL_FILE,
     VECNORMALIZE_FILE,
     UsageError,
-    as_positive_int,
+    add_progress_flags,
+    as_int,
     check_env_id,
+    check_env_kwargs,
     episode_steps,
     hyperparams_for,
+    is_run_config,
+    load_yaml,
     normalize_settings,
     parse_env_kwargs,
     ppo_kwargs,
     run_cli,
+    wants_progress,
     write_yaml,
 )
 
+DEFAULT_ENV = "CollisionEnv/OneBallTarget-v0"
 VEC_ENVS = ("native", "dummy", "subproc")
 EVAL_SEED_OFFSET = 100_000  # evaluation episodes never share seeds with training episodes
+BEST_VECNORMALIZE_FILE = "best_vecnormalize.pkl"
+#: train()'s callback settings, recorded in config.yml and reused by --hyperparams <run>/config.yml
+CALLBACK_DEFAULTS = {"eval_freq": 50_000, "eval_episodes": 20, "save_freq": 250_000}
 
 
 def make_vec_env(env_id: str, n_envs: int, seed: int, env_kwargs: dict, vec_env: str = "native",
                  monitor_dir: Path | None = None):
     """An SB3 ``VecEnv`` of ``n_envs`` sub-envs (sub-env i seeded ``seed + i``), monitored.
 
-    ``native``: the batched env through :class:`collision_env.envs.sb3.CollisionSB3VecEnv` (one
+    ``native``: the batched env through :func:`collision_env.envs.sb3.make_sb3_vec_env` (one
     ``VecMonitor``); ``dummy`` / ``subproc``: SB3's ``make_vec_env`` over ``gym.make`` (one
     ``Monitor`` per sub-env). Episodes last the env's own number of control steps whatever ``dt``
     is (``max_episode_steps`` follows the task config).
     """
     kwargs = {**env_kwargs, "max_episode_steps": episode_steps(env_id, env_kwargs)}
     if vec_env == "native":
-        from stable_baselines3.common.vec_env import VecMonitor
+        from collision_env.envs.sb3 import make_sb3_vec_env
 
-        from collision_env.envs.sb3 import CollisionSB3VecEnv
-
-        venv = CollisionSB3VecEnv(env_id, n_envs, **kwargs)
-        venv.seed(seed)
-        filename = None if monitor_dir is None else str(monitor_dir / "monitor.csv")
-        return VecMonitor(venv, filename=filename, info_keywords=("is_success",))
+        return make_sb3_vec_env(env_id, n_envs, seed=seed,
+                                monitor_file=None if monitor_dir is None else str(monitor_dir / "monitor.csv"),
+                                **kwargs)
     from stable_baselines3.common.env_util import make_vec_env as sb3_make_vec_env
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
 
@@ -92,8 +102,38 @@ def _wrap_normalize(venv, settings: dict | None, gamma: float, training: bool):
 
     if training:
         return VecNormalize(venv, gamma=gamma, **settings)
-    return VecNormalize(venv, training=False, norm_obs=settings.get("norm_obs", True), norm_reward=False,
-                        gamma=gamma)
+    return VecNormalize(venv, training=False, gamma=gamma, **{**settings, "norm_reward": False})
+
+
+def _callbacks(run_dir: Path, eval_env, eval_seed: int, n_envs: int, eval_freq: int, eval_episodes: int,
+               save_freq: int, normalized: bool) -> list:
+    from stable_baselines3.common.callbacks import BaseCallback, CheckpointCallback, EvalCallback
+
+    class SeededEvalCallback(EvalCallback):
+        """EvalCallback that replays the same episodes at every evaluation (reseeds the eval env)."""
+
+        def _on_step(self) -> bool:
+            if self.eval_freq > 0 and self.n_calls % self.eval_freq == 0:
+                self.eval_env.seed(eval_seed)
+            return super()._on_step()
+
+    class SaveBestStatistics(BaseCallback):
+        """Keep the VecNormalize statistics that the best model was evaluated with."""
+
+        def _on_step(self) -> bool:
+            self.model.get_vec_normalize_env().save(str(run_dir / BEST_VECNORMALIZE_FILE))
+            return True
+
+    out = []
+    if eval_freq:
+        out.append(SeededEvalCallback(eval_env, n_eval_episodes=eval_episodes, eval_freq=max(eval_freq // n_envs, 1),
+                                      best_model_save_path=str(run_dir), log_path=str(run_dir / "eval"),
+                                      deterministic=True, verbose=0,
+                                      callback_on_new_best=SaveBestStatistics() if normalized else None))
+    if save_freq:
+        out.append(CheckpointCallback(save_freq=max(save_freq // n_envs, 1), save_path=str(run_dir / "checkpoints"),
+                                      name_prefix="model", save_vecnormalize=normalized))
+    return out
 
 
 def _versions() -> dict:
@@ -122,49 +162,58 @@ def default_run_name(env_id: str, mode: str, substeps: int, seed: int) -> str:
     return f"{run_label(env_id, mode, substeps, seed)}-{time.strftime('%Y%m%d-%H%M%S')}"
 
 
-def train(env_id: str, *, timesteps: float | None = None, n_envs: int | None = None, seed: int = 0,
+def train(env_id: str = DEFAULT_ENV, *, timesteps: float | None = None, n_envs: int | None = None, seed: int = 0,
           mode: str | None = None, substeps: int | None = None, env_kwargs: dict | None = None,
           output: str | Path = "runs", run_name: str | None = None, hyperparams: str | Path = HYPERPARAMS,
-          vec_env: str = "native", eval_freq: int = 50_000, eval_episodes: int = 20, save_freq: int = 250_000,
+          vec_env: str = "native", eval_freq: int = CALLBACK_DEFAULTS["eval_freq"],
+          eval_episodes: int = CALLBACK_DEFAULTS["eval_episodes"], save_freq: int = CALLBACK_DEFAULTS["save_freq"],
           progress: bool = False, threads: int = 1, overwrite: bool = False, verbose: int = 0,
           log=print) -> Path:
     """Train PPO on ``env_id`` and write the run folder; returns its path.
 
     ``mode``/``substeps`` set the engine's fidelity (they override ``env_kwargs``, which override
     the hyperparameter entry's ``env_kwargs``). ``eval_freq`` / ``save_freq`` are in env steps;
-    0 turns the EvalCallback / CheckpointCallback off.
+    0 turns the EvalCallback / CheckpointCallback off. Everything is validated before the run
+    folder is made, so a mistake costs no half-written folder.
     """
     check_env_id(env_id)
     if vec_env not in VEC_ENVS:
         raise UsageError(f"--vec-env: expected one of {VEC_ENVS}, got {vec_env!r}")
     hp = hyperparams_for(env_id, hyperparams)
-    n_envs = as_positive_int("n_envs", n_envs if n_envs is not None else hp.get("n_envs", 8))
-    timesteps = as_positive_int("timesteps", timesteps if timesteps is not None else hp.get("n_timesteps", 1e6))
-    kwargs = {**(hp.get("env_kwargs") or {}), **(env_kwargs or {})}
+    n_envs = as_int("n_envs", n_envs if n_envs is not None else hp.get("n_envs", 8))
+    timesteps = as_int("timesteps", timesteps if timesteps is not None else hp.get("n_timesteps", 1e6))
+    seed = as_int("seed", seed, low=0)
+    eval_freq = as_int("eval_freq", eval_freq, low=0)
+    save_freq = as_int("save_freq", save_freq, low=0)
+    eval_episodes = as_int("eval_episodes", eval_episodes)
+    threads = as_int("threads", threads)
+    kwargs = check_env_kwargs({**(hp.get("env_kwargs") or {}), **(env_kwargs or {})})
     if mode is not None:
         kwargs["mode"] = mode
     if substeps is not None:
         kwargs["substeps"] = substeps
-    steps = episode_steps(env_id, kwargs)  # validates every env kwarg before anything is written
+    steps = episode_steps(env_id, kwargs)  # validates every env kwarg
     mode = kwargs.get("mode", "exact")
     substeps = int(kwargs.get("substeps", 1))
     norm = normalize_settings(hp.get("normalize"))
-    algo_kwargs = ppo_kwargs(hp)
+    algo_kwargs = ppo_kwargs(hp)  # validates every PPO keyword
     policy = hp.get("policy", "MlpPolicy")
 
     run_dir = Path(output) / (run_name or default_run_name(env_id, mode, substeps, seed))
-    if run_dir.exists() and any(run_dir.iterdir()) and not overwrite:
-        raise UsageError(f"run folder {run_dir} exists and is not empty (pass --overwrite to reuse it)")
+    if run_dir.exists() and any(run_dir.iterdir()):
+        if not overwrite:
+            raise UsageError(f"run folder {run_dir} exists and is not empty (pass --overwrite to replace it)")
+        shutil.rmtree(run_dir)  # nothing of an earlier run may survive into this one
     run_dir.mkdir(parents=True, exist_ok=True)
 
     import torch
     from stable_baselines3 import PPO
-    from stable_baselines3.common.callbacks import CheckpointCallback, EvalCallback
 
     torch.set_num_threads(threads)
+    callbacks_cfg = {"eval_freq": eval_freq, "eval_episodes": eval_episodes, "save_freq": save_freq}
     config = {
         "env_id": env_id, "env_kwargs": kwargs, "episode_steps": steps, "seed": seed, "n_envs": n_envs,
-        "n_timesteps": timesteps, "vec_env": vec_env,
+        "n_timesteps": timesteps, "vec_env": vec_env, "callbacks": callbacks_cfg, "threads": threads,
         "hyperparams": {**hp, "n_envs": n_envs, "n_timesteps": timesteps, "env_kwargs": dict(kwargs)},
         "hyperparams_file": str(hyperparams), "versions": _versions(),
     }
@@ -173,21 +222,20 @@ def train(env_id: str, *, timesteps: float | None = None, n_envs: int | None = N
     gamma = float(algo_kwargs.get("gamma", 0.99))
     venv = _wrap_normalize(make_vec_env(env_id, n_envs, seed, kwargs, vec_env, monitor_dir=run_dir), norm, gamma,
                            training=True)
-    callbacks = []
     eval_env = None
     if eval_freq:
-        eval_envs = min(eval_episodes, 4)
-        eval_env = _wrap_normalize(make_vec_env(env_id, eval_envs, seed + EVAL_SEED_OFFSET, kwargs, vec_env), norm,
+        eval_seed = seed + EVAL_SEED_OFFSET
+        eval_env = _wrap_normalize(make_vec_env(env_id, min(eval_episodes, 4), eval_seed, kwargs, vec_env), norm,
                                    gamma, training=False)
-        callbacks.append(EvalCallback(eval_env, n_eval_episodes=eval_episodes, eval_freq=max(eval_freq // n_envs, 1),
-                                      best_model_save_path=str(run_dir), log_path=str(run_dir / "eval"),
-                                      deterministic=True, verbose=0))
-    if save_freq:
-        callbacks.append(CheckpointCallback(save_freq=max(save_freq // n_envs, 1),
-                                            save_path=str(run_dir / "checkpoints"), name_prefix="model",
-                                            save_vecnormalize=norm is not None))
-    model = PPO(policy, venv, seed=seed, device="cpu", tensorboard_log=str(run_dir / "tb"), verbose=verbose,
-                **algo_kwargs)
+    callbacks = _callbacks(run_dir, eval_env, seed + EVAL_SEED_OFFSET, n_envs, eval_freq, eval_episodes, save_freq,
+                           norm is not None)
+    try:
+        model = PPO(policy, venv, seed=seed, device="cpu", tensorboard_log=str(run_dir / "tb"), verbose=verbose,
+                    **algo_kwargs)
+    except (TypeError, ValueError, AssertionError) as err:  # a bad value in the hyperparameter file
+        venv.close()
+        shutil.rmtree(run_dir)
+        raise UsageError(f"PPO rejected the hyperparameters for {env_id}: {err}") from None
     log(f"training PPO on {env_id} (mode={mode}, substeps={substeps}) for {timesteps:,} steps, "
         f"{n_envs} envs ({vec_env}), seed {seed} -> {run_dir}")
     start = time.perf_counter()
@@ -209,38 +257,47 @@ def train(env_id: str, *, timesteps: float | None = None, n_envs: int | None = N
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python -m agents.train_ppo", description=__doc__.split("\n\n")[0],
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--env", default="CollisionEnv/OneBallTarget-v0", help="registered env id (default: %(default)s)")
+    p.add_argument("--env", help=f"registered env id (default: {DEFAULT_ENV}, or the run's with a run config)")
     p.add_argument("--timesteps", type=float, help="total env steps (default: the entry's n_timesteps)")
     p.add_argument("--n-envs", type=int, help="parallel sub-envs (default: the entry's n_envs)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=int, help="default 0 (or the run's)")
     p.add_argument("--mode", choices=("exact", "posteriori", "naive"), help="engine fidelity mode (default: exact)")
     p.add_argument("--substeps", type=int, help="sub-steps per control step for naive/posteriori")
     p.add_argument("--env-kwargs", nargs="*", metavar="KEY=VALUE", help="more env keywords, e.g. dt=0.1")
     p.add_argument("--output", default="runs", help="folder for run folders (default: %(default)s)")
     p.add_argument("--run-name", help="run folder name (default: <env>-<mode>-s<seed>-<time>)")
-    p.add_argument("--overwrite", action="store_true", help="reuse an existing run folder")
-    p.add_argument("--hyperparams", default=str(HYPERPARAMS), help="hyperparameter YAML (default: the shipped one)")
-    p.add_argument("--vec-env", choices=VEC_ENVS, default="native",
+    p.add_argument("--overwrite", action="store_true", help="replace an existing run folder")
+    p.add_argument("--hyperparams", default=str(HYPERPARAMS),
+                   help="hyperparameter YAML, or a run's config.yml to repeat it (default: the shipped file)")
+    p.add_argument("--vec-env", choices=VEC_ENVS,
                    help="native batched env (default), or SB3's dummy/subproc over gym.make")
-    p.add_argument("--eval-freq", type=int, default=50_000, help="env steps between evaluations (0: none)")
-    p.add_argument("--eval-episodes", type=int, default=20)
-    p.add_argument("--save-freq", type=int, default=250_000, help="env steps between checkpoints (0: none)")
+    p.add_argument("--eval-freq", type=int, help=f"env steps between evaluations, 0: none "
+                                                 f"(default {CALLBACK_DEFAULTS['eval_freq']})")
+    p.add_argument("--eval-episodes", type=int, help=f"default {CALLBACK_DEFAULTS['eval_episodes']}")
+    p.add_argument("--save-freq", type=int, help=f"env steps between checkpoints, 0: none "
+                                                 f"(default {CALLBACK_DEFAULTS['save_freq']})")
     p.add_argument("--threads", type=int, default=1, help="torch threads (default: %(default)s)")
-    bar = p.add_mutually_exclusive_group()
-    bar.add_argument("--progress", dest="progress", action="store_true", default=None, help="progress bar")
-    bar.add_argument("--no-progress", dest="progress", action="store_false")
+    add_progress_flags(p)
     p.add_argument("-v", "--verbose", type=int, default=0, help="SB3 verbosity (1: print training statistics)")
     return p
 
 
 def main(argv: list[str] | None = None) -> Path:
     args = build_parser().parse_args(argv)
-    progress = sys.stdout.isatty() if args.progress is None else args.progress
-    run_dir = train(args.env, timesteps=args.timesteps, n_envs=args.n_envs, seed=args.seed, mode=args.mode,
-                    substeps=args.substeps, env_kwargs=parse_env_kwargs(args.env_kwargs), output=args.output,
-                    run_name=args.run_name, hyperparams=args.hyperparams, vec_env=args.vec_env,
-                    eval_freq=args.eval_freq, eval_episodes=args.eval_episodes, save_freq=args.save_freq,
-                    progress=progress, threads=args.threads, overwrite=args.overwrite, verbose=args.verbose)
+    # a run's config.yml supplies the defaults of the run it describes
+    data = load_yaml(args.hyperparams)
+    run = data if is_run_config(data) else {}
+    pick = lambda given, key, default: given if given is not None else run.get(key, default)  # noqa: E731
+    callbacks = {**CALLBACK_DEFAULTS, **run.get("callbacks", {})}
+    run_dir = train(pick(args.env, "env_id", DEFAULT_ENV), timesteps=args.timesteps, n_envs=args.n_envs,
+                    seed=pick(args.seed, "seed", 0), mode=args.mode, substeps=args.substeps,
+                    env_kwargs=parse_env_kwargs(args.env_kwargs), output=args.output, run_name=args.run_name,
+                    hyperparams=args.hyperparams, vec_env=pick(args.vec_env, "vec_env", "native"),
+                    eval_freq=callbacks["eval_freq"] if args.eval_freq is None else args.eval_freq,
+                    eval_episodes=callbacks["eval_episodes"] if args.eval_episodes is None else args.eval_episodes,
+                    save_freq=callbacks["save_freq"] if args.save_freq is None else args.save_freq,
+                    progress=wants_progress(args.progress), threads=args.threads, overwrite=args.overwrite,
+                    verbose=args.verbose)
     print(f"model:       {run_dir / MODEL_FILE}")
     print(f"config:      {run_dir / CONFIG_FILE}")
     print(f"tensorboard: tensorboard --logdir {run_dir / 'tb'}")

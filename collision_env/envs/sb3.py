@@ -125,10 +125,11 @@ class CollisionSB3VecEnv(VecEnv):
 
 
 def make_sb3_vec_env(env_id: str, n_envs: int = 8, seed: int | None = None, monitor: bool = True,
-                     **env_kwargs: Any) -> VecEnv:
+                     monitor_file: str | None = None, **env_kwargs: Any) -> VecEnv:
     """A :class:`CollisionSB3VecEnv` for ``env_id`` (seeded with ``seed + i`` at the first reset),
-    wrapped in ``VecMonitor(info_keywords=("is_success",))`` unless ``monitor=False``."""
+    wrapped in ``VecMonitor(info_keywords=("is_success",))`` (writing ``monitor_file`` if given)
+    unless ``monitor=False``."""
     venv = CollisionSB3VecEnv(env_id, n_envs, **env_kwargs)
     if seed is not None:
         venv.seed(seed)
-    return VecMonitor(venv, info_keywords=("is_success",)) if monitor else venv
+    return VecMonitor(venv, filename=monitor_file, info_keywords=("is_success",)) if monitor else venv

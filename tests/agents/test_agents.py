@@ -67,14 +67,26 @@ def test_rl_zoo_style_values_are_understood():
             config.ppo_kwargs(bad)
 
 
-def test_native_and_sb3_vector_envs_start_the_same_episodes():
-    kwargs = {"mode": "posteriori", "substeps": 2, "dt": 0.1}
+def test_native_and_sb3_vector_envs_play_the_same_episodes_through_their_ends():
+    # dt = 0.025 makes an episode 400 control steps, past the registered max_episode_steps of 200
+    kwargs = {"mode": "posteriori", "substeps": 2, "dt": 0.025}
     native = train_ppo.make_vec_env("CollisionEnv/Billiards-v0", 3, 5, kwargs, "native")
     dummy = train_ppo.make_vec_env("CollisionEnv/Billiards-v0", 3, 5, kwargs, "dummy")
     assert np.array_equal(native.reset(), dummy.reset())
-    actions = np.full((3, 2), 0.5, np.float32)
-    for _ in range(5):
-        assert np.array_equal(native.step(actions)[0], dummy.step(actions)[0])
+    rng = np.random.default_rng(0)
+    ends = []
+    for t in range(1, 421):
+        actions = rng.uniform(-1, 1, (3, 2)).astype(np.float32)
+        (o1, r1, d1, i1), (o2, r2, d2, i2) = native.step(actions), dummy.step(actions)
+        assert np.array_equal(o1, o2) and np.array_equal(r1, r2) and np.array_equal(d1, d2)
+        for a, b in zip(i1, i2, strict=True):
+            assert a["is_success"] == b["is_success"] and a["TimeLimit.truncated"] == b["TimeLimit.truncated"]
+            assert ("terminal_observation" in a) == ("terminal_observation" in b)
+            if "terminal_observation" in a:
+                assert np.array_equal(a["terminal_observation"], b["terminal_observation"])
+                assert a["episode"]["r"] == pytest.approx(b["episode"]["r"], rel=1e-5)
+                ends.append((t, a["TimeLimit.truncated"]))
+    assert ends and all(t == 400 for t, truncated in ends if truncated)  # the task's own length, not 200
 
 
 # --------------------------------------------------------------------------- train, save, evaluate
@@ -89,6 +101,10 @@ def test_train_save_reload_evaluate_and_record(tmp_path):
     assert cfg["env_id"] == "CollisionEnv/OneBallTarget-v0" and cfg["timesteps_done"] >= 2048
     assert cfg["env_kwargs"] == {"time_limit": 2.0} and cfg["episode_steps"] == 40 and cfg["train_seconds"] > 0
 
+    log = np.load(run / "eval" / "evaluations.npz")
+    assert log["timesteps"].tolist() == [1024, 2048] and log["results"].shape == (2, 2)
+    assert list((run / "checkpoints").glob("model_vecnormalize_*_steps.pkl"))
+
     results = evaluate.main([str(run), "--episodes", "3", "--gif"])
     _finite(results)
     assert set(results["policies"]) == {"ppo", "random", "scripted"}
@@ -100,9 +116,57 @@ def test_train_save_reload_evaluate_and_record(tmp_path):
     other = evaluate.evaluate(run, episodes=2, mode="posteriori", substeps=4, baselines=())
     assert (other["mode"], other["substeps"], other["train_mode"]) == ("posteriori", 4, "exact")
     _finite(other)
+    sim = evaluate.make_env(cfg["env_id"], evaluate.eval_kwargs(cfg, "posteriori", 4)).unwrapped.simulator
+    assert (sim.mode, sim.substeps) == ("posteriori", 4)  # the engine really runs in the other mode
     # deterministic: the same episodes give the same figures
     again = evaluate.evaluate(run, episodes=3, baselines=())
     assert again["policies"]["ppo"]["mean_return"] == results["policies"]["ppo"]["mean_return"]
+
+
+def test_observation_normalisation_uses_the_statistics_saved_with_each_model(tmp_path):
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    hp = dict(config.hyperparams_for("CollisionEnv/OneBallTarget-v0"),
+              normalize={"norm_obs": True, "norm_reward": True})
+    hp_file = tmp_path / "hp.yml"
+    config.write_yaml(hp_file, {"CollisionEnv/OneBallTarget-v0": hp})
+    args = TINY + ["--hyperparams", str(hp_file), "--output", str(tmp_path), "--run-name", "n", "--eval-freq", "1024",
+                   "--eval-episodes", "2", "--save-freq", "0"]
+    run = train_ppo.main(args)
+    assert (run / "vecnormalize.pkl").is_file() and (run / "best_vecnormalize.pkl").is_file()
+    env = evaluate.make_env("CollisionEnv/OneBallTarget-v0", {})
+    obs, _ = env.reset(seed=3)
+    for which, model_file, stats_file in (("final", "model.zip", "vecnormalize.pkl"),
+                                          ("best", "best_model.zip", "best_vecnormalize.pkl")):
+        act = evaluate.trained_policy(run, which)(env.unwrapped, 0)
+        venv = train_ppo.make_vec_env("CollisionEnv/OneBallTarget-v0", 1, 0, {})
+        stats = VecNormalize.load(str(run / stats_file), venv)
+        expect = PPO.load(run / model_file, device="cpu").predict(stats.normalize_obs(obs), deterministic=True)[0]
+        assert np.allclose(act(obs), expect, atol=1e-6)
+    # --overwrite replaces the whole folder: no statistics of the earlier run survive
+    train_ppo.main(TINY + ["--output", str(tmp_path), "--run-name", "n", "--overwrite", "--eval-freq", "0",
+                           "--save-freq", "0"])
+    assert not (run / "best_vecnormalize.pkl").exists() and not (run / "best_model.zip").exists()
+    _finite(evaluate.evaluate(run, episodes=2, baselines=()))
+
+
+def test_a_run_config_repeats_its_run(tmp_path):
+    first = train_ppo.main(["--env", "CollisionEnv/Line1D-v0", "--seed", "3", "--vec-env", "dummy", "--eval-freq", "0",
+                            "--save-freq", "0", "--output", str(tmp_path), "--run-name", "a", *TINY])
+    again = train_ppo.main(["--hyperparams", str(first / "config.yml"), "--output", str(tmp_path), "--run-name", "b",
+                            "--no-progress"])
+    a, b = config.read_run(first), config.read_run(again)
+    for key in ("env_id", "seed", "vec_env", "n_envs", "n_timesteps", "env_kwargs", "callbacks", "episode_steps"):
+        assert a[key] == b[key], key
+    assert (b["env_id"], b["seed"], b["vec_env"]) == ("CollisionEnv/Line1D-v0", 3, "dummy")
+    from stable_baselines3 import PPO
+
+    pa = PPO.load(first / "model.zip", device="cpu").policy.state_dict()
+    pb = PPO.load(again / "model.zip", device="cpu").policy.state_dict()
+    assert all(np.array_equal(pa[k].numpy(), pb[k].numpy()) for k in pa)  # the same training, bit for bit
+    with pytest.raises(config.UsageError, match="config of a CollisionEnv/Line1D-v0 run"):
+        train_ppo.train("CollisionEnv/OneBallTarget-v0", hyperparams=first / "config.yml", output=tmp_path)
 
 
 def test_record_mp4(tmp_path):
@@ -126,7 +190,7 @@ def test_main_job_trains_evaluates_and_records(tmp_path, capsys):
     out = capsys.readouterr().out
     for path in (run / "model.zip", run / "episodes.gif", run / "eval-exact.json"):
         assert path.is_file() and str(path) in out
-    assert "| random |" in out and "| scripted (exact aim) |" in out and "tensorboard --logdir" in out
+    assert "| random |" in out and f"| {evaluate.SCRIPTED_LABEL} |" in out and "tensorboard --logdir" in out
 
 
 def test_study_writes_tables_plot_and_readme_block(tmp_path):
@@ -139,8 +203,9 @@ def test_study_writes_tables_plot_and_readme_block(tmp_path):
                        "--readme", str(readme)])
     modes = [r for r in data["rows"] if r["part"] == "modes"]
     assert {(r["mode"], r["seed"]) for r in modes} == {("naive", 0), ("naive", 1), ("exact", 0), ("exact", 1)}
-    presets = {r["env_id"] for r in data["rows"] if r["part"] == "presets"}
-    assert presets == {"CollisionEnv/Line1D-v0", "CollisionEnv/OneBallTarget-v0"}  # exact runs shared
+    presets = [r["env_id"] for r in data["rows"] if r["part"] == "presets"]
+    assert sorted(presets) == ["CollisionEnv/Line1D-v0"] * 2 + ["CollisionEnv/OneBallTarget-v0"] * 2
+    assert len(list((tmp_path / "runs").iterdir())) == 6  # the exact OneBallTarget runs are shared, not retrained
     for name in ("study.json", "modes.md", "presets.md", "modes.png"):
         assert (docs / name).is_file(), name
     text = readme.read_text()
@@ -165,6 +230,44 @@ def test_bad_input_is_a_one_line_error_without_traceback(module, args, message):
     assert proc.returncode == 2
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and message in lines[0] and "Traceback" not in proc.stderr
+
+
+@pytest.mark.parametrize("command, args, message", [
+    ("train", ["--hyperparams", "{bad_yaml}"], "not valid YAML"),
+    ("train", ["--hyperparams", "{typo_yaml}"], "unknown key(s) ['n_step']"),
+    ("train", ["--env-kwargs", "mass_range=[1"], "cannot read the value"),
+    ("train", ["--env-kwargs", "render_mode=human"], "render_mode cannot be set"),
+    ("train", ["--seed", "-1"], "seed: expected an integer >= 0"),
+    ("train", ["--threads", "0"], "threads: expected a positive integer"),
+    ("train", ["--eval-freq", "-5"], "eval_freq"),
+    ("train", ["--env", "CartPole-v1"], "unknown env id"),
+    ("evaluate", ["{run}", "--gif", "--record-episodes", "0"], "record episodes"),
+    ("evaluate", ["{run}", "--video", "x.avi"], "expected a .gif or .mp4"),
+    ("evaluate", ["{run}", "--episodes", "-3"], "episodes"),
+    ("study", ["--timesteps", "0"], "timesteps"),
+    ("study", ["--modes", "exact:2"], "substeps must be"),
+    ("study", ["--render", "--docs", "{corrupt_docs}"], "is not a study result"),
+])
+def test_bad_input_in_process_is_one_line_and_exit_2(tmp_path, capsys, command, args, message):
+    (tmp_path / "bad.yml").write_text("a: [1\n")
+    config.write_yaml(tmp_path / "typo.yml", {"CollisionEnv/OneBallTarget-v0": {"n_step": 256}})
+    (tmp_path / "docs").mkdir()
+    (tmp_path / "docs" / "study.json").write_text("{not json")
+    run = tmp_path / "run"
+    if command == "evaluate":
+        run = train_ppo.main(TINY + ["--output", str(tmp_path), "--run-name", "run", "--eval-freq", "0",
+                                     "--save-freq", "0"])
+        capsys.readouterr()
+    fill = {"bad_yaml": tmp_path / "bad.yml", "typo_yaml": tmp_path / "typo.yml", "run": run,
+            "corrupt_docs": tmp_path / "docs"}
+    argv = [a.format(**fill) for a in args] + (["--output", str(tmp_path / "out")] if command == "train" else [])
+    main = {"train": train_ppo.main, "evaluate": evaluate.main, "study": study.main}[command]
+    with pytest.raises(SystemExit) as exit_info:
+        config.run_cli(main, argv, prog=command)
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and message in err[0], err
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())  # no half-made run folder
 
 
 def test_a_folder_that_is_not_a_run_is_rejected(tmp_path):
