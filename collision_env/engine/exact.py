@@ -30,7 +30,7 @@ import numpy as np
 
 from ._jit import njit
 from .ldp import least_distance
-from .motion import advance_all, body_kinematics, has_rotation
+from .motion import advance_all, ball_views, body_kinematics, has_rotation
 from .response import ball_ball, ball_wall, elastic_threshold, merge_bodies, stop_body
 from .toi import INF, ca_pair, ca_wall, toi_pair, toi_wall
 
@@ -43,23 +43,29 @@ _CONTACT_TOL = 1e-9
 #: Sweeps over a contact group in one instant before the cascade is replaced by its limit (see
 #: ``_settle_contact_group``). Cascades among comparable masses end within a few dozen sweeps.
 _MAX_SWEEPS = 1000
+#: Columns of the per-scene work arrays: float (time left in the step, start time of the step);
+#: int (events so far, active, stalled, sub-steps done).
+WORK_F = 2
+WORK_I = 4
 
 
-@njit
+@njit(inline="always")
 def record(imp, n_imp, scene, time, ball, other, wall, x, y, speed):
+    """Append an impact to the record buffer ``imp`` (``simulator.IMPACT_DTYPE``)."""
     k = n_imp[0]
-    imp[k, 0] = scene
-    imp[k, 1] = time
-    imp[k, 2] = ball
-    imp[k, 3] = other
-    imp[k, 4] = wall
-    imp[k, 5] = x
-    imp[k, 6] = y
-    imp[k, 7] = speed
+    r = imp[k]  # a view of row k (in numba and in numpy alike)
+    r["scene"] = scene
+    r["time"] = time
+    r["ball"] = ball
+    r["other"] = other
+    r["wall"] = wall
+    r["x"] = x
+    r["y"] = y
+    r["speed"] = speed
     n_imp[0] = k + 1
 
 
-@njit
+@njit(inline="always")
 def wall_point(i, wall, pos, radius, bounds):
     if wall == 0:
         return bounds[0], pos[i, 1]
@@ -70,7 +76,7 @@ def wall_point(i, wall, pos, radius, bounds):
     return pos[i, 0], bounds[3]
 
 
-@njit
+@njit(inline="always")
 def wall_gap(i, wall, pos, radius, bounds):
     if wall == 0:
         return pos[i, 0] - radius[i] - bounds[0]
@@ -81,7 +87,7 @@ def wall_gap(i, wall, pos, radius, bounds):
     return bounds[3] - radius[i] - pos[i, 1]
 
 
-@njit
+@njit(inline="always")
 def snap_to_wall(i, wall, pos, radius, bounds):
     """Put a ball exactly on the wall it touches (it is there up to round-off)."""
     if wall == 0:
@@ -122,7 +128,7 @@ def _predict_pair(i, k, now, horizon, pos, vel, mass, radius, body, omega, rot, 
     return _straight_pair(i, k, now, pos, vel, radius, body, counters)
 
 
-@njit
+@njit(inline="always")
 def _predict_wall(i, now, horizon, pos, vel, mass, radius, body, omega, rot, bounds, dim, ki, counters):
     if rot and omega[body[i]] != 0.0:
         counters[CLUSTER_TESTS] += 1
@@ -136,7 +142,7 @@ def _predict_wall(i, now, horizon, pos, vel, mass, radius, body, omega, rot, bou
     return now + tau, wall
 
 
-@njit
+@njit(inline="always")
 def _rescan(i, pt, rmin, rarg):
     best = INF
     arg = -1
@@ -148,7 +154,7 @@ def _rescan(i, pt, rmin, rarg):
     rarg[i] = arg
 
 
-@njit
+@njit(inline="always")
 def _touching(a, k, pos, radius):
     """Balls ``a`` and ``k`` touch within the contact tolerance."""
     dx = pos[k, 0] - pos[a, 0]
@@ -236,7 +242,7 @@ def _resolve_contact_group(
     return size
 
 
-@njit
+@njit(inline="always")
 def _contact_normal(c, c_a, c_b, pos):
     """Unit normal of contact ``c``, pointing from ball ``c_a[c]`` to its partner (ball or wall)."""
     a = c_a[c]
@@ -331,233 +337,64 @@ def _settle_contact_group(
             _record_contact(sc, t_abs, c, c_a, c_b, c_hit, pos, radius, bounds, closing[c], imp, n_imp)
 
 
-@njit
-def _scene(
-    sc, pos, vel, mass, inv_mass, radius, body, omega, time, remaining, events, bounds, e, ratio, floor, sign,
-    has_walls, pairs, dim, sticky, max_events, imp, n_imp, stalled, capped, counters,
-    pt, rmin, rarg, wt, wid, involved, flag, ki, kj, in_group, c_a, c_b, c_hit,
-):
-    n = pos.shape[0]
-    cascades = e < 1.0  # forward inelastic: resolve touching groups at one instant
-    room = n * (n - 1) // 2 + 4 * n + 1  # the most impacts one event can record (a contact group)
-    horizon_end = remaining[sc]
-    t0 = time[sc]
-    now = 0.0
-    rot = sticky and has_rotation(body, omega)
-    u_min = elastic_threshold(vel, ratio, floor)
-
-    for i in range(n):
-        wt[i] = INF
-        wid[i] = -1
-        rmin[i] = INF
-        rarg[i] = -1
-        flag[i] = False
-        for k in range(n):
-            pt[i, k] = INF
-    if has_walls:
-        for i in range(n):
-            wt[i], wid[i] = _predict_wall(
-                i, now, horizon_end, pos, vel, mass, radius, body, omega, rot, bounds, dim, ki, counters
-            )
-    if pairs:
-        for i in range(n):
-            for k in range(i + 1, n):
-                if rot:
-                    v = _predict_pair(i, k, now, horizon_end, pos, vel, mass, radius, body, omega, rot, ki, kj,
-                                      counters)
-                else:
-                    v = _straight_pair(i, k, now, pos, vel, radius, body, counters)
-                pt[i, k] = v
-                pt[k, i] = v
-        for i in range(n):
-            _rescan(i, pt, rmin, rarg)
-
-    while True:
-        best = INF
-        bi = -1
-        bj = -1
-        for i in range(n):
-            if wt[i] < best:
-                best = wt[i]
-                bi = i
-                bj = -1
-            if rmin[i] < best:
-                best = rmin[i]
-                bi = i
-                bj = rarg[i]
-        if not best <= horizon_end:
-            break
-        if events[sc] >= max_events:
-            capped[sc] = True
-            break
-        if n_imp[0] + room > imp.shape[0]:
-            stalled[sc] = True
-            break
-        if best > now:
-            advance_all(best - now, pos, vel, mass, body, omega, rot)
-            now = best
-        events[sc] += 1
-        counters[EVENTS] += 1
-        t_abs = t0 + sign * now
-
-        n_inv = 0
-        if bj < 0:  # ball bi meets wall wid[bi]
-            wall = wid[bi]
-            if sticky:
-                scale = radius[bi] + abs(pos[bi, 0]) + abs(pos[bi, 1])
-                axis = 0 if wall < 2 else 1
-                into = vel[bi, axis] < 0.0 if wall % 2 == 0 else vel[bi, axis] > 0.0
-                if wall_gap(bi, wall, pos, radius, bounds) <= _CONTACT_TOL * scale and into:
-                    if omega[body[bi]] == 0.0:
-                        snap_to_wall(bi, wall, pos, radius, bounds)
-                    x, y = wall_point(bi, wall, pos, radius, bounds)
-                    record(imp, n_imp, sc, t_abs, bi, -1, wall, x, y, abs(vel[bi, axis]))
-                    root = body[bi]
-                    for k in range(n):
-                        if body[k] == root:
-                            involved[n_inv] = k
-                            n_inv += 1
-                    stop_body(bi, vel, body, omega)
-                else:
-                    involved[0] = bi
-                    n_inv = 1
-            else:
-                snap_to_wall(bi, wall, pos, radius, bounds)
-                speed = ball_wall(bi, wall, vel, e, u_min)
-                if speed > 0.0:
-                    x, y = wall_point(bi, wall, pos, radius, bounds)
-                    record(imp, n_imp, sc, t_abs, bi, -1, wall, x, y, speed)
-                involved[0] = bi
-                n_inv = 1
-                if cascades and speed > 0.0:
-                    n_inv = _resolve_contact_group(
-                        sc, t_abs, bi, -1, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, u_min,
-                        imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit,
-                    )
-        else:  # balls bi and bj meet
-            dx = pos[bj, 0] - pos[bi, 0]
-            dy = pos[bj, 1] - pos[bi, 1]
-            dist = math.sqrt(dx * dx + dy * dy)
-            sigma = radius[bi] + radius[bj]
-            closing = (vel[bj, 0] - vel[bi, 0]) * dx + (vel[bj, 1] - vel[bi, 1]) * dy
-            if sticky:
-                scale = sigma + abs(pos[bi, 0]) + abs(pos[bi, 1])
-                if dist - sigma <= _CONTACT_TOL * scale and closing < 0.0:
-                    x = pos[bi, 0] + radius[bi] * dx / dist
-                    y = pos[bi, 1] + radius[bi] * dy / dist
-                    record(imp, n_imp, sc, t_abs, bi, bj, -1, x, y, -closing / dist)
-                    root = merge_bodies(bi, bj, pos, vel, mass, body, omega)
-                    for k in range(n):
-                        if body[k] == root:
-                            involved[n_inv] = k
-                            n_inv += 1
-                    rot = has_rotation(body, omega)
-                else:
-                    involved[0] = bi
-                    involved[1] = bj
-                    n_inv = 2
-            else:
-                speed = ball_ball(bi, bj, pos, vel, inv_mass, e, u_min)
-                if speed > 0.0:
-                    x = pos[bi, 0] + radius[bi] * dx / dist
-                    y = pos[bi, 1] + radius[bi] * dy / dist
-                    record(imp, n_imp, sc, t_abs, bi, bj, -1, x, y, speed)
-                involved[0] = bi
-                involved[1] = bj
-                n_inv = 2
-                if cascades and speed > 0.0:
-                    n_inv = _resolve_contact_group(
-                        sc, t_abs, bi, bj, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, u_min,
-                        imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit,
-                    )
-        if sticky:
-            rot = has_rotation(body, omega)
-
-        # Re-predict what the event changed.
-        for q in range(n_inv):
-            i = involved[q]
-            flag[i] = True
-            if has_walls:
-                wt[i], wid[i] = _predict_wall(
-                    i, now, horizon_end - now, pos, vel, mass, radius, body, omega, rot, bounds, dim, ki, counters
-                )
-        if pairs:
-            for q in range(n_inv):
-                i = involved[q]
-                for k in range(n):
-                    if k != i and not (flag[k] and k < i):
-                        if rot:
-                            v = _predict_pair(
-                                i, k, now, horizon_end - now, pos, vel, mass, radius, body, omega, rot, ki, kj,
-                                counters,
-                            )
-                        else:
-                            v = _straight_pair(i, k, now, pos, vel, radius, body, counters)
-                        pt[i, k] = v
-                        pt[k, i] = v
-            for q in range(n_inv):
-                _rescan(involved[q], pt, rmin, rarg)
-            for k in range(n):
-                if flag[k]:
-                    continue
-                stale = False
-                for q in range(n_inv):
-                    i = involved[q]
-                    v = pt[k, i]
-                    if v < rmin[k]:
-                        rmin[k] = v
-                        rarg[k] = i
-                    elif rarg[k] == i and v > rmin[k]:
-                        stale = True
-                if stale:
-                    _rescan(k, pt, rmin, rarg)
-        for q in range(n_inv):
-            flag[involved[q]] = False
-
-    if not (capped[sc] or stalled[sc]) and now < horizon_end:
-        advance_all(horizon_end - now, pos, vel, mass, body, omega, rot)
-        now = horizon_end
-    if now == horizon_end:
-        time[sc] = t0 + sign * horizon_end
-        remaining[sc] = 0.0
-    else:
-        time[sc] = t0 + sign * now
-        remaining[sc] = horizon_end - now
+def scratch_sizes(n):
+    """Lengths of :func:`step_exact`'s float, int and bool work buffers for ``n`` balls."""
+    nc = n * (n - 1) // 2 + 4 * n
+    return n * n + 2 * n + 14, 3 * n + 2 * nc, 2 * n + nc
 
 
 @njit
-def step_exact(
-    pos, vel, mass, inv_mass, radius, body, omega, time, remaining, events, active,
-    fparams, iparams, imp, n_imp, stalled, capped, counters, dt_abs, fresh,
-):
-    """Advance every active scene of the batch by its ``remaining`` time (see module doc).
+def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, counters, work_f, work_i, scratch_f,
+               scratch_i, scratch_b, dt_abs, fresh):
+    """Advance every active scene of the batch by its remaining time (see module doc).
 
-    ``fparams`` = (xmin, ymin, xmax, ymax, e, collapse_ratio, sign, collapse_floor);
-    ``iparams`` = (has_walls, pairs, dim, sticky, max_events).
-    ``fresh`` starts a step of ``dt_abs`` for every scene (all active, ``remaining = dt_abs``, no
-    events yet); otherwise the call resumes the scenes flagged ``active``.
-    Impacts go to ``imp`` rows (scene, time, ball, other, wall, x, y, speed), ``n_imp[0]`` rows so
-    far; a scene that finds the buffer full stops where it is and is flagged in ``stalled``, so
-    the caller can empty the buffer and call again for those scenes. Returns the number of
-    stalled scenes; ``n_imp[1]`` counts the scenes that reached the event cap.
+    ``balls`` is the (B, N, 8) per-ball state (``motion.BALL_FIELDS``), ``body_all`` the (B, N) cluster
+    roots, ``time`` the (B,) clocks. ``fparams`` = (xmin, ymin, xmax, ymax, e, collapse_ratio,
+    sign, collapse_floor); ``iparams`` = (has_walls, pairs, dim, sticky, max_events).
+    ``fresh`` starts a step of ``dt_abs`` for every scene (all active, the whole step left, no
+    events yet); otherwise the call resumes the scenes flagged active in ``work_i``.
+    Impacts go to ``imp`` rows (scene, time, ball, other, wall, x, y, speed) from row 0,
+    ``n_imp[0]`` rows in all; a scene that finds the buffer full stops where it is and is flagged
+    stalled, so the caller can empty the buffer and call again for those scenes. Returns the
+    number of stalled scenes; ``n_imp[1]`` counts the scenes that reached the event cap.
+    ``scratch_*`` are work buffers of :func:`scratch_sizes` (allocated once by the caller: an
+    allocation here, per call, would cost more than a one-ball step).
+
+    The whole batch is one call with the scene loop inside: a call between compiled functions
+    reference-counts every array it passes, which would cost as much as a small scene's events.
     """
-    n_scenes = pos.shape[0]
-    n = pos.shape[1]
+    pos_all, vel_all, mass_all, inv_mass_all, radius_all, omega_all = ball_views(balls)
+    remaining = work_f[:, 0]
+    events = work_i[:, 0]
+    active = work_i[:, 1]
+    stalled = work_i[:, 2]
+    n_imp[0] = 0
+    n_scenes = pos_all.shape[0]
+    n = pos_all.shape[1]
+    nc = n * (n - 1) // 2 + 4 * n
+    pt = scratch_f[0:n * n].reshape((n, n))
+    rmin = scratch_f[n * n:n * n + n]
+    wt = scratch_f[n * n + n:n * n + 2 * n]
+    ki = scratch_f[n * n + 2 * n:n * n + 2 * n + 7]
+    kj = scratch_f[n * n + 2 * n + 7:n * n + 2 * n + 14]
+    rarg = scratch_i[0:n]
+    wid = scratch_i[n:2 * n]
+    involved = scratch_i[2 * n:3 * n]
+    c_a = scratch_i[3 * n:3 * n + nc]
+    c_b = scratch_i[3 * n + nc:3 * n + 2 * nc]
+    flag = scratch_b[0:n]
+    in_group = scratch_b[n:2 * n]
+    c_hit = scratch_b[2 * n:2 * n + nc]
     bounds = fparams[0:4]
-    pt = np.empty((n, n))
-    rmin = np.empty(n)
-    rarg = np.empty(n, dtype=np.int64)
-    wt = np.empty(n)
-    wid = np.empty(n, dtype=np.int64)
-    involved = np.empty(n, dtype=np.int64)
-    flag = np.zeros(n, dtype=np.bool_)
-    ki = np.empty(7)
-    kj = np.empty(7)
-    in_group = np.zeros(n, dtype=np.bool_)
-    n_contacts = n * (n - 1) // 2 + 4 * n
-    c_a = np.empty(n_contacts, dtype=np.int64)
-    c_b = np.empty(n_contacts, dtype=np.int64)
-    c_hit = np.empty(n_contacts, dtype=np.bool_)
+    e = fparams[4]
+    ratio = fparams[5]
+    floor = fparams[7]
+    sign = fparams[6]
+    has_walls = iparams[0] != 0
+    pairs = iparams[1] != 0
+    dim = iparams[2]
+    sticky = iparams[3] != 0
+    max_events = iparams[4]
     if fresh:
         for sc in range(n_scenes):
             active[sc] = True
@@ -566,17 +403,206 @@ def step_exact(
             capped[sc] = False
         n_imp[1] = 0
     n_stalled = 0
-    for sc in range(n_scenes):
+    for sc in range(pos_all.shape[0]):
         if not active[sc]:
             continue
         stalled[sc] = False
-        _scene(
-            sc, pos[sc], vel[sc], mass[sc], inv_mass[sc], radius[sc], body[sc], omega[sc], time, remaining, events,
-            bounds, fparams[4], fparams[5], fparams[7], fparams[6], iparams[0] != 0, iparams[1] != 0, iparams[2],
-            iparams[3] != 0, iparams[4], imp, n_imp, stalled, capped, counters,
-            pt, rmin, rarg, wt, wid, involved, flag, ki, kj, in_group, c_a, c_b, c_hit,
-        )
+        pos = pos_all[sc]
+        vel = vel_all[sc]
+        mass = mass_all[sc]
+        inv_mass = inv_mass_all[sc]
+        radius = radius_all[sc]
+        body = body_all[sc]
+        omega = omega_all[sc]
+        n = pos.shape[0]
+        cascades = e < 1.0  # forward inelastic: resolve touching groups at one instant
+        room = n * (n - 1) // 2 + 4 * n + 1  # the most impacts one event can record (a contact group)
+        horizon_end = remaining[sc]
+        t0 = time[sc]
+        now = 0.0
+        rot = sticky and has_rotation(body, omega)
+        u_min = elastic_threshold(vel, ratio, floor)
+
+        for i in range(n):
+            wt[i] = INF
+            wid[i] = -1
+            rmin[i] = INF
+            rarg[i] = -1
+            flag[i] = False
+            for k in range(n):
+                pt[i, k] = INF
+        if has_walls:
+            for i in range(n):
+                wt[i], wid[i] = _predict_wall(
+                    i, now, horizon_end, pos, vel, mass, radius, body, omega, rot, bounds, dim, ki, counters
+                )
+        if pairs:
+            for i in range(n):
+                for k in range(i + 1, n):
+                    if rot:
+                        v = _predict_pair(i, k, now, horizon_end, pos, vel, mass, radius, body, omega, rot, ki, kj,
+                                          counters)
+                    else:
+                        v = _straight_pair(i, k, now, pos, vel, radius, body, counters)
+                    pt[i, k] = v
+                    pt[k, i] = v
+            for i in range(n):
+                _rescan(i, pt, rmin, rarg)
+
+        while True:
+            best = INF
+            bi = -1
+            bj = -1
+            for i in range(n):
+                if wt[i] < best:
+                    best = wt[i]
+                    bi = i
+                    bj = -1
+                if rmin[i] < best:
+                    best = rmin[i]
+                    bi = i
+                    bj = rarg[i]
+            if not best <= horizon_end:
+                break
+            if events[sc] >= max_events:
+                capped[sc] = True
+                break
+            if n_imp[0] + room > imp.shape[0]:
+                stalled[sc] = True
+                break
+            if best > now:
+                advance_all(best - now, pos, vel, mass, body, omega, rot)
+                now = best
+            events[sc] += 1
+            counters[EVENTS] += 1
+            t_abs = t0 + sign * now
+
+            n_inv = 0
+            if bj < 0:  # ball bi meets wall wid[bi]
+                wall = wid[bi]
+                if sticky:
+                    scale = radius[bi] + abs(pos[bi, 0]) + abs(pos[bi, 1])
+                    axis = 0 if wall < 2 else 1
+                    into = vel[bi, axis] < 0.0 if wall % 2 == 0 else vel[bi, axis] > 0.0
+                    if wall_gap(bi, wall, pos, radius, bounds) <= _CONTACT_TOL * scale and into:
+                        if omega[body[bi]] == 0.0:
+                            snap_to_wall(bi, wall, pos, radius, bounds)
+                        x, y = wall_point(bi, wall, pos, radius, bounds)
+                        record(imp, n_imp, sc, t_abs, bi, -1, wall, x, y, abs(vel[bi, axis]))
+                        root = body[bi]
+                        for k in range(n):
+                            if body[k] == root:
+                                involved[n_inv] = k
+                                n_inv += 1
+                        stop_body(bi, vel, body, omega)
+                    else:
+                        involved[0] = bi
+                        n_inv = 1
+                else:
+                    snap_to_wall(bi, wall, pos, radius, bounds)
+                    speed = ball_wall(bi, wall, vel, e, u_min)
+                    if speed > 0.0:
+                        x, y = wall_point(bi, wall, pos, radius, bounds)
+                        record(imp, n_imp, sc, t_abs, bi, -1, wall, x, y, speed)
+                    involved[0] = bi
+                    n_inv = 1
+                    if cascades and speed > 0.0:
+                        n_inv = _resolve_contact_group(
+                            sc, t_abs, bi, -1, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, u_min,
+                            imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit,
+                        )
+            else:  # balls bi and bj meet
+                dx = pos[bj, 0] - pos[bi, 0]
+                dy = pos[bj, 1] - pos[bi, 1]
+                dist = math.sqrt(dx * dx + dy * dy)
+                sigma = radius[bi] + radius[bj]
+                closing = (vel[bj, 0] - vel[bi, 0]) * dx + (vel[bj, 1] - vel[bi, 1]) * dy
+                if sticky:
+                    scale = sigma + abs(pos[bi, 0]) + abs(pos[bi, 1])
+                    if dist - sigma <= _CONTACT_TOL * scale and closing < 0.0:
+                        x = pos[bi, 0] + radius[bi] * dx / dist
+                        y = pos[bi, 1] + radius[bi] * dy / dist
+                        record(imp, n_imp, sc, t_abs, bi, bj, -1, x, y, -closing / dist)
+                        root = merge_bodies(bi, bj, pos, vel, mass, body, omega)
+                        for k in range(n):
+                            if body[k] == root:
+                                involved[n_inv] = k
+                                n_inv += 1
+                        rot = has_rotation(body, omega)
+                    else:
+                        involved[0] = bi
+                        involved[1] = bj
+                        n_inv = 2
+                else:
+                    speed = ball_ball(bi, bj, pos, vel, inv_mass, e, u_min)
+                    if speed > 0.0:
+                        x = pos[bi, 0] + radius[bi] * dx / dist
+                        y = pos[bi, 1] + radius[bi] * dy / dist
+                        record(imp, n_imp, sc, t_abs, bi, bj, -1, x, y, speed)
+                    involved[0] = bi
+                    involved[1] = bj
+                    n_inv = 2
+                    if cascades and speed > 0.0:
+                        n_inv = _resolve_contact_group(
+                            sc, t_abs, bi, bj, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, u_min,
+                            imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit,
+                        )
+            if sticky:
+                rot = has_rotation(body, omega)
+
+            # Re-predict what the event changed.
+            for q in range(n_inv):
+                i = involved[q]
+                flag[i] = True
+                if has_walls:
+                    wt[i], wid[i] = _predict_wall(
+                        i, now, horizon_end - now, pos, vel, mass, radius, body, omega, rot, bounds, dim, ki, counters
+                    )
+            if pairs:
+                for q in range(n_inv):
+                    i = involved[q]
+                    for k in range(n):
+                        if k != i and not (flag[k] and k < i):
+                            if rot:
+                                v = _predict_pair(
+                                    i, k, now, horizon_end - now, pos, vel, mass, radius, body, omega, rot, ki, kj,
+                                    counters,
+                                )
+                            else:
+                                v = _straight_pair(i, k, now, pos, vel, radius, body, counters)
+                            pt[i, k] = v
+                            pt[k, i] = v
+                for q in range(n_inv):
+                    _rescan(involved[q], pt, rmin, rarg)
+                for k in range(n):
+                    if flag[k]:
+                        continue
+                    stale = False
+                    for q in range(n_inv):
+                        i = involved[q]
+                        v = pt[k, i]
+                        if v < rmin[k]:
+                            rmin[k] = v
+                            rarg[k] = i
+                        elif rarg[k] == i and v > rmin[k]:
+                            stale = True
+                    if stale:
+                        _rescan(k, pt, rmin, rarg)
+            for q in range(n_inv):
+                flag[involved[q]] = False
+
+        if not (capped[sc] or stalled[sc]) and now < horizon_end:
+            advance_all(horizon_end - now, pos, vel, mass, body, omega, rot)
+            now = horizon_end
+        if now == horizon_end:
+            time[sc] = t0 + sign * horizon_end
+            remaining[sc] = 0.0
+        else:
+            time[sc] = t0 + sign * now
+            remaining[sc] = horizon_end - now
         n_stalled += stalled[sc]
         n_imp[1] += capped[sc]
         active[sc] = stalled[sc]
     return n_stalled
+
+

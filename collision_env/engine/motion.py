@@ -19,6 +19,17 @@ import math
 
 from ._jit import njit
 
+#: Last axis of the (B, N, 8) per-ball state: position (2), velocity (2), mass, 1 / mass, radius,
+#: and the angular velocity of the cluster the ball roots (see above).
+BALL_FIELDS = 8
+
+
+@njit(inline="always")
+def ball_views(balls):
+    """The per-ball state as views: pos, vel (B, N, 2), mass, inv_mass, radius, omega (B, N)."""
+    return (balls[:, :, 0:2], balls[:, :, 2:4], balls[:, :, 4], balls[:, :, 5], balls[:, :, 6],
+            balls[:, :, 7])
+
 
 @njit
 def body_kinematics(i, pos, vel, mass, body, omega):
@@ -79,7 +90,7 @@ def advance_body(root, dt, pos, vel, mass, body, omega):
             vel[k, 1] = vcy + w * rx
 
 
-@njit
+@njit(inline="always")
 def advance_all(dt, pos, vel, mass, body, omega, any_rotating):
     """Move every ball on by ``dt``: straight lines, and rigid rotation for spinning clusters."""
     n = pos.shape[0]
@@ -93,9 +104,73 @@ def advance_all(dt, pos, vel, mass, body, omega, any_rotating):
                 advance_body(r, dt, pos, vel, mass, body, omega)
 
 
-@njit
+@njit(inline="always")
 def has_rotation(body, omega):
     for r in range(body.shape[0]):
         if body[r] == r and omega[r] != 0.0:
             return True
     return False
+
+
+@njit
+def apply_impulses(balls, body, dv, sticky):
+    """Add ``dv`` to every ball's velocity as an impulse ``m dv`` at its centre.
+
+    A free ball's velocity just changes by ``dv``; an impulse on a member of a stuck cluster
+    changes the cluster's linear and angular velocity, and so every member's velocity (only
+    ``sticky`` scenes have clusters).
+    """
+    pos, vel, mass, _, _, omega = ball_views(balls)
+    n_scenes, n = pos.shape[0], pos.shape[1]
+    if not sticky:
+        for sc in range(n_scenes):
+            for i in range(n):
+                vel[sc, i, 0] += dv[sc, i, 0]
+                vel[sc, i, 1] += dv[sc, i, 1]
+        return
+    for sc in range(n_scenes):
+        for i in range(n):
+            if dv[sc, i, 0] == 0.0 and dv[sc, i, 1] == 0.0:
+                continue
+            root = body[sc, i]
+            if body[sc, i] == i and omega[sc, i] == 0.0:
+                alone = True
+                for k in range(n):
+                    if k != i and body[sc, k] == i:
+                        alone = False
+                        break
+                if alone:
+                    vel[sc, i, 0] += dv[sc, i, 0]
+                    vel[sc, i, 1] += dv[sc, i, 1]
+                    continue
+            m_tot = 0.0
+            cx = 0.0
+            cy = 0.0
+            vx = 0.0
+            vy = 0.0
+            for k in range(n):
+                if body[sc, k] == root:
+                    m = mass[sc, k]
+                    m_tot += m
+                    cx += m * pos[sc, k, 0]
+                    cy += m * pos[sc, k, 1]
+                    vx += m * vel[sc, k, 0]
+                    vy += m * vel[sc, k, 1]
+            cx /= m_tot
+            cy /= m_tot
+            jx = mass[sc, i] * dv[sc, i, 0]
+            jy = mass[sc, i] * dv[sc, i, 1]
+            vx = (vx + jx) / m_tot
+            vy = (vy + jy) / m_tot
+            inertia = 0.0
+            for k in range(n):
+                if body[sc, k] == root:
+                    inertia += mass[sc, k] * ((pos[sc, k, 0] - cx) ** 2 + (pos[sc, k, 1] - cy) ** 2)
+            w = omega[sc, root]
+            if inertia > 0.0:
+                w += ((pos[sc, i, 0] - cx) * jy - (pos[sc, i, 1] - cy) * jx) / inertia
+            omega[sc, root] = w
+            for k in range(n):
+                if body[sc, k] == root:
+                    vel[sc, k, 0] = vx - w * (pos[sc, k, 1] - cy)
+                    vel[sc, k, 1] = vy + w * (pos[sc, k, 0] - cx)

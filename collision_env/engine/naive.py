@@ -22,7 +22,7 @@ from .exact import EVENTS, PAIR_TESTS, WALL_TESTS, record, wall_point
 from .response import ball_ball, ball_wall, merge_bodies, stop_body
 
 
-@njit
+@njit(inline="always")
 def body_inverse_mass(i, mass, body):
     root = body[i]
     m_tot = 0.0
@@ -32,7 +32,7 @@ def body_inverse_mass(i, mass, body):
     return 1.0 / m_tot
 
 
-@njit
+@njit(inline="always")
 def shift_body(i, dx, dy, pos, body):
     root = body[i]
     for k in range(pos.shape[0]):
@@ -41,7 +41,7 @@ def shift_body(i, dx, dy, pos, body):
             pos[k, 1] += dy
 
 
-@njit
+@njit(inline="always")
 def contain(sc, t_abs, pos, vel, radius, body, omega, bounds, dim, e, u_min, sticky, imp, n_imp, counters):
     """Put every ball that ended up past a wall back on it; reflect it if it still moves outward."""
     n = pos.shape[0]
@@ -76,7 +76,7 @@ def contain(sc, t_abs, pos, vel, radius, body, omega, bounds, dim, e, u_min, sti
                 counters[EVENTS] += 1
 
 
-@njit
+@njit(inline="always")
 def resolve_naive(sc, t_abs, pos, vel, mass, inv_mass, radius, body, omega, bounds, dim, e, u_min,
                   has_walls, pairs, sticky, imp, n_imp, counters):
     n = pos.shape[0]

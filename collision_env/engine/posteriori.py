@@ -29,7 +29,7 @@ from .naive import contain, shift_body
 from .response import ball_ball, ball_wall, merge_bodies, stop_body
 
 
-@njit
+@njit(inline="always")
 def _move(i, dt, pos, vel, mass, body, omega):
     """Move ball ``i``'s body by ``dt`` (negative: rewind), leaving the other balls in place."""
     root = body[i]
@@ -56,7 +56,7 @@ def overlap_time_pair(dx, dy, dvx, dvy, sigma):
     return c / (b - sq)
 
 
-@njit
+@njit(inline="always")
 def overlap_time_border(x, y, vx, vy, r, bounds, dim):
     """The seed note's ``|ds|^2 / (v . ds)``, with the overshoot vector ``ds`` it uses."""
     cx = min(max(x, bounds[0] + r), bounds[2] - r)
@@ -68,7 +68,7 @@ def overlap_time_border(x, y, vx, vy, r, bounds, dim):
     return t, dsx, dsy
 
 
-@njit
+@njit(inline="always")
 def resolve_posteriori(sc, t_end, sign, h, pos, vel, mass, inv_mass, radius, body, omega, bounds, dim, e, u_min,
                        has_walls, pairs, sticky, imp, n_imp, counters):
     n = pos.shape[0]

@@ -46,7 +46,7 @@ import math
 from ._jit import njit
 
 
-@njit
+@njit(inline="always")
 def elastic_threshold(vel, collapse_ratio, collapse_floor):
     """``u_min`` for one scene: the closing speed at or below which a collision is elastic."""
     fastest = 0.0
@@ -55,13 +55,13 @@ def elastic_threshold(vel, collapse_ratio, collapse_floor):
     return max(collapse_ratio * math.sqrt(fastest), collapse_floor)
 
 
-@njit
+@njit(inline="always")
 def separation_speed(closing_speed, e, u_min):
     """Normal speed at which a collision leaves the pair separating (see the regulariser)."""
     return e * closing_speed if closing_speed > u_min else u_min
 
 
-@njit
+@njit(inline="always")
 def ball_ball(i, j, pos, vel, inv_mass, e, u_min):
     """Apply the impulse between balls ``i`` and ``j``. Returns the closing speed (0: no impulse)."""
     dx = pos[j, 0] - pos[i, 0]
@@ -85,7 +85,7 @@ def ball_ball(i, j, pos, vel, inv_mass, e, u_min):
     return -u
 
 
-@njit
+@njit(inline="always")
 def ball_wall(i, wall, vel, e, u_min):
     """Reflect the normal component of ball ``i``'s velocity off ``wall``. Returns the closing speed."""
     axis = 0 if wall < 2 else 1
@@ -146,7 +146,7 @@ def merge_bodies(i, j, pos, vel, mass, body, omega):
     return root
 
 
-@njit
+@njit(inline="always")
 def stop_body(i, vel, body, omega):
     """A stuck ball or cluster touching a wall stops dead and comes apart (PhET)."""
     root = body[i]

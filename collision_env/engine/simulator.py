@@ -11,11 +11,22 @@ import copy
 import math
 import warnings
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from ._jit import BACKEND, njit
-from .exact import CLUSTER_TESTS, EVENTS, PAIR_TESTS, WALL_TESTS, step_exact
+from .exact import (
+    CLUSTER_TESTS,
+    EVENTS,
+    PAIR_TESTS,
+    WALL_TESTS,
+    WORK_F,
+    WORK_I,
+    scratch_sizes,
+    step_exact,
+)
+from .motion import BALL_FIELDS, apply_impulses
 from .scene import CONSTANT_RADIUS, WALL_NAMES, Scene, radius_from_mass
 from .substep import NAIVE, POSTERIORI, step_substeps, worst_case_impacts
 
@@ -39,6 +50,17 @@ IMPACT_DTYPE = np.dtype(
 _CONTACT_RTOL = 1e-12
 
 
+class LiveArrays(NamedTuple):
+    """The engine's own state arrays (not copies): see :meth:`BatchSimulator.live_arrays`."""
+
+    balls: np.ndarray  #: (B, N, 8) per-ball state, laid out as ``motion.BALL_FIELDS``
+    positions: np.ndarray  #: (B, N, 2) view of ``balls``
+    velocities: np.ndarray  #: (B, N, 2) view of ``balls``
+    time: np.ndarray  #: (B,) clocks
+    clusters: np.ndarray  #: (B, N) root ball of each ball's cluster
+    capped: np.ndarray  #: (B,) the last step stopped at the event cap
+
+
 class EventCapWarning(RuntimeWarning):
     """A scene reached the cap on events per step and stopped early (in a valid state)."""
 
@@ -56,59 +78,22 @@ class Impact:
 
 
 @njit
-def _apply_impulses(pos, vel, mass, body, omega, dv):
-    """Add ``dv`` to every ball's velocity as an impulse ``m dv`` at its centre.
-
-    A free ball's velocity just changes by ``dv``; an impulse on a member of a stuck cluster
-    changes the cluster's linear and angular velocity, and so every member's velocity.
-    """
-    n_scenes, n = pos.shape[0], pos.shape[1]
-    for sc in range(n_scenes):
-        for i in range(n):
-            if dv[sc, i, 0] == 0.0 and dv[sc, i, 1] == 0.0:
-                continue
-            root = body[sc, i]
-            if body[sc, i] == i and omega[sc, i] == 0.0:
-                alone = True
-                for k in range(n):
-                    if k != i and body[sc, k] == i:
-                        alone = False
-                        break
-                if alone:
-                    vel[sc, i, 0] += dv[sc, i, 0]
-                    vel[sc, i, 1] += dv[sc, i, 1]
-                    continue
-            m_tot = 0.0
-            cx = 0.0
-            cy = 0.0
-            vx = 0.0
-            vy = 0.0
-            for k in range(n):
-                if body[sc, k] == root:
-                    m = mass[sc, k]
-                    m_tot += m
-                    cx += m * pos[sc, k, 0]
-                    cy += m * pos[sc, k, 1]
-                    vx += m * vel[sc, k, 0]
-                    vy += m * vel[sc, k, 1]
-            cx /= m_tot
-            cy /= m_tot
-            jx = mass[sc, i] * dv[sc, i, 0]
-            jy = mass[sc, i] * dv[sc, i, 1]
-            vx = (vx + jx) / m_tot
-            vy = (vy + jy) / m_tot
-            inertia = 0.0
-            for k in range(n):
-                if body[sc, k] == root:
-                    inertia += mass[sc, k] * ((pos[sc, k, 0] - cx) ** 2 + (pos[sc, k, 1] - cy) ** 2)
-            w = omega[sc, root]
-            if inertia > 0.0:
-                w += ((pos[sc, i, 0] - cx) * jy - (pos[sc, i, 1] - cy) * jx) / inertia
-            omega[sc, root] = w
-            for k in range(n):
-                if body[sc, k] == root:
-                    vel[sc, k, 0] = vx - w * (pos[sc, k, 1] - cy)
-                    vel[sc, k, 1] = vy + w * (pos[sc, k, 0] - cx)
+def _copy_impacts(buf, out, sign, sort):
+    """Copy the first ``len(out)`` impact records of ``buf`` into ``out``; with ``sort``, order each
+    scene's records by ``sign * time`` (stable, so simultaneous impacts keep their order). The
+    rows of one scene are contiguous and scenes come in order, so an insertion sort is linear here."""
+    n = out.shape[0]
+    for k in range(n):
+        out[k] = buf[k]
+    if not sort:
+        return
+    for k in range(1, n):
+        j = k
+        while j > 0 and out[j - 1]["scene"] == out[j]["scene"] and sign * out[j - 1]["time"] > sign * out[j]["time"]:
+            buf[0] = out[j]  # swap through row 0 of the buffer, which is copied out already
+            out[j] = out[j - 1]
+            out[j - 1] = buf[0]
+            j -= 1
 
 
 def _as_array(value, shape, field, label):
@@ -183,13 +168,16 @@ class BatchSimulator:
         self._n_scenes = n_scenes
         self._n = n
         pos, vel, mass, radius = self._checked_balls(np.arange(n_scenes), positions, velocities, masses, radii)
-        self._pos = pos
-        self._vel = vel
-        self._mass = mass
-        self._inv_mass = 1.0 / mass
-        self._radius = radius
+        # Every per-ball float lives in one (B, N, 8) array, _pos, _vel, ... are views into it: each
+        # array handed to a kernel costs ~0.1 us per call, which is most of a small scene's step.
+        self._balls = np.zeros((n_scenes, n, BALL_FIELDS))
+        self._bind_views()
+        self._pos[...] = pos
+        self._vel[...] = vel
+        self._mass[...] = mass
+        self._inv_mass[...] = 1.0 / mass
+        self._radius[...] = radius
         self._body = np.tile(np.arange(n, dtype=np.int64), (n_scenes, 1))
-        self._omega = np.zeros((n_scenes, n))
         self._time = np.zeros(n_scenes)
         self._capped = np.zeros(n_scenes, dtype=np.bool_)
         self._counters = np.zeros(4, dtype=np.int64)
@@ -267,17 +255,34 @@ class BatchSimulator:
         return pos, vel, m, r
 
     # ------------------------------------------------------------------ stepping
+    def _bind_views(self):
+        b = self._balls
+        self._pos = b[..., 0:2]
+        self._vel = b[..., 2:4]
+        self._mass = b[..., 4]
+        self._inv_mass = b[..., 5]
+        self._radius = b[..., 6]
+        self._omega = b[..., 7]
+
     def _alloc_work(self):
         b = self._n_scenes
         rows = max(4096, 2 * worst_case_impacts(self._n))
-        self._imp = np.empty((rows, 8))
+        self._imp = np.empty(rows, dtype=IMPACT_DTYPE)
         self._n_imp = np.zeros(2, dtype=np.int64)  # rows filled, scenes that reached the cap
-        self._remaining = np.empty(b)
-        self._events = np.empty(b, dtype=np.int64)
-        self._active = np.zeros(b, dtype=np.bool_)
-        self._stalled = np.zeros(b, dtype=np.bool_)
-        self._t_start = np.empty(b)
-        self._done = np.empty(b, dtype=np.int64)
+        self._work_f = np.zeros((b, WORK_F))  # per scene: time left in the step, sub-step start time
+        self._work_i = np.zeros((b, WORK_I), dtype=np.int64)  # per scene: events, active, stalled, sub-steps done
+        # the mode's kernel and its arguments, bound once (the arrays are only ever updated in place)
+        state = (self._balls, self._body, self._time, self._capped, self._fparams, self._iparams, self._imp,
+                 self._n_imp, self._counters, self._work_f, self._work_i)
+        if self.mode == "exact":
+            nf, ni, nb = scratch_sizes(self._n)
+            self._kernel = step_exact
+            self._kernel_args = state + (np.empty(nf), np.empty(ni, dtype=np.int64), np.zeros(nb, dtype=np.bool_))
+        else:
+            self._kernel = step_substeps
+            self._kernel_args = (NAIVE if self.mode == "naive" else POSTERIORI, self.substeps) + state
+        self._sign = 1.0
+        self._live = LiveArrays(self._balls, self._pos, self._vel, self._time, self._body, self._capped)
 
     def step(self, dt):
         """Advance every scene by ``dt`` seconds (``dt < 0`` runs time backwards).
@@ -299,9 +304,11 @@ class BatchSimulator:
             self._capped[:] = False
             return np.zeros(0, dtype=IMPACT_DTYPE)
         sign = 1.0 if dt > 0.0 else -1.0
-        fp = self._fparams
-        fp[4] = e if sign > 0 else 1.0 / e
-        fp[6] = sign
+        if sign != self._sign:  # reverse steps use 1/e
+            fp = self._fparams
+            fp[4] = e if sign > 0 else 1.0 / e
+            fp[6] = sign
+            self._sign = sign
         if sign < 0:
             np.negative(self._vel, out=self._vel)
             np.negative(self._omega, out=self._omega)
@@ -323,23 +330,16 @@ class BatchSimulator:
     def _run(self, dt_abs):
         chunks = []
         fresh = True
-        while True:
-            self._n_imp[0] = 0
-            if self.mode == "exact":
-                stalled = step_exact(
-                    self._pos, self._vel, self._mass, self._inv_mass, self._radius, self._body, self._omega,
-                    self._time, self._remaining, self._events, self._active, self._fparams, self._iparams,
-                    self._imp, self._n_imp, self._stalled, self._capped, self._counters, dt_abs, fresh,
-                )
-            else:
-                stalled = step_substeps(
-                    NAIVE if self.mode == "naive" else POSTERIORI, self._pos, self._vel, self._mass,
-                    self._inv_mass, self._radius, self._body, self._omega, self._time, self._t_start, self._done,
-                    self._active, self._fparams, self._iparams, dt_abs, self.substeps, self._imp, self._n_imp,
-                    self._stalled, self._counters, fresh,
-                )
-            if self._n_imp[0]:
-                chunks.append(self._imp[: self._n_imp[0]].copy())
+        kernel, args, n_imp = self._kernel, self._kernel_args, self._n_imp
+        while True:  # each call resets n_imp[0] and fills the impact buffer from row 0
+            stalled = kernel(*args, dt_abs, fresh)
+            rows = n_imp[0]
+            if rows:
+                out = np.empty(rows, dtype=IMPACT_DTYPE)
+                # exact mode records each scene's impacts in the order they happen, scenes in order;
+                # the cheap modes' reconstructed times need sorting within each scene
+                _copy_impacts(self._imp, out, self._sign, kernel is step_substeps)
+                chunks.append(out)
             if not stalled:
                 return chunks
             fresh = False
@@ -347,13 +347,11 @@ class BatchSimulator:
     @staticmethod
     def _impacts(chunks, sign):
         if not chunks:
-            return np.zeros(0, dtype=IMPACT_DTYPE)
-        rows = chunks[0] if len(chunks) == 1 else np.concatenate(chunks)
-        out = np.empty(len(rows), dtype=IMPACT_DTYPE)
-        for k, name in enumerate(IMPACT_DTYPE.names):
-            out[name] = rows[:, k]
-        order = np.lexsort((sign * out["time"], out["scene"]))
-        return out[order]
+            return np.empty(0, dtype=IMPACT_DTYPE)
+        if len(chunks) == 1:
+            return chunks[0]
+        out = np.concatenate(chunks)  # a stalled step: a scene's impacts may span chunks
+        return out[np.lexsort((sign * out["time"], out["scene"]))]
 
     # ------------------------------------------------------------------ state access
     @property
@@ -393,6 +391,12 @@ class BatchSimulator:
     def cap_reached(self):
         """``(B,)`` bool: the event cap stopped that scene's last step early."""
         return self._capped.copy()
+
+    def live_arrays(self) -> LiveArrays:
+        """The engine's own state arrays, not copies, for compiled kernels that read them every
+        step (the envs' kernels). Every step updates them in place. Treat them as read-only, except
+        through the engine's own kernels (``motion.apply_impulses`` is how the envs nudge)."""
+        return self._live
 
     @property
     def models(self):
@@ -444,10 +448,7 @@ class BatchSimulator:
             if self.scene.dimension == 1 and dv[..., 1].any():
                 s, i = np.argwhere(dv[..., 1] != 0.0)[0]
                 raise ValueError(f"{self._label(s, i)}nudge y must be 0 in a 1D scene, got {dv[s, i, 1]}")
-        if self.scene.sticky:
-            _apply_impulses(self._pos, self._vel, self._mass, self._body, self._omega, dv)
-        else:
-            self._vel += dv
+        apply_impulses(self._balls, self._body, dv, self.scene.sticky)
 
     def set_scenes(self, index, positions, velocities, masses=None, radii=None, time=0.0):
         """Start the scenes picked by ``index`` (indices or a ``(B,)`` bool mask) afresh.
@@ -512,12 +513,16 @@ class BatchSimulator:
 
     def __getstate__(self):
         state = self.__dict__.copy()
-        for key in ("_imp", "_n_imp", "_remaining", "_events", "_active", "_stalled", "_t_start", "_done"):
+        for key in ("_imp", "_n_imp", "_work_f", "_work_i", "_kernel", "_kernel_args", "_sign", "_live",
+                    "_pos", "_vel", "_mass", "_inv_mass", "_radius", "_omega"):
             state.pop(key)
         return state
 
     def __setstate__(self, state):
         self.__dict__.update(state)
+        self._fparams[4] = self.scene.elasticity  # the forward state (reverse steps set it per step)
+        self._fparams[6] = 1.0
+        self._bind_views()
         self._alloc_work()
 
     def __deepcopy__(self, memo):

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ._jit import njit
-from .motion import advance_all, has_rotation
+from .motion import advance_all, ball_views, has_rotation
 from .naive import resolve_naive
 from .posteriori import resolve_posteriori
 from .response import elastic_threshold
@@ -17,16 +17,21 @@ def worst_case_impacts(n):
 
 
 @njit
-def step_substeps(
-    mode, pos, vel, mass, inv_mass, radius, body, omega, time, t_start, done, active,
-    fparams, iparams, dt_abs, k_total, imp, n_imp, stalled, counters, fresh,
-):
+def step_substeps(mode, k_total, balls, body, time, capped, fparams, iparams, imp, n_imp, counters, work_f, work_i,
+                  dt_abs, fresh):
     """Run the remaining sub-steps of every active scene (``done[sc]`` of ``k_total`` are done).
 
-    Parameters as :func:`exact.step_exact` (``fresh`` starts a step for every scene); a scene
-    stops between sub-steps when the impact buffer could not hold another sub-step's worst case,
-    and is flagged in ``stalled``. Returns the number of stalled scenes.
+    Parameters as :func:`exact.step_exact` (``fresh`` starts a step for every scene; ``capped``
+    is not used: the cheap modes have no event cap); a scene stops between sub-steps when the
+    impact buffer could not hold another sub-step's worst case, and is flagged stalled. Returns
+    the number of stalled scenes.
     """
+    pos, vel, mass, inv_mass, radius, omega = ball_views(balls)
+    t_start = work_f[:, 1]
+    active = work_i[:, 1]
+    stalled = work_i[:, 2]
+    done = work_i[:, 3]
+    n_imp[0] = 0
     n = pos.shape[1]
     worst = n * (n - 1) // 2 + 4 * n
     bounds = fparams[0:4]

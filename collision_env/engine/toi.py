@@ -50,7 +50,7 @@ def toi_pair(dx, dy, dvx, dvy, sigma):
     return c / (-b + math.sqrt(disc))
 
 
-@njit
+@njit(inline="always")
 def toi_wall_axis(x, v, r, lo, hi):
     """Time until a ball moving along one axis touches the wall it heads for, and that wall.
 
@@ -66,7 +66,7 @@ def toi_wall_axis(x, v, r, lo, hi):
     return INF, -1
 
 
-@njit
+@njit(inline="always")
 def toi_wall(x, y, vx, vy, r, bounds, dim):
     """First wall a ball in straight-line motion touches: ``(t, wall)``, wall 0..3 or -1.
 

@@ -174,7 +174,13 @@ def sample_episode(cfg: TaskConfig, rng: np.random.Generator) -> Episodes:
 
 
 class TaskCore:
-    """A batch of B task instances on one BatchSimulator."""
+    """A batch of B task instances on one BatchSimulator.
+
+    The task state is packed into a few arrays (see ``_kernels``: ``S`` per-scene floats, ``C``
+    per-scene counters and flags, ``T`` per-target wall and status, ``t_geo`` per-target geometry,
+    ``BF`` per-ball mass and radius, ``body`` the cluster mirror), because each array a compiled
+    kernel takes costs time to pass on every step. The named properties below are views into them.
+    """
 
     def __init__(self, cfg: TaskConfig, num_scenes: int):
         from collision_env.engine import IMPACT_DTYPE, BatchSimulator, Scene
@@ -201,29 +207,21 @@ class TaskCore:
         self.Q[K.Q_CLUSTER] = int(cfg.scorers == "cluster")
         self.Q[K.Q_DIM] = cfg.dimension
         self.Q[K.Q_NSTEPS] = cfg.n_steps
+        self._cluster_scoring = cfg.scorers == "cluster"
+        self.Q[K.Q_STICKY] = int(self.scene.sticky)
         self.ctrl = np.array(cfg.controlled, dtype=np.int64)
         self.qual = cfg.scoring_mask
         self.obs_dim = cfg.obs_dim
         self.action_dim = cfg.action_dim
 
         # task state, one row per scene
-        self.masses = np.zeros((B, N))
-        self.radii = np.zeros((B, N))
-        self.t_wall = np.zeros((B, Kt), dtype=np.int64)
+        self.S = np.zeros((B, K.S_LEN))
+        self.C = np.zeros((B, K.C_LEN), dtype=np.int64)
+        self.T = np.zeros((B, Kt, K.T_LEN), dtype=np.int64)
         self.t_geo = np.zeros((B, Kt, 4))
-        self.t_status = np.zeros((B, Kt), dtype=np.int8)
-        self.cur = np.zeros(B, dtype=np.int64)
+        self.BF = np.zeros((B, N, 2))
         self.body = np.tile(np.arange(N, dtype=np.int64), (B, 1))
-        self.steps = np.zeros(B, dtype=np.int64)
-        self.phi = np.zeros(B)
-        # latest engine read-back (kept for the next nudge and for rendering)
-        self.pos = np.zeros((B, N, 2))
-        self.vel = np.zeros((B, N, 2))
-        self.time = np.zeros(B)
-        # scratch: the nudge and its cost (rewritten every step)
-        self._dv = np.zeros((B, N, 2))
-        self.nudge = np.zeros(B)  # requested |dv| of the last step, m/s (read by the envs' infos)
-        self._cost = np.zeros(B)
+        self._dv = np.zeros((B, N, 2))  # scratch: the nudge (rewritten every step)
 
         # A placeholder layout drawn from a fixed seed builds the engine now, so that bad engine
         # arguments fail at construction; reset() overwrites every scene.
@@ -234,20 +232,32 @@ class TaskCore:
                                     radii=rep(ep.radii), mode=cfg.mode, substeps=cfg.substeps,
                                     max_events=cfg.max_events)
         self._write_episode(np.arange(B), Episodes(*(rep(getattr(ep, f)) for f in Episodes.__slots__)))
-        self.pos = self.batch.positions
-        self.vel = self.batch.velocities
         self.impact_dtype = IMPACT_DTYPE
+
+    # views into the packed state (writable: they share memory with it)
+    t_wall = property(lambda self: self.T[..., K.T_WALL], doc="(B, K) target walls (codes 0..3).")
+    t_status = property(lambda self: self.T[..., K.T_STATUS], doc="(B, K) 0 pending, 1 hit, 2 failed.")
+    masses = property(lambda self: self.BF[..., K.BF_MASS], doc="(B, N) ball masses, kg.")
+    radii = property(lambda self: self.BF[..., K.BF_RADIUS], doc="(B, N) ball radii, m.")
+    cur = property(lambda self: self.C[:, K.C_CUR], doc="(B,) index of the current (sequential) target.")
+    steps = property(lambda self: self.C[:, K.C_STEPS], doc="(B,) control steps taken this episode.")
+    phi = property(lambda self: self.S[:, K.S_PHI], doc="(B,) aiming potential after the last step.")
+    nudge = property(lambda self: self.S[:, K.S_NUDGE], doc="(B,) requested |dv| of the last step, m/s.")
+    # the engine's state (copies)
+    pos = property(lambda self: self.batch.positions, doc="(B, N, 2) ball centres, m (a copy).")
+    vel = property(lambda self: self.batch.velocities, doc="(B, N, 2) ball velocities, m/s (a copy).")
+    time = property(lambda self: self.batch.time, doc="(B,) simulated time, s (a copy).")
 
     # ------------------------------------------------------------------------------------- #
     def _write_episode(self, idx: np.ndarray, eps: Episodes) -> None:
-        self.masses[idx] = eps.masses
-        self.radii[idx] = eps.radii
-        self.t_wall[idx] = eps.t_wall
+        self.BF[idx, :, K.BF_MASS] = eps.masses
+        self.BF[idx, :, K.BF_RADIUS] = eps.radii
+        self.T[idx, :, K.T_WALL] = eps.t_wall
+        self.T[idx, :, K.T_STATUS] = 0
         self.t_geo[idx] = eps.t_geo
-        self.t_status[idx] = 0
-        self.cur[idx] = 0
+        self.C[idx, K.C_CUR] = 0
+        self.C[idx, K.C_STEPS] = 0
         self.body[idx] = np.arange(self.cfg.n_balls)
-        self.steps[idx] = 0
 
     def reset_scenes(self, idx: np.ndarray, rngs: list) -> None:
         """Draw a new episode for scenes ``idx`` (one generator each) and load it into the engine."""
@@ -255,43 +265,45 @@ class TaskCore:
         self.batch.set_scenes(idx, eps.positions, eps.velocities, masses=eps.masses, radii=eps.radii, time=0.0)
         self._write_episode(idx, eps)
 
-    def advance(self, actions: np.ndarray, active: np.ndarray, dt: float):
+    def advance(self, actions: np.ndarray, active: np.ndarray, dt: float) -> np.ndarray:
         """Nudge (actions (B, A) float64; inactive rows get none) and step the engine by dt.
 
-        Returns the engine's impact records and the action cost per scene (a scratch array,
-        valid until the next call); ``self.nudge`` holds the requested |dv| per scene (m/s).
-        An action with NaN raises ValueError and changes nothing.
+        Returns the engine's impact records; the nudge's size and cost per scene are in ``S``
+        (``nudge`` is the size, m/s). An action with NaN raises ValueError and changes nothing.
         """
-        bad = K.nudge_kernel(actions, active, self.vel, self.ctrl, self.P, self.Q, self._dv, self.nudge, self._cost)
+        live = self.batch.live_arrays()
+        # scales the actions and nudges the engine's balls (finite values, y = 0 in 1D)
+        bad = K.nudge_kernel(actions, active, live.balls, live.clusters, self.ctrl, self.P, self.Q, self._dv, self.S)
         if bad >= 0:
             where = f"sub-env {bad}: " if self.num_scenes > 1 else ""
             raise ValueError(f"{where}action contains NaN: {actions[bad].tolist()}")
-        self.batch.nudge(self._dv, check=False)  # nudge_kernel wrote finite values, y = 0 in 1D
-        return self.batch.step(dt), self._cost
+        return self.batch.step(dt)
 
-    def finish(self, flags: np.ndarray, imp: np.ndarray, cost: np.ndarray, out=None):
-        """Read the engine back and run the task kernel. Returns (obs, reward, term, trunc, success, n_hit, energy)."""
-        B = self.num_scenes
-        self.pos = self.batch.positions
-        self.vel = self.batch.velocities
-        self.time = self.batch.time
-        if out is None:
-            out = (np.zeros((B, self.obs_dim), dtype=np.float32), np.zeros(B), np.zeros(B, dtype=bool),
-                   np.zeros(B, dtype=bool), np.zeros(B, dtype=bool), np.zeros(B, dtype=np.int64), np.zeros(B))
-        obs, reward, term, trunc, success, n_hit, energy = out
-        clusters = self.batch.clusters if self.Q[K.Q_CLUSTER] else self.body
-        K.task_kernel(flags, imp, self.t_wall, self.t_geo, self.t_status, self.cur, self.qual, self.body,
-                      clusters, self.pos, self.vel, self.masses, self.radii, self.time, self.steps, cost, self.phi,
-                      self.P, self.Q, obs, reward, term, trunc, success, n_hit, energy)
-        return out
+    def finish(self, flags: np.ndarray, imp: np.ndarray, obs: np.ndarray) -> np.ndarray:
+        """Run the task kernel on the engine's state after a step; returns ``obs`` (written in place).
+
+        ``flags`` per scene as in ``_kernels``. Reward, energy, targets hit and the end flags are
+        then in ``S`` and ``C`` (see :meth:`outputs`).
+        """
+        live = self.batch.live_arrays()
+        K.task_kernel(flags, imp, live.positions, live.velocities, live.time,
+                      live.clusters if self._cluster_scoring else self.body, self.S,
+                      self.C, self.T, self.t_geo, self.BF, self.body, self.qual, self.P, self.Q, obs)
+        return obs
+
+    def outputs(self) -> tuple:
+        """Fresh ``(reward, terminated, truncated, success, targets_hit, energy, nudge)`` arrays (B,)."""
+        S, C = self.S, self.C
+        return (S[:, K.S_REWARD].copy(), C[:, K.C_TERM].astype(bool), C[:, K.C_TRUNC].astype(bool),
+                C[:, K.C_SUCCESS].astype(bool), C[:, K.C_NHIT].copy(), S[:, K.S_ENERGY].copy(),
+                S[:, K.S_NUDGE].copy())
 
     def empty_impacts(self) -> np.ndarray:
         """A fresh zero-length impact record array (the engine's dtype)."""
         return np.empty(0, dtype=self.impact_dtype)
 
     # ------------------------------------------------------------------------------------- #
-    _TASK_FIELDS = ("masses", "radii", "t_wall", "t_geo", "t_status", "cur", "body", "steps", "phi",
-                    "pos", "vel", "time")
+    _TASK_FIELDS = ("S", "C", "T", "t_geo", "BF", "body")
 
     def get_state(self) -> dict:
         state = {name: getattr(self, name).copy() for name in self._TASK_FIELDS}
@@ -299,10 +311,13 @@ class TaskCore:
         return state
 
     def set_state(self, state: dict) -> None:
-        self.batch.set_state(state["engine"])
-        for name in self._TASK_FIELDS:
+        arrays = {}
+        for name in self._TASK_FIELDS:  # check everything before changing anything
             arr = np.asarray(state[name])
             if arr.shape != getattr(self, name).shape:
                 raise ValueError(f"set_state: field {name!r} has shape {arr.shape}, "
                                  f"expected {getattr(self, name).shape}")
-            setattr(self, name, arr.astype(getattr(self, name).dtype, copy=True))
+            arrays[name] = arr
+        self.batch.set_state(state["engine"])
+        for name, arr in arrays.items():
+            np.copyto(getattr(self, name), arr, casting="unsafe")

@@ -18,6 +18,7 @@ import math
 import numpy as np
 
 from collision_env.engine._jit import njit
+from collision_env.engine.motion import apply_impulses
 
 # indices into the float parameter vector P
 P_XMIN, P_YMIN, P_XMAX, P_YMAX = 0, 1, 2, 3
@@ -26,13 +27,26 @@ P_VSCALE, P_MSCALE, P_TLIMIT = 8, 9, 10
 P_MAXDV, P_MAXSPEED, P_ACTCOST = 11, 12, 13
 P_LEN = 14
 # indices into the int parameter vector Q
-Q_SEQ, Q_CLUSTER, Q_DIM, Q_NSTEPS = 0, 1, 2, 3
-Q_LEN = 4
+Q_SEQ, Q_CLUSTER, Q_DIM, Q_NSTEPS, Q_STICKY = 0, 1, 2, 3, 4
+Q_LEN = 5
+# The per-scene task state lives in a few packed arrays, because every array handed to a
+# compiled kernel costs about 0.1 us to pass (a step passes them all, every control step).
+# columns of the per-scene float array S (B, S_LEN)
+S_PHI, S_NUDGE, S_COST, S_REWARD, S_ENERGY = 0, 1, 2, 3, 4
+S_LEN = 5
+# columns of the per-scene int array C (B, C_LEN)
+C_CUR, C_STEPS, C_NHIT, C_TERM, C_TRUNC, C_SUCCESS = 0, 1, 2, 3, 4, 5
+C_LEN = 6
+# last axis of the per-target int array T (B, K, T_LEN) and of the per-ball float array BF (B, N, 2)
+T_WALL, T_STATUS = 0, 1
+T_LEN = 2
+BF_MASS, BF_RADIUS = 0, 1
 
 
 @njit
-def nudge_kernel(actions, active, vel, ctrl, P, Q, dv, nudge, cost):  # pragma: no cover - numba
-    """Scale actions to velocity changes ``dv`` (B, N, 2), their size ``nudge`` (B,) and cost (B,).
+def nudge_kernel(actions, active, balls, body, ctrl, P, Q, dv, S):  # pragma: no cover - numba
+    """Scale actions to velocity changes ``dv`` (B, N, 2), their size ``S[:, S_NUDGE]`` and cost
+    ``S[:, S_COST]``, and apply them to the engine's balls with the engine's own impulse kernel.
 
     Returns -1, or the first active row holding a NaN (then nothing is written). Only the controlled
     balls' entries of ``dv`` are written (the others must be zero).
@@ -47,6 +61,7 @@ def nudge_kernel(actions, active, vel, ctrl, P, Q, dv, nudge, cost):  # pragma: 
             for c in range(actions.shape[1]):
                 if actions[b, c] != actions[b, c]:
                     return b  # NaN: reject the whole call before changing anything
+    vel = balls[:, :, 2:4]  # the engine's velocities (motion.ball_views)
     dim = Q[Q_DIM]
     max_dv = P[P_MAXDV]
     max_speed = P[P_MAXSPEED]
@@ -79,8 +94,9 @@ def nudge_kernel(actions, active, vel, ctrl, P, Q, dv, nudge, cost):  # pragma: 
                     ny *= f
                 dv[b, i, 0] = nx - vx
                 dv[b, i, 1] = ny - vy
-        nudge[b] = c_total
-        cost[b] = cost_per * c_total
+        S[b, S_NUDGE] = c_total
+        S[b, S_COST] = cost_per * c_total
+    apply_impulses(balls, body, dv, Q[Q_STICKY] != 0)
     return -1
 
 
@@ -111,19 +127,33 @@ def _in_cluster(body, b, i):  # pragma: no cover - numba
 
 
 @njit
-def task_kernel(flags, imp, t_wall, t_geo, t_status, cur, qual, body, clusters, pos, vel, masses,
-                radii, sim_time, steps, cost, phi, P, Q, obs, reward, terminated, truncated, success,
-                n_hit, energy):  # pragma: no cover - numba
+def task_kernel(flags, imp, pos, vel, sim_time, clusters, S, C, T, t_geo, BF, body, qual, P, Q,
+                obs):  # pragma: no cover - numba
     """Score a step's impacts, update target state, and write reward, flags and observation.
 
-    ``imp`` is the engine's impact record array for the batch (sorted by scene then time).
+    ``imp`` is the engine's impact record array for the batch (sorted by scene then time);
+    ``pos``, ``vel``, ``sim_time`` and ``clusters`` are the engine's state after the step.
     In cluster mode ``body`` mirrors the engine's cluster roots through the step, replayed from
     the impacts (a ball-ball impact merges two clusters, a wall impact stops the cluster and
     takes it apart, as the engine does), so a wall impact scores only if its ball was part of a
-    cluster at that instant; at the end ``body`` is set to the engine's ``clusters`` read-back.
-    Inputs that are updated in place: t_status, cur, body, steps, phi. Outputs are written only
-    for rows whose flag is 0 or 1.
+    cluster at that instant; at the end ``body`` is set to the engine's ``clusters``.
+    Updated in place: target status, current target, step count, body, phi. Written for rows
+    whose flag is 0 or 1: the observation, reward, energy, targets hit and the end flags.
     """
+    t_wall = T[:, :, T_WALL]
+    t_status = T[:, :, T_STATUS]
+    masses = BF[:, :, BF_MASS]
+    radii = BF[:, :, BF_RADIUS]
+    cur = C[:, C_CUR]
+    steps = C[:, C_STEPS]
+    n_hit = C[:, C_NHIT]
+    terminated = C[:, C_TERM]
+    truncated = C[:, C_TRUNC]
+    success = C[:, C_SUCCESS]
+    cost = S[:, S_COST]
+    phi = S[:, S_PHI]
+    reward = S[:, S_REWARD]
+    energy = S[:, S_ENERGY]
     B = flags.shape[0]
     N = pos.shape[1]
     K = t_wall.shape[1]

@@ -9,6 +9,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from collision_env.envs import _kernels as K
 from collision_env.envs._config import PRESETS, TaskConfig, make_config
 from collision_env.envs._core import Impacts, TaskCore
 
@@ -120,17 +121,20 @@ class CollisionTargetEnv(gym.Env):
         self._ones = np.ones(1, dtype=bool)
         self._reset_flag = np.zeros(1, dtype=np.int8)
         self._step_flag = np.ones(1, dtype=np.int8)
-        self._zero_cost = np.zeros(1)
         self._adim = cfg.action_dim
+        self._action = np.zeros((1, cfg.action_dim))
         self._dt = cfg.dt
-        # scalar outputs are read into Python values at once, so their buffers are reused
-        self._scratch = (np.zeros(1), np.zeros(1, dtype=bool), np.zeros(1, dtype=bool), np.zeros(1, dtype=bool),
-                         np.zeros(1, dtype=np.int64), np.zeros(1))
         self._trails = bool(trails)
         self._renderer = None
 
-    def _out(self):
-        return (np.empty((1, self._core.obs_dim), dtype=np.float32), *self._scratch)
+    def _obs(self):
+        return np.empty((1, self._core.obs_dim), dtype=np.float32)  # fresh on every call
+
+    def _scalars(self) -> tuple:
+        """This step's (reward, terminated, truncated, success, targets hit, energy, nudge) as Python values."""
+        S, C = self._core.S[0].tolist(), self._core.C[0].tolist()
+        return (S[K.S_REWARD], bool(C[K.C_TERM]), bool(C[K.C_TRUNC]), bool(C[K.C_SUCCESS]), C[K.C_NHIT],
+                S[K.S_ENERGY], S[K.S_NUDGE])
 
     # ------------------------------------------------------------------------------------- #
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
@@ -138,9 +142,10 @@ class CollisionTargetEnv(gym.Env):
         core = self._core
         core.reset_scenes(np.zeros(1, dtype=np.int64), [self.np_random])
         imp = core.empty_impacts()
-        obs, _, _, _, _, n_hit, energy = core.finish(self._reset_flag, imp, self._zero_cost, out=self._out())
-        info = {"impacts": Impacts(imp), "event_cap": False, "nudge": 0.0, "energy": float(energy[0]),
-                "time": float(core.time[0]), "targets_hit": int(n_hit[0]), "is_success": False}
+        obs = core.finish(self._reset_flag, imp, self._obs())
+        _, _, _, _, n_hit, energy, _ = self._scalars()
+        info = {"impacts": Impacts(imp), "event_cap": False, "nudge": 0.0, "energy": energy,
+                "time": float(core.batch.live_arrays().time[0]), "targets_hit": n_hit, "is_success": False}
         if self.render_mode is not None:
             self._get_renderer().start()  # trails and flashes are recorded from the episode start
         if self.render_mode == "human":
@@ -148,20 +153,25 @@ class CollisionTargetEnv(gym.Env):
         return obs[0], info
 
     def step(self, action):
-        a = np.asarray(action, dtype=np.float64)
-        if a.size != self._adim:
-            raise ValueError(f"action: expected shape {self.action_space.shape}, got {a.shape}")
+        a = self._action  # (1, A) float64, the kernel's input (reused: the kernel only reads it)
+        if getattr(action, "shape", None) == self.action_space.shape:
+            a[0] = action
+        elif np.size(action) == self._adim:
+            a[0] = np.ravel(action)
+        else:
+            raise ValueError(f"action: expected shape {self.action_space.shape}, got {np.shape(action)}")
         core = self._core
-        imp, cost = core.advance(a.reshape(1, self._adim), self._ones, self._dt)  # raises on NaN
-        obs, reward, term, trunc, success, n_hit, energy = core.finish(self._step_flag, imp, cost, out=self._out())
-        info = {"impacts": Impacts(imp), "event_cap": bool(core.batch.cap_reached[0]),
-                "nudge": float(core.nudge[0]), "energy": float(energy[0]), "time": float(core.time[0]),
-                "targets_hit": int(n_hit[0]), "is_success": bool(success[0])}
+        imp = core.advance(a, self._ones, self._dt)  # raises on NaN
+        obs = core.finish(self._step_flag, imp, self._obs())
+        reward, term, trunc, success, n_hit, energy, nudge = self._scalars()
+        live = core.batch.live_arrays()
+        info = {"impacts": Impacts(imp), "event_cap": bool(live.capped[0]), "nudge": nudge, "energy": energy,
+                "time": float(live.time[0]), "targets_hit": n_hit, "is_success": success}
         if self._renderer is not None:
             self._renderer.record(core, 0, imp)
         if self.render_mode == "human":
             self.render()
-        return obs[0], float(reward[0]), bool(term[0]), bool(trunc[0]), info
+        return obs[0], reward, term, trunc, info
 
     # ------------------------------------------------------------------------------------- #
     def render(self):

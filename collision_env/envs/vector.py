@@ -106,7 +106,7 @@ class CollisionTargetVectorEnv(VectorEnv):
         n = self.num_envs
         info = {"impacts": Impacts(imp), "_impacts": np.ones(n, dtype=bool)}
         for key, value in (("event_cap", event_cap), ("nudge", nudge), ("energy", energy),
-                           ("time", self._core.time.copy()), ("targets_hit", n_hit), ("is_success", success)):
+                           ("time", self._core.time), ("targets_hit", n_hit), ("is_success", success)):
             info[key] = value
             info["_" + key] = np.ones(n, dtype=bool)
         return info
@@ -127,7 +127,8 @@ class CollisionTargetVectorEnv(VectorEnv):
         core.reset_scenes(idx, [self._rngs[i] for i in idx])
         flags = np.where(mask, 0, 3).astype(np.int8)  # the others are observed unchanged
         imp = core.empty_impacts()
-        obs, _, _, _, success, n_hit, energy = core.finish(flags, imp, np.zeros(self.num_envs), out=self._fresh_out())
+        obs = core.finish(flags, imp, self._fresh_obs())
+        _, _, _, success, n_hit, energy, _ = core.outputs()
         self._autoreset[mask] = False
         if self.render_mode is not None:
             renderers = self._get_renderers()
@@ -141,10 +142,8 @@ class CollisionTargetVectorEnv(VectorEnv):
             info["_impacts"] = mask.copy()
         return obs, info
 
-    def _fresh_out(self):
-        B, D = self.num_envs, self._core.obs_dim
-        return (np.zeros((B, D), dtype=np.float32), np.zeros(B), np.zeros(B, dtype=bool), np.zeros(B, dtype=bool),
-                np.zeros(B, dtype=bool), np.zeros(B, dtype=np.int64), np.zeros(B))
+    def _fresh_obs(self):
+        return np.zeros((self.num_envs, self._core.obs_dim), dtype=np.float32)
 
     def step(self, actions):
         if self._rngs[0] is None:
@@ -159,7 +158,7 @@ class CollisionTargetVectorEnv(VectorEnv):
             resetting = self._autoreset
             any_reset = bool(resetting.any())
             active = ~resetting if any_reset else self._all
-            imp, cost = core.advance(a, active, self.config.dt)
+            imp = core.advance(a, active, self.config.dt)
             event_cap = core.batch.cap_reached
             if any_reset:
                 idx = np.flatnonzero(resetting)
@@ -169,35 +168,35 @@ class CollisionTargetVectorEnv(VectorEnv):
                 event_cap &= active
             else:
                 flags = np.ones(B, dtype=np.int8)
-            obs, reward, term, trunc, success, n_hit, energy = core.finish(flags, imp, cost, out=self._fresh_out())
+            obs = core.finish(flags, imp, self._fresh_obs())
+            reward, term, trunc, success, n_hit, energy, nudge = core.outputs()
             if cap_limit is not None:
                 trunc |= (core.steps >= cap_limit) & active
             self._autoreset = term | trunc
-            info = self._info(energy, event_cap, core.nudge.copy(), success, n_hit, imp)
+            info = self._info(energy, event_cap, nudge, success, n_hit, imp)
             if self._renderers is not None:
                 self._record(imp, resetting if any_reset else None)
             return obs, reward, term, trunc, info
 
         # SAME_STEP: step everything, then reset the sub-envs that ended and report their last step
-        imp, cost = core.advance(a, self._all, self.config.dt)
+        imp = core.advance(a, self._all, self.config.dt)
         event_cap = core.batch.cap_reached
-        obs, reward, term, trunc, success, n_hit, energy = core.finish(
-            np.ones(B, dtype=np.int8), imp, cost, out=self._fresh_out())
+        obs = core.finish(np.ones(B, dtype=np.int8), imp, self._fresh_obs())
+        reward, term, trunc, success, n_hit, energy, nudge = core.outputs()
         if cap_limit is not None:
             trunc |= core.steps >= cap_limit
         done = term | trunc
         if self._renderers is not None:
             self._record(imp, None)
         if not done.any():
-            return obs, reward, term, trunc, self._info(energy, event_cap, core.nudge.copy(), success, n_hit, imp)
+            return obs, reward, term, trunc, self._info(energy, event_cap, nudge, success, n_hit, imp)
         idx = np.flatnonzero(done)
         in_done = done[imp["scene"]]
         final_obs = np.full(B, None, dtype=object)
         for i in idx:
             final_obs[i] = obs[i].copy()
         final_info = {"impacts": Impacts(imp[in_done]), "_impacts": done.copy()}
-        time_now = core.time.copy()
-        nudge = core.nudge.copy()
+        time_now = core.time
         for key, value in (("event_cap", event_cap), ("nudge", nudge), ("energy", energy), ("time", time_now),
                            ("targets_hit", n_hit), ("is_success", success)):
             v = np.zeros_like(value)
@@ -206,9 +205,8 @@ class CollisionTargetVectorEnv(VectorEnv):
             final_info["_" + key] = done.copy()
         core.reset_scenes(idx, [self._rngs[i] for i in idx])
         flags = np.where(done, 0, 2).astype(np.int8)
-        r_out = (obs, np.zeros(B), np.zeros(B, dtype=bool), np.zeros(B, dtype=bool), np.zeros(B, dtype=bool),
-                 np.zeros(B, dtype=np.int64), np.zeros(B))
-        _, _, _, _, r_success, r_hit, r_energy = core.finish(flags, imp[:0], np.zeros(B), out=r_out)
+        core.finish(flags, imp[:0], obs)  # the reset sub-envs' first observations, in place
+        _, _, _, _, r_hit, r_energy, _ = core.outputs()
         event_cap = event_cap & ~done
         energy = np.where(done, r_energy, energy)
         success = success & ~done

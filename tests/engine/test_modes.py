@@ -97,3 +97,24 @@ def test_cheap_modes_keep_balls_inside_the_border(mode):
         x, y = sim.positions[0]
         r = sim.radii[0]
         assert -2 + r <= x <= 2 - r and -1 + r <= y <= 1 - r
+
+
+@pytest.mark.parametrize("mode, substeps", [("naive", 1), ("posteriori", 1), ("posteriori", 3), ("exact", 1)])
+def test_batched_impacts_come_by_scene_then_in_the_order_they_happened(mode, substeps):
+    from collision_env.engine import BatchSimulator
+
+    rng = np.random.default_rng(3)
+    b, n = 3, 6
+    pos = np.stack([np.column_stack([np.linspace(-1.6, 1.6, n), rng.uniform(-0.6, 0.6, n)]) for _ in range(b)])
+    vel = rng.normal(size=(b, n, 2)) * 3.0
+    sim = BatchSimulator(Scene(elasticity=0.9), pos, vel, np.ones((b, n)), radii=np.full((b, n), 0.12), mode=mode,
+                         substeps=substeps)
+    seen = 0
+    for dt in [0.2] * 10 + [-0.2] * 5:
+        rows = sim.step(dt)
+        seen += len(rows)
+        assert np.all(np.diff(rows["scene"]) >= 0)
+        for s in range(b):
+            t = rows["time"][rows["scene"] == s]
+            assert np.all(np.diff(np.sign(dt) * t) >= 0)
+    assert seen > 30
