@@ -127,6 +127,11 @@ def _spread(values: list) -> str:
     return f"{pct(mean)} ± {100 * statistics.stdev(values):.0f}"
 
 
+def _seconds(rows: list) -> float:
+    """Median training wall-clock over seeds (a shared machine's noise hits single runs)."""
+    return statistics.median(r["train_seconds"] for r in rows)
+
+
 def _by_env_and_mode(rows: list) -> dict:
     """{env_id: {(mode, substeps): [rows sorted by seed]}} for the modes part, in run order."""
     out: dict = {}
@@ -145,22 +150,46 @@ def modes_table(rows: list) -> str:
         first = next(iter(groups.values()))[0]
         lines = [f"**`{env_id}`**: PPO with the shipped hyperparameters ({first['timesteps_done']:,} steps), "
                  f"trained under each engine mode, evaluated deterministically on the same {first['episodes']} "
-                 "episodes. Success: mean ± standard deviation over seeds, then each seed's figure.",
+                 "episodes. Success: mean ± standard deviation over seeds, then each seed's figure; training "
+                 "time: median over seeds.",
                  "",
                  "| trained in | success, evaluated exact | per seed | success in its own mode | "
                  "training time (s) | ÷ exact's |",
                  "|---|---:|---:|---:|---:|---:|"]
         exact_rows = groups.get(("exact", 1))
-        exact_time = statistics.fmean(r["train_seconds"] for r in exact_rows) if exact_rows else None
+        exact_time = _seconds(exact_rows) if exact_rows else None
         for (mode, k), rs in groups.items():
             exact = [r["exact"]["success_rate"] for r in rs]
             own = [r["own"]["success_rate"] for r in rs]
-            secs = statistics.fmean(r["train_seconds"] for r in rs)
+            secs = _seconds(rs)
             ratio = f"{secs / exact_time:.2f}" if exact_time else "n/a"
             lines.append(f"| {_label(mode, k)} | {_spread(exact)} | {' / '.join(pct(x) for x in exact)} | "
                          f"{_spread(own)} | {secs:.0f} | {ratio} |")
         tables.append("\n".join(lines))
     return "\n\n".join(tables)
+
+
+def modes_reading(rows: list) -> str:
+    """What the modes tables say, in words generated from the same figures."""
+    out = []
+    for env_id, groups in _by_env_and_mode(rows).items():
+        exact_rows = groups.get(("exact", 1))
+        cheap = {key: rs for key, rs in groups.items() if key != ("exact", 1)}
+        if not exact_rows or not cheap:
+            continue
+        ref = statistics.fmean(r["exact"]["success_rate"] for r in exact_rows)
+        diffs = [statistics.fmean(r["exact"]["success_rate"] for r in rs) - ref for rs in cheap.values()]
+        spread = max(statistics.stdev([r["exact"]["success_rate"] for r in rs]) if len(rs) > 1 else 0.0
+                     for rs in groups.values())
+        ratios = [_seconds(rs) / _seconds(exact_rows) for rs in cheap.values()]
+        worst = min(diffs)
+        verdict = ("within the seed-to-seed spread" if max(abs(d) for d in diffs) <= spread
+                   else f"at worst {100 * -worst:.0f} points below" if worst < 0 else "no worse")
+        out.append(f"- `{env_id}`: policies trained in the cheaper modes succeed in exact mode "
+                   f"{pct(ref + min(diffs))}–{pct(ref + max(diffs))} against exact-trained {pct(ref)}, "
+                   f"{verdict} (largest standard deviation over seeds {100 * spread:.0f} points), after "
+                   f"{min(ratios):.2f}–{max(ratios):.2f}× exact mode's training time.")
+    return "\n".join(out)
 
 
 def presets_table(rows: list, base: list) -> str:
@@ -171,7 +200,7 @@ def presets_table(rows: list, base: list) -> str:
     episodes = rows[0]["episodes"]
     lines = [f"Every preset, PPO in exact mode with the shipped hyperparameters, beside the baselines on the same "
              f"{episodes} evaluation episodes (success rate; mean return in brackets). PPO: mean ± standard "
-             "deviation over seeds, then each seed.",
+             "deviation over seeds, then each seed; training time: median over seeds.",
              "",
              "| env | steps | PPO success | per seed | PPO return | random | scripted (exact aim) "
              "| training time (s) |",
@@ -188,12 +217,13 @@ def presets_table(rows: list, base: list) -> str:
         fmt = lambda p: "n/a" if p is None else f"{pct(p['success_rate'])} ({p['mean_return']:.2f})"  # noqa: E731
         lines.append(f"| `{env_id}` | {rs[0]['timesteps_done']:,} | {_spread(succ)} | "
                      f"{' / '.join(pct(x) for x in succ)} | {ret:.2f} | {fmt(b.get('random'))} | "
-                     f"{fmt(b.get('scripted'))} | {statistics.fmean(r['train_seconds'] for r in rs):.0f} |")
+                     f"{fmt(b.get('scripted'))} | {_seconds(rs):.0f} |")
     return "\n".join(lines)
 
 
 def plot(rows: list, path: Path) -> Path | None:
-    """Per env: success evaluated exact and in its own mode (bars: means, dots: seeds), and training time."""
+    """Per env: success evaluated exact and in its own mode (bars: means, dots: seeds), and training time
+    (bars: medians)."""
     envs = _by_env_and_mode(rows)
     if not envs:
         return None
@@ -214,7 +244,7 @@ def plot(rows: list, path: Path) -> Path | None:
                     label="evaluated in its own mode" if i == 0 else None)
             ax1.plot([i - 0.2] * len(exact), exact, "k.", ms=6)
             ax1.plot([i + 0.2] * len(own), own, "k.", ms=6)
-            ax2.bar(i, statistics.fmean(r["train_seconds"] for r in rs), 0.6, color="tab:orange")
+            ax2.bar(i, _seconds(rs), 0.6, color="tab:orange")
             ax2.plot([i] * len(rs), [r["train_seconds"] for r in rs], "k.", ms=6)
         for ax in (ax1, ax2):
             ax.set_xticks(range(len(labels)), labels, rotation=15)
@@ -224,7 +254,7 @@ def plot(rows: list, path: Path) -> Path | None:
         ax1.set_title(f"{env_id}: success (dots: seeds)", fontsize=9)
         ax2.set_ylabel("training wall-clock (s)")
         steps = next(iter(groups.values()))[0]["timesteps_done"]
-        ax2.set_title(f"{env_id}: training time for {steps:,} steps", fontsize=9)
+        ax2.set_title(f"{env_id}: training time for {steps:,} steps (bar: median)", fontsize=9)
     axes[-1, 0].set_xlabel("trained in")
     axes[-1, 1].set_xlabel("trained in")
     fig.tight_layout()
@@ -246,13 +276,17 @@ def render(data: dict, docs: Path, readme: Path | None) -> None:
     presets = presets_table(data["rows"], data["baselines"])
     png = plot(data["rows"], docs / "modes.png")
     if modes:
-        (docs / "modes.md").write_text(f"# Train cheap, evaluate exact\n\n{stamp}\n\n{modes}\n")
+        reading = modes_reading(data["rows"])
+        (docs / "modes.md").write_text(f"# Train cheap, evaluate exact\n\n{stamp}\n\n{modes}\n\n{reading}\n")
     if presets:
         (docs / "presets.md").write_text(f"# Every preset against the baselines\n\n{stamp}\n\n{presets}\n")
     if readme is not None:
         parts = [stamp]
         if modes:
             parts.append(modes)
+            reading = modes_reading(data["rows"])
+            if reading:
+                parts.append("Read from these figures:\n\n" + reading)
         if png is not None:
             parts.append(f"![success and training time per training mode]({os.path.relpath(png, readme.parent)})")
         if presets:

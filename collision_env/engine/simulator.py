@@ -153,11 +153,11 @@ class BatchSimulator:
         if not (isinstance(collapse_floor, (int, float)) and 0.0 <= collapse_floor < math.inf):
             raise ValueError(f"collapse_floor: must be a finite speed >= 0 (m/s), got {collapse_floor!r}")
         self.scene = scene
-        self.mode = mode
-        self.substeps = int(substeps)
-        self.max_events = int(max_events)
-        self.collapse_ratio = float(collapse_ratio)
-        self.collapse_floor = float(collapse_floor)
+        self._mode = mode
+        self._substeps = int(substeps)
+        self._max_events = int(max_events)
+        self._collapse_ratio = float(collapse_ratio)
+        self._collapse_floor = float(collapse_floor)
 
         pos = np.array(positions, dtype=np.float64) if not isinstance(positions, np.ndarray) else positions
         if pos.ndim != 3 or pos.shape[-1] != 2:
@@ -281,7 +281,7 @@ class BatchSimulator:
         else:
             self._kernel = step_substeps
             self._kernel_args = (NAIVE if self.mode == "naive" else POSTERIORI, self.substeps) + state
-        self._sign = 1.0
+        self._sign = float(self._fparams[6])  # the direction _fparams are set for (see step)
         self._live = LiveArrays(self._balls, self._pos, self._vel, self._time, self._body, self._capped)
 
     def step(self, dt):
@@ -392,6 +392,14 @@ class BatchSimulator:
         """``(B,)`` bool: the event cap stopped that scene's last step early."""
         return self._capped.copy()
 
+    # the settings are fixed at construction: the kernels are bound to them (make a new simulator
+    # to change one; get_state/set_state carry a state across)
+    mode = property(lambda self: self._mode, doc='"naive", "posteriori" or "exact".')
+    substeps = property(lambda self: self._substeps, doc="Sub-steps per step (naive and posteriori).")
+    max_events = property(lambda self: self._max_events, doc="Event cap per step and scene (exact).")
+    collapse_ratio = property(lambda self: self._collapse_ratio, doc="Collapse regulariser: u_min / fastest speed.")
+    collapse_floor = property(lambda self: self._collapse_floor, doc="Collapse regulariser: smallest u_min, m/s.")
+
     def live_arrays(self) -> LiveArrays:
         """The engine's own state arrays, not copies, for compiled kernels that read them every
         step (the envs' kernels). Every step updates them in place. Treat them as read-only, except
@@ -436,8 +444,9 @@ class BatchSimulator:
 
         A member of a stuck cluster passes the impulse to the whole cluster (linear and angular).
         ``check=False`` skips validation, for callers that build ``dv`` as a float64 array of the
-        right shape with finite values (and zero y in 1D) themselves: the envs do, every control
-        step, where the checks would cost more than the nudge.
+        right shape with finite values (and zero y in 1D) themselves, where the checks would cost
+        more than the nudge. (The envs nudge from their own kernel, through ``motion.apply_impulses``,
+        the function this calls.)
         """
         if check:
             dv = _as_array(dv, (self._n_scenes, self._n, 2), "nudge", "")
@@ -520,8 +529,6 @@ class BatchSimulator:
 
     def __setstate__(self, state):
         self.__dict__.update(state)
-        self._fparams[4] = self.scene.elasticity  # the forward state (reverse steps set it per step)
-        self._fparams[6] = 1.0
         self._bind_views()
         self._alloc_work()
 

@@ -286,7 +286,7 @@ class TaskCore:
         then in ``S`` and ``C`` (see :meth:`outputs`).
         """
         live = self.batch.live_arrays()
-        K.task_kernel(flags, imp, live.positions, live.velocities, live.time,
+        K.task_kernel(flags, imp, live.balls, live.time,
                       live.clusters if self._cluster_scoring else self.body, self.S,
                       self.C, self.T, self.t_geo, self.BF, self.body, self.qual, self.P, self.Q, obs)
         return obs
@@ -313,6 +313,8 @@ class TaskCore:
     def set_state(self, state: dict) -> None:
         arrays = {}
         for name in self._TASK_FIELDS:  # check everything before changing anything
+            if name not in state:
+                raise ValueError(f"set_state: missing field {name!r} (a state from get_state of this version?)")
             arr = np.asarray(state[name])
             if arr.shape != getattr(self, name).shape:
                 raise ValueError(f"set_state: field {name!r} has shape {arr.shape}, "

@@ -18,7 +18,7 @@ import math
 import numpy as np
 
 from collision_env.engine._jit import njit
-from collision_env.engine.motion import apply_impulses
+from collision_env.engine.motion import apply_impulses, ball_views
 
 # indices into the float parameter vector P
 P_XMIN, P_YMIN, P_XMAX, P_YMAX = 0, 1, 2, 3
@@ -61,7 +61,7 @@ def nudge_kernel(actions, active, balls, body, ctrl, P, Q, dv, S):  # pragma: no
             for c in range(actions.shape[1]):
                 if actions[b, c] != actions[b, c]:
                     return b  # NaN: reject the whole call before changing anything
-    vel = balls[:, :, 2:4]  # the engine's velocities (motion.ball_views)
+    _, vel, _, _, _, _ = ball_views(balls)
     dim = Q[Q_DIM]
     max_dv = P[P_MAXDV]
     max_speed = P[P_MAXSPEED]
@@ -127,12 +127,13 @@ def _in_cluster(body, b, i):  # pragma: no cover - numba
 
 
 @njit
-def task_kernel(flags, imp, pos, vel, sim_time, clusters, S, C, T, t_geo, BF, body, qual, P, Q,
+def task_kernel(flags, imp, balls, sim_time, clusters, S, C, T, t_geo, BF, body, qual, P, Q,
                 obs):  # pragma: no cover - numba
     """Score a step's impacts, update target state, and write reward, flags and observation.
 
     ``imp`` is the engine's impact record array for the batch (sorted by scene then time);
-    ``pos``, ``vel``, ``sim_time`` and ``clusters`` are the engine's state after the step.
+    ``balls`` (the per-ball state, ``engine.motion.BALL_FIELDS``), ``sim_time`` and ``clusters``
+    are the engine's state after the step.
     In cluster mode ``body`` mirrors the engine's cluster roots through the step, replayed from
     the impacts (a ball-ball impact merges two clusters, a wall impact stops the cluster and
     takes it apart, as the engine does), so a wall impact scores only if its ball was part of a
@@ -140,6 +141,7 @@ def task_kernel(flags, imp, pos, vel, sim_time, clusters, S, C, T, t_geo, BF, bo
     Updated in place: target status, current target, step count, body, phi. Written for rows
     whose flag is 0 or 1: the observation, reward, energy, targets hit and the end flags.
     """
+    pos, vel, _, _, _, _ = ball_views(balls)  # (always a C array: one compiled version for any B, N)
     t_wall = T[:, :, T_WALL]
     t_status = T[:, :, T_STATUS]
     masses = BF[:, :, BF_MASS]

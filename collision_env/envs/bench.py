@@ -85,7 +85,7 @@ def _engine_us(core, seconds: float, steps: int = 200) -> float:
         sim.set_state(state)
         t0 = time.perf_counter()
         for _ in range(steps):
-            sim.nudge(dv, check=False)  # as the env does
+            sim.nudge(dv, check=False)  # the impulse kernel the env applies from its own nudge kernel
             sim.step(dt)
         elapsed = time.perf_counter() - t0
         total += elapsed
