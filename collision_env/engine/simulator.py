@@ -537,6 +537,9 @@ class BatchSimulator:
         new.__setstate__(copy.deepcopy(self.__getstate__(), memo))
         return new
 
+    def __copy__(self):  # a shallow copy would share the state arrays but not the bookkeeping around them
+        return self.copy()
+
 
 class Simulator:
     """One scene: the public surface of BRIEF section 5.
@@ -618,9 +621,12 @@ class Simulator:
         self._batch.set_state({key: np.asarray(value)[None] for key, value in state.items()})
 
     def copy(self):
+        """An independent copy (``copy.copy`` and ``copy.deepcopy`` give one too)."""
         new = object.__new__(Simulator)
         new._batch = self._batch.copy()
         return new
+
+    __copy__ = copy
 
 
 def warm_up():

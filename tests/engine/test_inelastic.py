@@ -222,3 +222,24 @@ def test_reverse_with_partial_elasticity_uses_inverse_restitution(e):
         sim.step(-0.1)
     np.testing.assert_allclose(sim.positions, start["positions"], atol=1e-12)
     np.testing.assert_allclose(sim.velocities, start["velocities"], atol=1e-12)
+
+
+def test_copies_and_pickles_keep_the_time_direction_right():
+    import copy
+    import pickle
+
+    def fresh():
+        sim = Simulator(Scene(elasticity=0.5), [[-1, 0.05], [1, 0]], [[1.5, 0], [-1, 0.2]], [1.0, 2.0])
+        sim.step(0.7)
+        sim.step(-0.3)  # the last step ran backwards (restitution 1/e)
+        return sim
+
+    ref = fresh()
+    expect = [(h.time, h.ball) for h in ref.step(-0.3)] + [(h.time, h.ball) for h in ref.step(0.5)]
+    for clone in (lambda s: copy.copy(s), lambda s: s.copy(), lambda s: pickle.loads(pickle.dumps(s))):
+        sim = fresh()
+        other = clone(sim)
+        for s in (sim, other):
+            got = [(h.time, h.ball) for h in s.step(-0.3)] + [(h.time, h.ball) for h in s.step(0.5)]
+            assert got == expect
+            np.testing.assert_array_equal(s.positions, ref.positions)
