@@ -50,6 +50,15 @@ WORK_I = 4
 
 
 @njit(inline="always")
+def scene_params(fparams, iparams):
+    """The scene's parameters: ``fparams`` = (xmin, ymin, xmax, ymax, e, collapse_ratio, sign,
+    collapse_floor), ``iparams`` = (has_walls, pairs, dim, sticky, max_events). Returns bounds, e,
+    ratio, floor, sign, has_walls, pairs, dim, sticky, max_events."""
+    return (fparams[0:4], fparams[4], fparams[5], fparams[7], fparams[6], iparams[0] != 0, iparams[1] != 0,
+            iparams[2], iparams[3] != 0, iparams[4])
+
+
+@njit(inline="always")
 def record(imp, n_imp, scene, time, ball, other, wall, x, y, speed):
     """Append an impact to the record buffer ``imp`` (``simulator.IMPACT_DTYPE``)."""
     k = n_imp[0]
@@ -385,16 +394,7 @@ def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, coun
     flag = scratch_b[0:n]
     in_group = scratch_b[n:2 * n]
     c_hit = scratch_b[2 * n:2 * n + nc]
-    bounds = fparams[0:4]
-    e = fparams[4]
-    ratio = fparams[5]
-    floor = fparams[7]
-    sign = fparams[6]
-    has_walls = iparams[0] != 0
-    pairs = iparams[1] != 0
-    dim = iparams[2]
-    sticky = iparams[3] != 0
-    max_events = iparams[4]
+    bounds, e, ratio, floor, sign, has_walls, pairs, dim, sticky, max_events = scene_params(fparams, iparams)
     if fresh:
         for sc in range(n_scenes):
             active[sc] = True

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from ._jit import njit
+from .exact import scene_params
 from .motion import advance_all, ball_views, has_rotation
 from .naive import resolve_naive
 from .posteriori import resolve_posteriori
@@ -34,15 +35,7 @@ def step_substeps(mode, k_total, balls, body, time, capped, fparams, iparams, im
     n_imp[0] = 0
     n = pos.shape[1]
     worst = n * (n - 1) // 2 + 4 * n
-    bounds = fparams[0:4]
-    e = fparams[4]
-    ratio = fparams[5]
-    floor = fparams[7]
-    sign = fparams[6]
-    has_walls = iparams[0] != 0
-    pairs = iparams[1] != 0
-    dim = iparams[2]
-    sticky = iparams[3] != 0
+    bounds, e, ratio, floor, sign, has_walls, pairs, dim, sticky, _ = scene_params(fparams, iparams)
     h = dt_abs / k_total
     if fresh:
         for sc in range(pos.shape[0]):
