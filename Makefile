@@ -25,7 +25,7 @@ test: $(STAMP)
 bench: $(STAMP)
 	$(PY) -m collision_env.engine.bench --quick
 
-# Re-measure every figure of the README and docs/ (about 10 minutes; the agents study is separate).
+# Re-measure every figure of the README and docs/ (a few minutes; the agents study is separate).
 figures: $(STAMP)
 	$(PY) -m collision_env.bench --readme README.md
 	$(PY) -m collision_env.engine.bench --markdown docs/bench/engine.md --readme README.md

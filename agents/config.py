@@ -56,6 +56,8 @@ RESERVED_ENV_KWARGS = ("render_mode", "max_episode_steps", "disable_env_checker"
 
 
 def check_env_kwargs(env_kwargs: dict) -> dict:
+    if not isinstance(env_kwargs, dict):
+        raise UsageError(f"env kwargs: expected a mapping of env keywords, got {env_kwargs!r}")
     clash = sorted(set(env_kwargs) & set(RESERVED_ENV_KWARGS))
     if clash:
         raise UsageError(f"env kwargs: {', '.join(clash)} cannot be set here (the agent scripts set them)")
@@ -230,9 +232,20 @@ def ppo_kwargs(hp: dict) -> dict:
             continue
         if key == "policy_kwargs":
             out[key] = _policy_kwargs(value)
-        else:
-            out[key] = _schedule_or_number(key, value)
+            continue
+        value = _schedule_or_number(key, value)
+        optional = value is None and key in ("clip_range_vf", "target_kl")
+        number = isinstance(value, (int, float)) and not isinstance(value, bool)
+        if key in _NUMBERS and not (callable(value) or number or optional):
+            raise UsageError(f"{key}: expected a number{' or lin_<x>' if key in _SCHEDULES else ''}, got {value!r}")
+        out[key] = value
     return out
+
+
+#: PPO keywords that take a number (the first three also a schedule, lin_<x>).
+_SCHEDULES = ("learning_rate", "clip_range", "clip_range_vf")
+_NUMBERS = _SCHEDULES + ("n_steps", "batch_size", "n_epochs", "gamma", "gae_lambda", "ent_coef", "vf_coef",
+                         "max_grad_norm", "target_kl", "sde_sample_freq")
 
 
 def as_int(name: str, value: Any, low: int = 1) -> int:

@@ -85,12 +85,9 @@ def train_and_evaluate(task: dict) -> dict:
 
 def baselines(task: dict) -> dict:
     """Random and scripted baselines of one preset in exact mode, on the study's evaluation episodes."""
-    import gymnasium as gym
+    from agents.evaluate import EVAL_SEED, make_env, play, random_policy, scripted_baseline
 
-    import collision_env  # noqa: F401
-    from agents.evaluate import EVAL_SEED, play, random_policy, scripted_baseline
-
-    env = gym.make(task["env_id"])
+    env = make_env(task["env_id"], {})  # as agents.evaluate builds the env PPO is evaluated on
     out = {"env_id": task["env_id"], "random": play(env, random_policy(EVAL_SEED), task["episodes"], EVAL_SEED)}
     scripted = scripted_baseline(env)
     out["scripted"] = None if scripted is None else play(env, scripted, task["episodes"], EVAL_SEED)
@@ -317,6 +314,13 @@ def main(argv: list[str] | None = None) -> dict:
     args = build_parser().parse_args(argv)
     docs = Path(args.docs)
     readme = Path(args.readme) if args.readme else None
+    if readme is not None:  # a README without the block's markers would only be found after the study
+        from collision_env._readme import markers
+
+        start, end = markers(README_BLOCK)
+        text = readme.read_text() if readme.is_file() else ""
+        if start not in text or end not in text:
+            raise UsageError(f"--readme: {readme} has no {start} ... {end} block to write into")
     if args.render:
         path = docs / "study.json"
         if not path.is_file():

@@ -187,7 +187,7 @@ def train(env_id: str = DEFAULT_ENV, *, timesteps: float | None = None, n_envs: 
     save_freq = as_int("save_freq", save_freq, low=0)
     eval_episodes = as_int("eval_episodes", eval_episodes)
     threads = as_int("threads", threads)
-    kwargs = check_env_kwargs({**(hp.get("env_kwargs") or {}), **(env_kwargs or {})})
+    kwargs = {**check_env_kwargs(hp.get("env_kwargs") or {}), **check_env_kwargs(env_kwargs or {})}
     if mode is not None:
         kwargs["mode"] = mode
     if substeps is not None:

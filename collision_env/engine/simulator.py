@@ -56,6 +56,8 @@ class LiveArrays(NamedTuple):
     balls: np.ndarray  #: (B, N, 8) per-ball state, laid out as ``motion.BALL_FIELDS``
     positions: np.ndarray  #: (B, N, 2) view of ``balls``
     velocities: np.ndarray  #: (B, N, 2) view of ``balls``
+    masses: np.ndarray  #: (B, N) view of ``balls``
+    radii: np.ndarray  #: (B, N) view of ``balls``
     time: np.ndarray  #: (B,) clocks
     clusters: np.ndarray  #: (B, N) root ball of each ball's cluster
     capped: np.ndarray  #: (B,) the last step stopped at the event cap
@@ -282,7 +284,8 @@ class BatchSimulator:
             self._kernel = step_substeps
             self._kernel_args = (NAIVE if self.mode == "naive" else POSTERIORI, self.substeps) + state
         self._sign = float(self._fparams[6])  # the direction _fparams are set for (see step)
-        self._live = LiveArrays(self._balls, self._pos, self._vel, self._time, self._body, self._capped)
+        self._live = LiveArrays(self._balls, self._pos, self._vel, self._mass, self._radius, self._time, self._body,
+                                self._capped)
 
     def step(self, dt):
         """Advance every scene by ``dt`` seconds (``dt < 0`` runs time backwards).

@@ -178,8 +178,8 @@ class TaskCore:
 
     The task state is packed into a few arrays (see ``_kernels``: ``S`` per-scene floats, ``C``
     per-scene counters and flags, ``T`` per-target wall and status, ``t_geo`` per-target geometry,
-    ``BF`` per-ball mass and radius, ``body`` the cluster mirror), because each array a compiled
-    kernel takes costs time to pass on every step. The named properties below are views into them.
+    ``body`` the cluster mirror), because each array a compiled kernel takes costs time to pass on
+    every step. The balls' state is the engine's own. The named properties below are views.
     """
 
     def __init__(self, cfg: TaskConfig, num_scenes: int):
@@ -219,7 +219,6 @@ class TaskCore:
         self.C = np.zeros((B, K.C_LEN), dtype=np.int64)
         self.T = np.zeros((B, Kt, K.T_LEN), dtype=np.int64)
         self.t_geo = np.zeros((B, Kt, 4))
-        self.BF = np.zeros((B, N, 2))
         self.body = np.tile(np.arange(N, dtype=np.int64), (B, 1))
         self._dv = np.zeros((B, N, 2))  # scratch: the nudge (rewritten every step)
 
@@ -237,21 +236,17 @@ class TaskCore:
     # views into the packed state (writable: they share memory with it)
     t_wall = property(lambda self: self.T[..., K.T_WALL], doc="(B, K) target walls (codes 0..3).")
     t_status = property(lambda self: self.T[..., K.T_STATUS], doc="(B, K) 0 pending, 1 hit, 2 failed.")
-    masses = property(lambda self: self.BF[..., K.BF_MASS], doc="(B, N) ball masses, kg.")
-    radii = property(lambda self: self.BF[..., K.BF_RADIUS], doc="(B, N) ball radii, m.")
     cur = property(lambda self: self.C[:, K.C_CUR], doc="(B,) index of the current (sequential) target.")
     steps = property(lambda self: self.C[:, K.C_STEPS], doc="(B,) control steps taken this episode.")
-    phi = property(lambda self: self.S[:, K.S_PHI], doc="(B,) aiming potential after the last step.")
-    nudge = property(lambda self: self.S[:, K.S_NUDGE], doc="(B,) requested |dv| of the last step, m/s.")
-    # the engine's state (copies)
-    pos = property(lambda self: self.batch.positions, doc="(B, N, 2) ball centres, m (a copy).")
-    vel = property(lambda self: self.batch.velocities, doc="(B, N, 2) ball velocities, m/s (a copy).")
-    time = property(lambda self: self.batch.time, doc="(B,) simulated time, s (a copy).")
+    # the engine's state: live views, to read (the renderer and the scripted policies do, per sub-env)
+    pos = property(lambda self: self.batch.live_arrays().positions, doc="(B, N, 2) ball centres, m.")
+    vel = property(lambda self: self.batch.live_arrays().velocities, doc="(B, N, 2) ball velocities, m/s.")
+    time = property(lambda self: self.batch.live_arrays().time, doc="(B,) simulated time, s.")
+    masses = property(lambda self: self.batch.live_arrays().masses, doc="(B, N) ball masses, kg.")
+    radii = property(lambda self: self.batch.live_arrays().radii, doc="(B, N) ball radii, m.")
 
     # ------------------------------------------------------------------------------------- #
     def _write_episode(self, idx: np.ndarray, eps: Episodes) -> None:
-        self.BF[idx, :, K.BF_MASS] = eps.masses
-        self.BF[idx, :, K.BF_RADIUS] = eps.radii
         self.T[idx, :, K.T_WALL] = eps.t_wall
         self.T[idx, :, K.T_STATUS] = 0
         self.t_geo[idx] = eps.t_geo
@@ -288,7 +283,7 @@ class TaskCore:
         live = self.batch.live_arrays()
         K.task_kernel(flags, imp, live.balls, live.time,
                       live.clusters if self._cluster_scoring else self.body, self.S,
-                      self.C, self.T, self.t_geo, self.BF, self.body, self.qual, self.P, self.Q, obs)
+                      self.C, self.T, self.t_geo, self.body, self.qual, self.P, self.Q, obs)
         return obs
 
     def outputs(self) -> tuple:
@@ -303,7 +298,7 @@ class TaskCore:
         return np.empty(0, dtype=self.impact_dtype)
 
     # ------------------------------------------------------------------------------------- #
-    _TASK_FIELDS = ("S", "C", "T", "t_geo", "BF", "body")
+    _TASK_FIELDS = ("S", "C", "T", "t_geo", "body")
 
     def get_state(self) -> dict:
         state = {name: getattr(self, name).copy() for name in self._TASK_FIELDS}
@@ -311,10 +306,11 @@ class TaskCore:
         return state
 
     def set_state(self, state: dict) -> None:
+        missing = [name for name in (*self._TASK_FIELDS, "engine") if name not in state]
+        if missing:
+            raise ValueError(f"set_state: missing field(s) {missing} (not a state from get_state?)")
         arrays = {}
         for name in self._TASK_FIELDS:  # check everything before changing anything
-            if name not in state:
-                raise ValueError(f"set_state: missing field {name!r} (a state from get_state of this version?)")
             arr = np.asarray(state[name])
             if arr.shape != getattr(self, name).shape:
                 raise ValueError(f"set_state: field {name!r} has shape {arr.shape}, "

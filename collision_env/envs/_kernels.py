@@ -32,27 +32,27 @@ Q_LEN = 5
 # The per-scene task state lives in a few packed arrays, because every array handed to a
 # compiled kernel costs about 0.1 us to pass (a step passes them all, every control step).
 # columns of the per-scene float array S (B, S_LEN)
-S_PHI, S_NUDGE, S_COST, S_REWARD, S_ENERGY = 0, 1, 2, 3, 4
-S_LEN = 5
-# columns of the per-scene int array C (B, C_LEN)
-C_CUR, C_STEPS, C_NHIT, C_TERM, C_TRUNC, C_SUCCESS = 0, 1, 2, 3, 4, 5
-C_LEN = 6
-# last axis of the per-target int array T (B, K, T_LEN) and of the per-ball float array BF (B, N, 2)
+S_PHI, S_NUDGE, S_REWARD, S_ENERGY = 0, 1, 2, 3
+S_LEN = 4
+# columns of the per-scene int array C (B, C_LEN); the last two are the task kernel's scratch
+C_CUR, C_STEPS, C_NHIT, C_TERM, C_TRUNC, C_SUCCESS, C_HITS, C_MISSES = 0, 1, 2, 3, 4, 5, 6, 7
+C_LEN = 8
+# last axis of the per-target int array T (B, K, T_LEN)
 T_WALL, T_STATUS = 0, 1
 T_LEN = 2
-BF_MASS, BF_RADIUS = 0, 1
 
 
 @njit
 def nudge_kernel(actions, active, balls, body, ctrl, P, Q, dv, S):  # pragma: no cover - numba
-    """Scale actions to velocity changes ``dv`` (B, N, 2), their size ``S[:, S_NUDGE]`` and cost
-    ``S[:, S_COST]``, and apply them to the engine's balls with the engine's own impulse kernel.
+    """Scale actions to velocity changes ``dv`` (B, N, 2) and their size ``S[:, S_NUDGE]``, and apply
+    them to the engine's balls with the engine's own impulse kernel.
 
     Returns -1, or the first active row holding a NaN (then nothing is written). Only the controlled
     balls' entries of ``dv`` are written (the others must be zero).
     Each action component is clipped to [-1, 1] and multiplied by ``max_dv``. The nudge never
     raises a ball's speed above max(max_speed, current speed). ``nudge`` is the requested |dv|
-    (after clipping), summed over the controlled balls, in m/s; the cost is ``action_cost`` times it.
+    (after clipping), summed over the controlled balls, in m/s; the task kernel charges
+    ``action_cost`` times it.
     Rows with ``active`` False get no nudge and no cost.
     """
     B = actions.shape[0]
@@ -65,7 +65,6 @@ def nudge_kernel(actions, active, balls, body, ctrl, P, Q, dv, S):  # pragma: no
     dim = Q[Q_DIM]
     max_dv = P[P_MAXDV]
     max_speed = P[P_MAXSPEED]
-    cost_per = P[P_ACTCOST]
     for b in range(B):
         c_total = 0.0
         if not active[b]:
@@ -95,7 +94,6 @@ def nudge_kernel(actions, active, balls, body, ctrl, P, Q, dv, S):  # pragma: no
                 dv[b, i, 0] = nx - vx
                 dv[b, i, 1] = ny - vy
         S[b, S_NUDGE] = c_total
-        S[b, S_COST] = cost_per * c_total
     apply_impulses(balls, body, dv, Q[Q_STICKY] != 0)
     return -1
 
@@ -127,7 +125,7 @@ def _in_cluster(body, b, i):  # pragma: no cover - numba
 
 
 @njit
-def task_kernel(flags, imp, balls, sim_time, clusters, S, C, T, t_geo, BF, body, qual, P, Q,
+def task_kernel(flags, imp, balls, sim_time, clusters, S, C, T, t_geo, body, qual, P, Q,
                 obs):  # pragma: no cover - numba
     """Score a step's impacts, update target state, and write reward, flags and observation.
 
@@ -141,18 +139,18 @@ def task_kernel(flags, imp, balls, sim_time, clusters, S, C, T, t_geo, BF, body,
     Updated in place: target status, current target, step count, body, phi. Written for rows
     whose flag is 0 or 1: the observation, reward, energy, targets hit and the end flags.
     """
-    pos, vel, _, _, _, _ = ball_views(balls)  # (always a C array: one compiled version for any B, N)
+    pos, vel, masses, _, radii, _ = ball_views(balls)  # (always a C array: one compiled version for any B, N)
     t_wall = T[:, :, T_WALL]
     t_status = T[:, :, T_STATUS]
-    masses = BF[:, :, BF_MASS]
-    radii = BF[:, :, BF_RADIUS]
     cur = C[:, C_CUR]
     steps = C[:, C_STEPS]
     n_hit = C[:, C_NHIT]
     terminated = C[:, C_TERM]
     truncated = C[:, C_TRUNC]
     success = C[:, C_SUCCESS]
-    cost = S[:, S_COST]
+    nudge = S[:, S_NUDGE]
+    hits = C[:, C_HITS]
+    misses = C[:, C_MISSES]
     phi = S[:, S_PHI]
     reward = S[:, S_REWARD]
     energy = S[:, S_ENERGY]
@@ -176,8 +174,9 @@ def task_kernel(flags, imp, balls, sim_time, clusters, S, C, T, t_geo, BF, body,
     tlimit = P[P_TLIMIT]
     shaping = P[P_SHAPING] != 0.0  # the aiming potential is only computed when it is used
 
-    hits = np.zeros(B, np.int64)
-    misses = np.zeros(B, np.int64)
+    for b in range(B):
+        hits[b] = 0
+        misses[b] = 0
     for j in range(imp.shape[0]):
         b = imp[j]["scene"]
         if flags[b] != 1:
@@ -225,7 +224,7 @@ def task_kernel(flags, imp, balls, sim_time, clusters, S, C, T, t_geo, BF, body,
         if not hit:
             misses[b] += 1
 
-    S = 1 if seq else K
+    slots = 1 if seq else K
     for b in range(B):
         f = flags[b]
         if f == 2:
@@ -267,7 +266,7 @@ def task_kernel(flags, imp, balls, sim_time, clusters, S, C, T, t_geo, BF, body,
             obs[b, o + 5] = 1.0 if scoring else 0.0
             o += 6
         energy[b] = ke
-        for sl in range(S):
+        for sl in range(slots):
             k = sl
             if seq:
                 k = min(cur[b], K - 1)
@@ -346,7 +345,7 @@ def task_kernel(flags, imp, balls, sim_time, clusters, S, C, T, t_geo, BF, body,
         phi_new = -best
 
         if f == 1:
-            rew = hits[b] * P[P_HIT] - misses[b] * P[P_MISS] - cost[b]
+            rew = hits[b] * P[P_HIT] - misses[b] * P[P_MISS] - P[P_ACTCOST] * nudge[b]
             if done_ok:
                 rew += P[P_BONUS]
             if hits[b] == 0:

@@ -235,6 +235,8 @@ def test_bad_input_is_a_one_line_error_without_traceback(module, args, message):
 @pytest.mark.parametrize("command, args, message", [
     ("train", ["--hyperparams", "{bad_yaml}"], "not valid YAML"),
     ("train", ["--hyperparams", "{typo_yaml}"], "unknown key(s) ['n_step']"),
+    ("train", ["--hyperparams", "{gamma_yaml}"], "gamma: expected a number"),
+    ("train", ["--hyperparams", "{kwargs_yaml}"], "expected a mapping of env keywords"),
     ("train", ["--env-kwargs", "mass_range=[1"], "cannot read the value"),
     ("train", ["--env-kwargs", "render_mode=human"], "render_mode cannot be set"),
     ("train", ["--seed", "-1"], "seed: expected an integer >= 0"),
@@ -247,10 +249,13 @@ def test_bad_input_is_a_one_line_error_without_traceback(module, args, message):
     ("study", ["--timesteps", "0"], "timesteps"),
     ("study", ["--modes", "exact:2"], "substeps must be"),
     ("study", ["--render", "--docs", "{corrupt_docs}"], "is not a study result"),
+    ("study", ["--readme", "{corrupt_docs}/none.md"], "block to write into"),
 ])
 def test_bad_input_in_process_is_one_line_and_exit_2(tmp_path, capsys, command, args, message):
     (tmp_path / "bad.yml").write_text("a: [1\n")
     config.write_yaml(tmp_path / "typo.yml", {"CollisionEnv/OneBallTarget-v0": {"n_step": 256}})
+    config.write_yaml(tmp_path / "gamma.yml", {"CollisionEnv/OneBallTarget-v0": {"gamma": "abc"}})
+    config.write_yaml(tmp_path / "kwargs.yml", {"CollisionEnv/OneBallTarget-v0": {"env_kwargs": [1, 2]}})
     (tmp_path / "docs").mkdir()
     (tmp_path / "docs" / "study.json").write_text("{not json")
     run = tmp_path / "run"
@@ -258,7 +263,8 @@ def test_bad_input_in_process_is_one_line_and_exit_2(tmp_path, capsys, command, 
         run = train_ppo.main(TINY + ["--output", str(tmp_path), "--run-name", "run", "--eval-freq", "0",
                                      "--save-freq", "0"])
         capsys.readouterr()
-    fill = {"bad_yaml": tmp_path / "bad.yml", "typo_yaml": tmp_path / "typo.yml", "run": run,
+    fill = {"bad_yaml": tmp_path / "bad.yml", "typo_yaml": tmp_path / "typo.yml", "gamma_yaml": tmp_path / "gamma.yml",
+            "kwargs_yaml": tmp_path / "kwargs.yml", "run": run,
             "corrupt_docs": tmp_path / "docs"}
     argv = [a.format(**fill) for a in args] + (["--output", str(tmp_path / "out")] if command == "train" else [])
     main = {"train": train_ppo.main, "evaluate": evaluate.main, "study": study.main}[command]
