@@ -21,6 +21,8 @@ BALL_DENSITY = 35.0
 CONSTANT_RADIUS = 0.15
 
 WALL_NAMES = ("left", "right", "bottom", "top")
+#: Wall codes: indices into ``WALL_NAMES``, as impact records and the kernels store them.
+WALL_LEFT, WALL_RIGHT, WALL_BOTTOM, WALL_TOP = 0, 1, 2, 3
 
 
 def radius_from_mass(mass):
