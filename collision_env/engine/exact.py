@@ -1,19 +1,34 @@
 """Exact mode: a-priori, event-driven stepping to machine precision at any dt.
 
-Per scene and step: predict every ball's wall time and every pair's time of impact, then repeat
-"advance everything to the earliest event, resolve it, re-predict only the balls it changed"
-until the step ends. Pair predictions live in an N x N table of step-local times with cached
-per-row minima, so finding the next event is O(N) and an event re-predicts O(N) pairs per ball
-it changed.
+The scheduler of the event-driven loop (Alder & Wainwright 1959; Rapaport 1980; Lubachevsky
+1991). Its parts, each with one job:
 
-Determinism: ties are broken by index (walls before pairs for the same ball, then the lowest
-ball index, then the lowest partner index). Simultaneous events are therefore resolved one after
+- the **calendar** (:mod:`~collision_env.engine.calendar`): one pending event per ball in a binary
+  heap, invalidated lazily; it persists from one step to the next;
+- the **broad phase** (:mod:`~collision_env.engine.grid`): a cell grid, so that a prediction looks
+  only at the 3 x 3 cells around a ball, kept current by cell-crossing events (one cell, i.e. all
+  pairs, in small scenes);
+- this **scheduler**, :func:`step_exact`, in named phases: *begin* (re-predict only the balls that
+  changed since the last step: a nudge, an env's action, a reversal of time; everything after a
+  reset or ``set_state``), then repeatedly *pop* the earliest event, *verify* it, *advance* the
+  balls it involves, *resolve* it, and *invalidate* (re-predict the balls whose motion changed),
+  and finally *finish* (bring every ball to the end of the step and rebase the calendar's times).
+
+Balls move lazily: a ball's stored position refers to its own ``ref_time`` and is brought up to
+date only when an event involves it (or when the step ends), so an event costs O(log N) with O(1)
+partners instead of moving every ball. Stick scenes (rotating clusters) keep every ball at the
+same time instead, as their kinematics need.
+
+Determinism: ties are broken by index (a ball's wall before its partners, then the lowest ball
+index, then the lowest partner index). Simultaneous events are therefore resolved one after
 another, each seeing the velocities the previous one produced; an exact corner hit is an x-wall
 event followed by a y-wall event at the same instant, and a touching train (Newton's cradle) is a
 chain of zero-time events.
 
-Times are relative: the clock runs from 0 to the step length within each step, and absolute
-times are formed once, when an impact is recorded, as ``start + sign * local``.
+Times are relative: the calendar's times run from 0 at the start of each step, and absolute
+times are formed once, when an impact is recorded, as ``start + sign * local``. An event's time
+is re-computed from the two balls' stored states when it is popped (DynamO's re-verification), so
+a prediction made steps ago gives the same impact time as a fresh one.
 
 The cap on events per step (``max_events``) is never silent: a scene that reaches it stops at
 the instant of its last resolved event, in a valid state (no overlap, nothing outside the border),
@@ -28,14 +43,54 @@ import math
 
 import numpy as np
 
+from . import calendar as cal
+from . import grid
 from ._jit import njit
+from .layout import (
+    C_CELL,
+    C_CELL_HEAD,
+    C_CELL_NEXT,
+    C_CHANGES,
+    C_EVENT_OTHER,
+    C_EVENT_STAMP,
+    C_EVENT_TIME,
+    C_REF_TIME,
+    C_SEEN_VX,
+    C_SEEN_VY,
+    C_SEEN_X,
+    C_SEEN_Y,
+    S_COLLAPSE_FLOOR,
+    S_COLLAPSE_RATIO,
+    S_DIM,
+    S_ELASTICITY,
+    S_HAS_WALLS,
+    S_MAX_EVENTS,
+    S_PAIRS,
+    S_SIGN,
+    S_STICKY,
+    S_XMIN,
+    S_YMAX,
+    W_ACTIVE,
+    W_CALENDAR_VALID,
+    W_EVENTS,
+    W_GRID_HX,
+    W_GRID_HY,
+    W_GRID_NX,
+    W_GRID_NY,
+    W_GRID_X0,
+    W_GRID_Y0,
+    W_REMAINING,
+    W_STALLED,
+)
 from .ldp import least_distance
 from .motion import advance_all, ball_views, body_kinematics, has_rotation
 from .response import ball_ball, ball_wall, elastic_threshold, merge_bodies, stop_body
 from .toi import INF, ca_pair, ca_wall, toi_pair, toi_wall
 
-# counters: 0 pair predictions, 1 wall predictions, 2 events, 3 rotating-cluster predictions
-PAIR_TESTS, WALL_TESTS, EVENTS, CLUSTER_TESTS = 0, 1, 2, 3
+#: Work counters (``BatchSimulator.stats``): pair predictions, wall predictions, events,
+#: rotating-cluster predictions, grid-cell crossings, stale calendar entries re-predicted.
+COUNTERS = ("pair_tests", "wall_tests", "events", "cluster_tests", "cell_crossings", "stale_events")
+PAIR_TESTS, WALL_TESTS, EVENTS, CLUSTER_TESTS, CELL_CROSSINGS, STALE_EVENTS = range(6)
 
 #: Contact tolerance (relative to the length scale): re-verifying a cluster event, and which
 #: balls touch in a contact group.
@@ -43,19 +98,15 @@ _CONTACT_TOL = 1e-9
 #: Sweeps over a contact group in one instant before the cascade is replaced by its limit (see
 #: ``_settle_contact_group``). Cascades among comparable masses end within a few dozen sweeps.
 _MAX_SWEEPS = 1000
-#: Columns of the per-scene work arrays: float (time left in the step, start time of the step);
-#: int (events so far, active, stalled, sub-steps done).
-WORK_F = 2
-WORK_I = 4
 
 
 @njit(inline="always")
 def scene_params(fparams, iparams):
-    """The scene's parameters: ``fparams`` = (xmin, ymin, xmax, ymax, e, collapse_ratio, sign,
-    collapse_floor), ``iparams`` = (has_walls, pairs, dim, sticky, max_events). Returns bounds, e,
-    ratio, floor, sign, has_walls, pairs, dim, sticky, max_events."""
-    return (fparams[0:4], fparams[4], fparams[5], fparams[7], fparams[6], iparams[0] != 0, iparams[1] != 0,
-            iparams[2], iparams[3] != 0, iparams[4])
+    """The scene's parameters (``layout.SCENE_F`` and ``layout.SCENE_I``). Returns bounds, e, ratio,
+    floor, sign, has_walls, pairs, dim, sticky, max_events."""
+    return (fparams[S_XMIN:S_YMAX + 1], fparams[S_ELASTICITY], fparams[S_COLLAPSE_RATIO],
+            fparams[S_COLLAPSE_FLOOR], fparams[S_SIGN], iparams[S_HAS_WALLS] != 0, iparams[S_PAIRS] != 0,
+            iparams[S_DIM], iparams[S_STICKY] != 0, iparams[S_MAX_EVENTS])
 
 
 @njit(inline="always")
@@ -109,19 +160,6 @@ def snap_to_wall(i, wall, pos, radius, bounds):
         pos[i, 1] = bounds[3] - radius[i]
 
 
-@njit(inline="always")
-def _straight_pair(i, k, now, pos, vel, radius, body, counters):
-    """``_predict_pair`` when nothing rotates: inlined into the loops, which call it O(N) times per
-    event (a call that numba does not inline costs as much as the time-of-impact kernel itself)."""
-    if body[i] == body[k]:
-        return INF
-    counters[PAIR_TESTS] += 1
-    return now + toi_pair(
-        pos[k, 0] - pos[i, 0], pos[k, 1] - pos[i, 1], vel[k, 0] - vel[i, 0], vel[k, 1] - vel[i, 1],
-        radius[i] + radius[k],
-    )
-
-
 @njit
 def _predict_pair(i, k, now, horizon, pos, vel, mass, radius, body, omega, rot, ki, kj, counters):
     if body[i] == body[k]:
@@ -134,7 +172,9 @@ def _predict_pair(i, k, now, horizon, pos, vel, mass, radius, body, omega, rot, 
             ki[q] = a[q]
             kj[q] = c[q]
         return now + ca_pair(ki, kj, radius[i] + radius[k], horizon)
-    return _straight_pair(i, k, now, pos, vel, radius, body, counters)
+    counters[PAIR_TESTS] += 1
+    return now + toi_pair(pos[k, 0] - pos[i, 0], pos[k, 1] - pos[i, 1], vel[k, 0] - vel[i, 0],
+                          vel[k, 1] - vel[i, 1], radius[i] + radius[k])
 
 
 @njit(inline="always")
@@ -149,18 +189,6 @@ def _predict_wall(i, now, horizon, pos, vel, mass, radius, body, omega, rot, bou
     counters[WALL_TESTS] += 1
     tau, wall = toi_wall(pos[i, 0], pos[i, 1], vel[i, 0], vel[i, 1], radius[i], bounds, dim)
     return now + tau, wall
-
-
-@njit(inline="always")
-def _rescan(i, pt, rmin, rarg):
-    best = INF
-    arg = -1
-    for k in range(pt.shape[0]):
-        if pt[i, k] < best:
-            best = pt[i, k]
-            arg = k
-    rmin[i] = best
-    rarg[i] = arg
 
 
 @njit(inline="always")
@@ -347,66 +375,346 @@ def _settle_contact_group(
 
 
 def scratch_sizes(n):
-    """Lengths of :func:`step_exact`'s float, int and bool work buffers for ``n`` balls."""
-    nc = n * (n - 1) // 2 + 4 * n
-    return n * n + 2 * n + 14, 3 * n + 2 * nc, 2 * n + nc
+    """Lengths of :func:`step_exact`'s float, int and bool work buffers for ``n`` balls: O(N)."""
+    nc = contact_capacity(n)
+    return 14, n + 2 * nc, n + nc
 
 
 @njit
-def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, counters, work_f, work_i, scratch_f,
-               scratch_i, scratch_b, dt_abs, fresh):
+def contact_capacity(n):
+    """Most contacts a contact group of ``n`` balls can have: the contact graph of disks that do not
+    overlap is planar (at most 3n - 6 edges), and a ball touches at most two walls (four in a box
+    no wider than the ball)."""
+    return 3 * n + 4 * n + 8
+
+
+@njit
+def impacts_per_event(n, cascades):
+    """Most impacts one event can record: a contact group's contacts, or the event alone."""
+    return contact_capacity(n) + 1 if cascades else 2
+
+
+# ---------------------------------------------------------------------------- lazy motion
+@njit(inline="always")
+def _position_at(k, t, pos, vel, cf):
+    """Where ball ``k`` is at step time ``t`` (its stored position refers to its ``ref_time``)."""
+    dt = t - cf[k, C_REF_TIME]
+    return pos[k, 0] + vel[k, 0] * dt, pos[k, 1] + vel[k, 1] * dt
+
+
+@njit(inline="always")
+def _sync(k, t, pos, vel, cf):
+    """Bring ball ``k``'s stored position to step time ``t`` (straight-line motion)."""
+    dt = t - cf[k, C_REF_TIME]
+    if dt != 0.0:
+        pos[k, 0] += vel[k, 0] * dt
+        pos[k, 1] += vel[k, 1] * dt
+        cf[k, C_REF_TIME] = t
+
+
+@njit(inline="always")
+def _sync_all(t, pos, vel, mass, body, omega, rot, sticky, cf):
+    """Bring every ball to step time ``t``. Stick scenes keep all balls at one time (a rotating
+    cluster moves as a whole), so they advance together; elsewhere each ball moves on its own."""
+    n = pos.shape[0]
+    if sticky:
+        dt = t - cf[0, C_REF_TIME]
+        if dt != 0.0:
+            advance_all(dt, pos, vel, mass, body, omega, rot)
+            for k in range(n):
+                cf[k, C_REF_TIME] = t
+    else:
+        for k in range(n):
+            _sync(k, t, pos, vel, cf)
+
+
+@njit(inline="always")
+def _pair_time(i, k, pos, vel, radius, cf):
+    """Step time at which balls ``i`` and ``k`` in straight-line motion meet (inf: never), computed
+    from their stored states at the later of their reference times. Every prediction and every
+    re-verification of a pair uses this one formula on the stored states alone, so the answer does
+    not depend on when it is asked: a calendar kept for many steps and a fresh one agree."""
+    tc = max(cf[i, C_REF_TIME], cf[k, C_REF_TIME])
+    xi, yi = _position_at(i, tc, pos, vel, cf)
+    xk, yk = _position_at(k, tc, pos, vel, cf)
+    return tc + toi_pair(xk - xi, yk - yi, vel[k, 0] - vel[i, 0], vel[k, 1] - vel[i, 1], radius[i] + radius[k])
+
+
+@njit(inline="always")
+def _wall_time(i, pos, vel, radius, bounds, dim, cf):
+    """Step time and code of the first wall ball ``i`` meets in straight-line motion."""
+    tau, wall = toi_wall(pos[i, 0], pos[i, 1], vel[i, 0], vel[i, 1], radius[i], bounds, dim)
+    return cf[i, C_REF_TIME] + tau, wall
+
+
+# ---------------------------------------------------------------------------- predict
+@njit(inline="always")
+def _predict(i, now, horizon, rebuild, pos, vel, mass, radius, body, omega, rot, sticky, bounds, has_walls, pairs,
+             dim, geo, cf, ci, ki, kj, counters):
+    """Find ball ``i``'s next event and schedule it.
+
+    Looks at its wall, its partners in the 3 x 3 cells around it and its next cell crossing, from
+    the balls' stored states (``now`` and ``horizon`` matter only to rotating clusters). Every
+    partner is offered the pair event too (``calendar.offer_pair``). ``rebuild`` is the first
+    prediction of a whole scene: only partners of higher index are looked at (each pair once),
+    ball ``i`` keeps what lower ones offered it, and the heap is ordered afterwards.
+    """
+    n = pos.shape[0]
+    x0, y0, hx, hy, nx, ny = geo
+    if rebuild:
+        best_t = cf[i, C_EVENT_TIME]
+        best_code = ci[i, C_EVENT_OTHER]
+        best_stamp = ci[i, C_EVENT_STAMP]
+    else:
+        best_t = INF
+        best_code = cal.EV_NONE
+        best_stamp = 0
+    if has_walls:
+        if rot:  # (stick scenes keep every ball at ``now``)
+            t_wall, wall = _predict_wall(i, now, horizon, pos, vel, mass, radius, body, omega, rot, bounds, dim, ki,
+                                         counters)
+        else:
+            counters[WALL_TESTS] += 1
+            t_wall, wall = _wall_time(i, pos, vel, radius, bounds, dim, cf)
+        if wall >= 0 and cal.earlier(t_wall, cal.EV_WALL - wall, best_t, best_code, i):
+            best_t = t_wall
+            best_code = cal.EV_WALL - wall
+    if pairs:
+        cx0, cx1, cy0, cy1 = grid.block(ci[i, C_CELL], nx, ny)
+        for cy in range(cy0, cy1 + 1):
+            for cx in range(cx0, cx1 + 1):
+                k = ci[cy * nx + cx, C_CELL_HEAD]
+                while k >= 0:
+                    if k != i and (k > i or not rebuild):
+                        if rot:
+                            t = _predict_pair(i, k, now, horizon, pos, vel, mass, radius, body, omega, rot, ki, kj,
+                                              counters)
+                        elif body[i] == body[k]:
+                            t = INF
+                        else:
+                            counters[PAIR_TESTS] += 1
+                            t = _pair_time(i, k, pos, vel, radius, cf)
+                        if t < INF:
+                            if cal.earlier(t, k, best_t, best_code, i):
+                                best_t = t
+                                best_code = k
+                                best_stamp = ci[k, C_CHANGES]
+                            cal.offer_pair(k, t, i, n, not rebuild, cf, ci)
+                    k = ci[k, C_CELL_NEXT]
+        if nx * ny > 1:
+            tau, direction = grid.crossing(pos[i, 0], pos[i, 1], vel[i, 0], vel[i, 1], ci[i, C_CELL], x0, y0,
+                                           hx, hy, nx, ny)
+            tau += cf[i, C_REF_TIME]
+            if direction >= 0 and cal.earlier(tau, cal.EV_CROSS - direction, best_t, best_code, i):
+                best_t = tau
+                best_code = cal.EV_CROSS - direction
+    cal.set_event(i, best_t, best_code, best_stamp, cf, ci)
+    if not rebuild:
+        cal.reschedule(i, n, cf, ci)
+
+
+# ---------------------------------------------------------------------------- begin
+@njit(inline="always")
+def _begin_whole_scene(pos, cf, ci, geo, pending):
+    """Forget every prediction of a scene and lay its balls into the grid; every ball is then to
+    be predicted (listed in ``pending``). Returns how many."""
+    n = pos.shape[0]
+    x0, y0, hx, hy, nx, ny = geo
+    grid.fill_cells(n, pos, ci, x0, y0, hx, hy, nx, ny)
+    for i in range(n):
+        cf[i, C_REF_TIME] = 0.0
+        cal.set_event(i, INF, cal.EV_NONE, 0, cf, ci)
+        pending[i] = i
+    return n
+
+
+@njit(inline="always")
+def _changed_since_last_step(i, pos, vel, cf):
+    return (pos[i, 0] != cf[i, C_SEEN_X] or pos[i, 1] != cf[i, C_SEEN_Y] or vel[i, 0] != cf[i, C_SEEN_VX]
+            or vel[i, 1] != cf[i, C_SEEN_VY])
+
+
+@njit(inline="always")
+def _begin_changed_balls(pos, vel, cf, ci, geo, pending):
+    """List in ``pending`` the balls whose position or velocity changed since the last step ended
+    (a nudge, an env's action, the negated velocities of a reversal of time): their trajectories
+    are new (their change counters move on, which makes events others hold with them stale) and
+    they may sit in another cell. Returns how many."""
+    n = pos.shape[0]
+    x0, y0, hx, hy, nx, ny = geo
+    n_changed = 0
+    for i in range(n):
+        if _changed_since_last_step(i, pos, vel, cf):
+            pending[n_changed] = i
+            n_changed += 1
+            ci[i, C_CHANGES] += 1
+            c = grid.cell_of(pos[i, 0], pos[i, 1], x0, y0, hx, hy, nx, ny)
+            if c != ci[i, C_CELL]:
+                grid.unlink(i, ci)
+                grid.link(i, c, ci)
+    return n_changed
+
+
+# ---------------------------------------------------------------------------- verify
+@njit(inline="always")
+def _verified_time(i, code, pos, vel, radius, bounds, dim, cf):
+    """The popped event's time, computed afresh from the stored states (a prediction from an
+    earlier step carries the round-off of rebasing its time), or inf if it no longer happens."""
+    if code >= 0:
+        return _pair_time(i, code, pos, vel, radius, cf)
+    t, wall = _wall_time(i, pos, vel, radius, bounds, dim, cf)
+    return t if wall == cal.EV_WALL - code else INF
+
+
+# ---------------------------------------------------------------------------- finish
+@njit(inline="always")
+def _finish(t_end, pos, vel, mass, body, omega, rot, sticky, cf, ci):
+    """End the step at step time ``t_end``: every ball there, the calendar's times made relative to
+    it (the next step starts at 0), and the state remembered for the next step's change check."""
+    n = pos.shape[0]
+    _sync_all(t_end, pos, vel, mass, body, omega, rot, sticky, cf)
+    for i in range(n):
+        cf[i, C_EVENT_TIME] -= t_end
+        cf[i, C_REF_TIME] = 0.0
+        cf[i, C_SEEN_X] = pos[i, 0]
+        cf[i, C_SEEN_Y] = pos[i, 1]
+        cf[i, C_SEEN_VX] = vel[i, 0]
+        cf[i, C_SEEN_VY] = vel[i, 1]
+    cal.heapify(n, cf, ci)  # rebasing can round two times into a tie the heap must order by index
+
+
+# ---------------------------------------------------------------------------- resolve
+@njit(inline="always")
+def _resolve_wall(sc, t_abs, bi, wall, pos, vel, inv_mass, radius, body, omega, bounds, has_walls, pairs, dim, e,
+                  u_min, sticky, cascades, imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit):
+    """Ball ``bi`` meets ``wall``. Returns how many balls' motion it changed (listed in ``involved``)."""
+    n = pos.shape[0]
+    n_inv = 0
+    if sticky:
+        scale = radius[bi] + abs(pos[bi, 0]) + abs(pos[bi, 1])
+        axis = 0 if wall < 2 else 1
+        into = vel[bi, axis] < 0.0 if wall % 2 == 0 else vel[bi, axis] > 0.0
+        if wall_gap(bi, wall, pos, radius, bounds) <= _CONTACT_TOL * scale and into:
+            if omega[body[bi]] == 0.0:
+                snap_to_wall(bi, wall, pos, radius, bounds)
+            x, y = wall_point(bi, wall, pos, radius, bounds)
+            record(imp, n_imp, sc, t_abs, bi, -1, wall, x, y, abs(vel[bi, axis]))
+            root = body[bi]
+            for k in range(n):
+                if body[k] == root:
+                    involved[n_inv] = k
+                    n_inv += 1
+            stop_body(bi, vel, body, omega)
+        else:
+            involved[0] = bi
+            n_inv = 1
+        return n_inv
+    snap_to_wall(bi, wall, pos, radius, bounds)
+    speed = ball_wall(bi, wall, vel, e, u_min)
+    if speed > 0.0:
+        x, y = wall_point(bi, wall, pos, radius, bounds)
+        record(imp, n_imp, sc, t_abs, bi, -1, wall, x, y, speed)
+    involved[0] = bi
+    n_inv = 1
+    if cascades and speed > 0.0:
+        n_inv = _resolve_contact_group(
+            sc, t_abs, bi, -1, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, u_min,
+            imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit,
+        )
+    return n_inv
+
+
+@njit(inline="always")
+def _resolve_pair(sc, t_abs, bi, bj, pos, vel, mass, inv_mass, radius, body, omega, bounds, has_walls, pairs, dim, e,
+                  u_min, sticky, cascades, imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit):
+    """Balls ``bi`` and ``bj`` meet. Returns how many balls' motion it changed (in ``involved``)."""
+    n = pos.shape[0]
+    n_inv = 0
+    dx = pos[bj, 0] - pos[bi, 0]
+    dy = pos[bj, 1] - pos[bi, 1]
+    dist = math.sqrt(dx * dx + dy * dy)
+    sigma = radius[bi] + radius[bj]
+    closing = (vel[bj, 0] - vel[bi, 0]) * dx + (vel[bj, 1] - vel[bi, 1]) * dy
+    if sticky:
+        scale = sigma + abs(pos[bi, 0]) + abs(pos[bi, 1])
+        if dist - sigma <= _CONTACT_TOL * scale and closing < 0.0:
+            x = pos[bi, 0] + radius[bi] * dx / dist
+            y = pos[bi, 1] + radius[bi] * dy / dist
+            record(imp, n_imp, sc, t_abs, bi, bj, -1, x, y, -closing / dist)
+            root = merge_bodies(bi, bj, pos, vel, mass, body, omega)
+            for k in range(n):
+                if body[k] == root:
+                    involved[n_inv] = k
+                    n_inv += 1
+        else:
+            involved[0] = bi
+            involved[1] = bj
+            n_inv = 2
+        return n_inv
+    speed = ball_ball(bi, bj, pos, vel, inv_mass, e, u_min)
+    if speed > 0.0:
+        x = pos[bi, 0] + radius[bi] * dx / dist
+        y = pos[bi, 1] + radius[bi] * dy / dist
+        record(imp, n_imp, sc, t_abs, bi, bj, -1, x, y, speed)
+    involved[0] = bi
+    involved[1] = bj
+    n_inv = 2
+    if cascades and speed > 0.0:
+        n_inv = _resolve_contact_group(
+            sc, t_abs, bi, bj, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, u_min,
+            imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit,
+        )
+    return n_inv
+
+
+# ---------------------------------------------------------------------------- the scheduler
+@njit
+def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, counters, work_f, work_i, cal_f, cal_i,
+               scratch_f, scratch_i, scratch_b, dt_abs, fresh):
     """Advance every active scene of the batch by its remaining time (see module doc).
 
-    ``balls`` is the (B, N, 8) per-ball state (``motion.BALL_FIELDS``), ``body_all`` the (B, N) cluster
-    roots, ``time`` the (B,) clocks. ``fparams`` = (xmin, ymin, xmax, ymax, e, collapse_ratio,
-    sign, collapse_floor); ``iparams`` = (has_walls, pairs, dim, sticky, max_events).
-    ``fresh`` starts a step of ``dt_abs`` for every scene (all active, the whole step left, no
-    events yet); otherwise the call resumes the scenes flagged active in ``work_i``.
-    Impacts go to ``imp`` rows (scene, time, ball, other, wall, x, y, speed) from row 0,
-    ``n_imp[0]`` rows in all; a scene that finds the buffer full stops where it is and is flagged
-    stalled, so the caller can empty the buffer and call again for those scenes. Returns the
-    number of stalled scenes; ``n_imp[1]`` counts the scenes that reached the event cap.
-    ``scratch_*`` are work buffers of :func:`scratch_sizes` (allocated once by the caller: an
-    allocation here, per call, would cost more than a one-ball step).
+    ``balls`` is the (B, N, 8) per-ball state (``layout.BALL``), ``body_all`` the (B, N) cluster
+    roots, ``time`` the (B,) clocks; ``fparams``/``iparams`` the scene parameters
+    (``layout.SCENE_F``/``SCENE_I``); ``work_f``/``work_i`` the per-scene bookkeeping and grid
+    geometry (``layout.WORK_F``/``WORK_I``); ``cal_f``/``cal_i`` the persistent calendar and grid
+    (``layout.CAL_F``/``CAL_I``). ``fresh`` starts a step of ``dt_abs`` for every scene;
+    otherwise the call resumes the scenes flagged active.
+    Impacts go to ``imp`` rows (``simulator.IMPACT_DTYPE``) from row 0, ``n_imp[0]`` rows in all; a
+    scene that finds the buffer full stops where it is and is flagged stalled, so the caller can
+    empty the buffer and call again for those scenes. Returns the number of stalled scenes;
+    ``n_imp[1]`` counts the scenes that reached the event cap.
+    ``scratch_*`` are work buffers of :func:`scratch_sizes` (allocated once by the caller).
 
     The whole batch is one call with the scene loop inside: a call between compiled functions
     reference-counts every array it passes, which would cost as much as a small scene's events.
     """
     pos_all, vel_all, mass_all, inv_mass_all, radius_all, omega_all = ball_views(balls)
-    remaining = work_f[:, 0]
-    events = work_i[:, 0]
-    active = work_i[:, 1]
-    stalled = work_i[:, 2]
     n_imp[0] = 0
     n_scenes = pos_all.shape[0]
     n = pos_all.shape[1]
-    nc = n * (n - 1) // 2 + 4 * n
-    pt = scratch_f[0:n * n].reshape((n, n))
-    rmin = scratch_f[n * n:n * n + n]
-    wt = scratch_f[n * n + n:n * n + 2 * n]
-    ki = scratch_f[n * n + 2 * n:n * n + 2 * n + 7]
-    kj = scratch_f[n * n + 2 * n + 7:n * n + 2 * n + 14]
-    rarg = scratch_i[0:n]
-    wid = scratch_i[n:2 * n]
-    involved = scratch_i[2 * n:3 * n]
-    c_a = scratch_i[3 * n:3 * n + nc]
-    c_b = scratch_i[3 * n + nc:3 * n + 2 * nc]
-    flag = scratch_b[0:n]
-    in_group = scratch_b[n:2 * n]
-    c_hit = scratch_b[2 * n:2 * n + nc]
+    nc = contact_capacity(n)
+    ki = scratch_f[0:7]
+    kj = scratch_f[7:14]
+    pending = scratch_i[0:n]  # balls to predict
+    c_a = scratch_i[n:n + nc]
+    c_b = scratch_i[n + nc:n + 2 * nc]
+    in_group = scratch_b[0:n]
+    c_hit = scratch_b[n:n + nc]
     bounds, e, ratio, floor, sign, has_walls, pairs, dim, sticky, max_events = scene_params(fparams, iparams)
+    cascades = e < 1.0  # forward inelastic: resolve touching groups at one instant
+    room = impacts_per_event(n, cascades)
     if fresh:
         for sc in range(n_scenes):
-            active[sc] = True
-            remaining[sc] = dt_abs
-            events[sc] = 0
+            work_i[sc, W_ACTIVE] = True
+            work_f[sc, W_REMAINING] = dt_abs
+            work_i[sc, W_EVENTS] = 0
             capped[sc] = False
         n_imp[1] = 0
     n_stalled = 0
-    for sc in range(pos_all.shape[0]):
-        if not active[sc]:
+    for sc in range(n_scenes):
+        if not work_i[sc, W_ACTIVE]:
             continue
-        stalled[sc] = False
+        work_i[sc, W_STALLED] = False
         pos = pos_all[sc]
         vel = vel_all[sc]
         mass = mass_all[sc]
@@ -414,195 +722,114 @@ def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, coun
         radius = radius_all[sc]
         body = body_all[sc]
         omega = omega_all[sc]
-        n = pos.shape[0]
-        cascades = e < 1.0  # forward inelastic: resolve touching groups at one instant
-        room = n * (n - 1) // 2 + 4 * n + 1  # the most impacts one event can record (a contact group)
-        horizon_end = remaining[sc]
+        cf = cal_f[sc]
+        ci = cal_i[sc]
+        geo = (work_f[sc, W_GRID_X0], work_f[sc, W_GRID_Y0], work_f[sc, W_GRID_HX], work_f[sc, W_GRID_HY],
+               work_i[sc, W_GRID_NX], work_i[sc, W_GRID_NY])
+        nx = geo[4]
+        horizon_end = work_f[sc, W_REMAINING]
         t0 = time[sc]
         now = 0.0
         rot = sticky and has_rotation(body, omega)
         u_min = elastic_threshold(vel, ratio, floor)
 
-        for i in range(n):
-            wt[i] = INF
-            wid[i] = -1
-            rmin[i] = INF
-            rarg[i] = -1
-            flag[i] = False
-            for k in range(n):
-                pt[i, k] = INF
-        if has_walls:
-            for i in range(n):
-                wt[i], wid[i] = _predict_wall(
-                    i, now, horizon_end, pos, vel, mass, radius, body, omega, rot, bounds, dim, ki, counters
-                )
-        if pairs:
-            for i in range(n):
-                for k in range(i + 1, n):
-                    if rot:
-                        v = _predict_pair(i, k, now, horizon_end, pos, vel, mass, radius, body, omega, rot, ki, kj,
-                                          counters)
-                    else:
-                        v = _straight_pair(i, k, now, pos, vel, radius, body, counters)
-                    pt[i, k] = v
-                    pt[k, i] = v
-            for i in range(n):
-                _rescan(i, pt, rmin, rarg)
+        # begin: everything afresh after a reset (and for rotating clusters, whose predictions reach
+        # only to the end of a step), otherwise only the balls changed since the last step
+        whole = not work_i[sc, W_CALENDAR_VALID] or rot
+        if whole:
+            n_pending = _begin_whole_scene(pos, cf, ci, geo, pending)
+        elif fresh:
+            n_pending = _begin_changed_balls(pos, vel, cf, ci, geo, pending)
+        else:
+            n_pending = 0
 
         while True:
-            best = INF
-            bi = -1
-            bj = -1
-            for i in range(n):
-                if wt[i] < best:
-                    best = wt[i]
-                    bi = i
-                    bj = -1
-                if rmin[i] < best:
-                    best = rmin[i]
-                    bi = i
-                    bj = rarg[i]
-            if not best <= horizon_end:
+            # predict (the one place where predictions are made: what begin or the last event listed)
+            for q in range(n_pending):
+                _predict(pending[q], now, horizon_end - now, whole, pos, vel, mass, radius, body, omega, rot, sticky,
+                         bounds, has_walls, pairs, dim, geo, cf, ci, ki, kj, counters)
+            if whole:
+                cal.reset_heap(n, cf, ci)
+                work_i[sc, W_CALENDAR_VALID] = True
+                whole = False
+            n_pending = 0
+            # pop
+            bi = cal.next_ball(ci)
+            t = cf[bi, C_EVENT_TIME]
+            code = ci[bi, C_EVENT_OTHER]
+            if not t <= horizon_end:
                 break
-            if events[sc] >= max_events:
+            if cal.is_stale(bi, ci):
+                counters[STALE_EVENTS] += 1
+                pending[0] = bi
+                n_pending = 1
+                continue
+            if cal.is_crossing(code):
+                now = max(now, t)
+                counters[CELL_CROSSINGS] += 1
+                grid.unlink(bi, ci)
+                grid.link(bi, grid.neighbour_cell(ci[bi, C_CELL], cal.EV_CROSS - code, nx), ci)
+                pending[0] = bi
+                n_pending = 1
+                continue
+            # verify (rotating clusters' predictions are re-checked by the contact test instead)
+            if not sticky:
+                t_check = _verified_time(bi, code, pos, vel, radius, bounds, dim, cf)
+                if t_check > t:
+                    if t_check == INF:
+                        pending[0] = bi
+                        n_pending = 1
+                    else:
+                        cf[bi, C_EVENT_TIME] = t_check
+                        cal.reschedule(bi, n, cf, ci)
+                    continue
+                t = t_check
+            if work_i[sc, W_EVENTS] >= max_events:
                 capped[sc] = True
                 break
             if n_imp[0] + room > imp.shape[0]:
-                stalled[sc] = True
+                work_i[sc, W_STALLED] = True
                 break
-            if best > now:
-                advance_all(best - now, pos, vel, mass, body, omega, rot)
-                now = best
-            events[sc] += 1
+            # advance
+            now = max(now, t)
+            bj = -1
+            if code >= 0:  # a pair is resolved, and reported, from its lower ball
+                bj = max(bi, code)
+                bi = min(bi, code)
+            if sticky:
+                _sync_all(now, pos, vel, mass, body, omega, rot, sticky, cf)
+            else:
+                _sync(bi, now, pos, vel, cf)
+                if bj >= 0:
+                    _sync(bj, now, pos, vel, cf)
+                if cascades:  # a contact group reaches beyond the two balls
+                    _sync_all(now, pos, vel, mass, body, omega, rot, sticky, cf)
+            work_i[sc, W_EVENTS] += 1
             counters[EVENTS] += 1
             t_abs = t0 + sign * now
-
-            n_inv = 0
-            if bj < 0:  # ball bi meets wall wid[bi]
-                wall = wid[bi]
-                if sticky:
-                    scale = radius[bi] + abs(pos[bi, 0]) + abs(pos[bi, 1])
-                    axis = 0 if wall < 2 else 1
-                    into = vel[bi, axis] < 0.0 if wall % 2 == 0 else vel[bi, axis] > 0.0
-                    if wall_gap(bi, wall, pos, radius, bounds) <= _CONTACT_TOL * scale and into:
-                        if omega[body[bi]] == 0.0:
-                            snap_to_wall(bi, wall, pos, radius, bounds)
-                        x, y = wall_point(bi, wall, pos, radius, bounds)
-                        record(imp, n_imp, sc, t_abs, bi, -1, wall, x, y, abs(vel[bi, axis]))
-                        root = body[bi]
-                        for k in range(n):
-                            if body[k] == root:
-                                involved[n_inv] = k
-                                n_inv += 1
-                        stop_body(bi, vel, body, omega)
-                    else:
-                        involved[0] = bi
-                        n_inv = 1
-                else:
-                    snap_to_wall(bi, wall, pos, radius, bounds)
-                    speed = ball_wall(bi, wall, vel, e, u_min)
-                    if speed > 0.0:
-                        x, y = wall_point(bi, wall, pos, radius, bounds)
-                        record(imp, n_imp, sc, t_abs, bi, -1, wall, x, y, speed)
-                    involved[0] = bi
-                    n_inv = 1
-                    if cascades and speed > 0.0:
-                        n_inv = _resolve_contact_group(
-                            sc, t_abs, bi, -1, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, u_min,
-                            imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit,
-                        )
-            else:  # balls bi and bj meet
-                dx = pos[bj, 0] - pos[bi, 0]
-                dy = pos[bj, 1] - pos[bi, 1]
-                dist = math.sqrt(dx * dx + dy * dy)
-                sigma = radius[bi] + radius[bj]
-                closing = (vel[bj, 0] - vel[bi, 0]) * dx + (vel[bj, 1] - vel[bi, 1]) * dy
-                if sticky:
-                    scale = sigma + abs(pos[bi, 0]) + abs(pos[bi, 1])
-                    if dist - sigma <= _CONTACT_TOL * scale and closing < 0.0:
-                        x = pos[bi, 0] + radius[bi] * dx / dist
-                        y = pos[bi, 1] + radius[bi] * dy / dist
-                        record(imp, n_imp, sc, t_abs, bi, bj, -1, x, y, -closing / dist)
-                        root = merge_bodies(bi, bj, pos, vel, mass, body, omega)
-                        for k in range(n):
-                            if body[k] == root:
-                                involved[n_inv] = k
-                                n_inv += 1
-                        rot = has_rotation(body, omega)
-                    else:
-                        involved[0] = bi
-                        involved[1] = bj
-                        n_inv = 2
-                else:
-                    speed = ball_ball(bi, bj, pos, vel, inv_mass, e, u_min)
-                    if speed > 0.0:
-                        x = pos[bi, 0] + radius[bi] * dx / dist
-                        y = pos[bi, 1] + radius[bi] * dy / dist
-                        record(imp, n_imp, sc, t_abs, bi, bj, -1, x, y, speed)
-                    involved[0] = bi
-                    involved[1] = bj
-                    n_inv = 2
-                    if cascades and speed > 0.0:
-                        n_inv = _resolve_contact_group(
-                            sc, t_abs, bi, bj, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, u_min,
-                            imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit,
-                        )
+            # resolve: the balls whose motion changed are listed in ``pending``
+            if bj < 0:
+                n_pending = _resolve_wall(sc, t_abs, bi, cal.EV_WALL - code, pos, vel, inv_mass, radius, body, omega,
+                                          bounds, has_walls, pairs, dim, e, u_min, sticky, cascades, imp, n_imp,
+                                          counters, pending, in_group, c_a, c_b, c_hit)
+            else:
+                n_pending = _resolve_pair(sc, t_abs, bi, bj, pos, vel, mass, inv_mass, radius, body, omega, bounds,
+                                          has_walls, pairs, dim, e, u_min, sticky, cascades, imp, n_imp, counters,
+                                          pending, in_group, c_a, c_b, c_hit)
             if sticky:
                 rot = has_rotation(body, omega)
+            # invalidate: events that other balls hold with these become stale through the change
+            # counters; the balls themselves are predicted afresh at the top of the loop
+            for q in range(n_pending):
+                ci[pending[q], C_CHANGES] += 1
 
-            # Re-predict what the event changed.
-            for q in range(n_inv):
-                i = involved[q]
-                flag[i] = True
-                if has_walls:
-                    wt[i], wid[i] = _predict_wall(
-                        i, now, horizon_end - now, pos, vel, mass, radius, body, omega, rot, bounds, dim, ki, counters
-                    )
-            if pairs:
-                for q in range(n_inv):
-                    i = involved[q]
-                    for k in range(n):
-                        if k != i and not (flag[k] and k < i):
-                            if rot:
-                                v = _predict_pair(
-                                    i, k, now, horizon_end - now, pos, vel, mass, radius, body, omega, rot, ki, kj,
-                                    counters,
-                                )
-                            else:
-                                v = _straight_pair(i, k, now, pos, vel, radius, body, counters)
-                            pt[i, k] = v
-                            pt[k, i] = v
-                for q in range(n_inv):
-                    _rescan(involved[q], pt, rmin, rarg)
-                for k in range(n):
-                    if flag[k]:
-                        continue
-                    stale = False
-                    for q in range(n_inv):
-                        i = involved[q]
-                        v = pt[k, i]
-                        if v < rmin[k]:
-                            rmin[k] = v
-                            rarg[k] = i
-                        elif rarg[k] == i and v > rmin[k]:
-                            stale = True
-                    if stale:
-                        _rescan(k, pt, rmin, rarg)
-            for q in range(n_inv):
-                flag[involved[q]] = False
-
-        if not (capped[sc] or stalled[sc]) and now < horizon_end:
-            advance_all(horizon_end - now, pos, vel, mass, body, omega, rot)
-            now = horizon_end
-        if now == horizon_end:
-            time[sc] = t0 + sign * horizon_end
-            remaining[sc] = 0.0
-        else:
-            time[sc] = t0 + sign * now
-            remaining[sc] = horizon_end - now
-        n_stalled += stalled[sc]
+        # finish
+        stopped = capped[sc] or work_i[sc, W_STALLED]
+        t_end = now if stopped else horizon_end
+        _finish(t_end, pos, vel, mass, body, omega, rot, sticky, cf, ci)
+        time[sc] = t0 + sign * t_end
+        work_f[sc, W_REMAINING] = horizon_end - t_end
+        n_stalled += work_i[sc, W_STALLED]
         n_imp[1] += capped[sc]
-        active[sc] = stalled[sc]
+        work_i[sc, W_ACTIVE] = work_i[sc, W_STALLED]
     return n_stalled
-
-

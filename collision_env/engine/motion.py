@@ -18,17 +18,18 @@ from __future__ import annotations
 import math
 
 from ._jit import njit
+from .layout import B_INV_MASS, B_MASS, B_OMEGA, B_RADIUS, B_VX, B_X, BALL
 
-#: Last axis of the (B, N, 8) per-ball state: position (2), velocity (2), mass, 1 / mass, radius,
-#: and the angular velocity of the cluster the ball roots (see above).
-BALL_FIELDS = 8
+#: Last axis of the (B, N, 8) per-ball state, laid out as ``layout.BALL``: position (2),
+#: velocity (2), mass, 1 / mass, radius, and the angular velocity of the cluster the ball roots.
+BALL_FIELDS = len(BALL)
 
 
 @njit(inline="always")
 def ball_views(balls):
     """The per-ball state as views: pos, vel (B, N, 2), mass, inv_mass, radius, omega (B, N)."""
-    return (balls[:, :, 0:2], balls[:, :, 2:4], balls[:, :, 4], balls[:, :, 5], balls[:, :, 6],
-            balls[:, :, 7])
+    return (balls[:, :, B_X:B_X + 2], balls[:, :, B_VX:B_VX + 2], balls[:, :, B_MASS], balls[:, :, B_INV_MASS],
+            balls[:, :, B_RADIUS], balls[:, :, B_OMEGA])
 
 
 @njit

@@ -24,6 +24,7 @@ import math
 
 from ._jit import njit
 from .exact import EVENTS, PAIR_TESTS, WALL_TESTS, record, wall_point
+from .grid import later_neighbours
 from .motion import advance_body
 from .naive import contain, shift_body
 from .response import ball_ball, ball_wall, merge_bodies, stop_body
@@ -70,11 +71,15 @@ def overlap_time_border(x, y, vx, vy, r, bounds, dim):
 
 @njit(inline="always")
 def resolve_posteriori(sc, t_end, sign, h, pos, vel, mass, inv_mass, radius, body, omega, bounds, dim, e, u_min,
-                       has_walls, pairs, sticky, imp, n_imp, counters):
+                       has_walls, pairs, sticky, imp, n_imp, counters, cells):
+    """Reconstruct and resolve the collisions of a sub-step; ``cells`` is the sub-step's broad
+    phase (``substep.cell_lists``): pairs come from it in index order."""
     n = pos.shape[0]
+    head, nxt, cell, near, cells_x, cells_y = cells
     if pairs:
         for i in range(n):
-            for j in range(i + 1, n):
+            for q in range(later_neighbours(i, n, head, nxt, cell, cells_x, cells_y, near)):
+                j = near[q]
                 if body[i] == body[j]:
                     continue
                 counters[PAIR_TESTS] += 1

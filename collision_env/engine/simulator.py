@@ -16,19 +16,29 @@ from typing import NamedTuple
 import numpy as np
 
 from ._jit import BACKEND, njit
-from .exact import (
-    CLUSTER_TESTS,
-    EVENTS,
-    PAIR_TESTS,
-    WALL_TESTS,
+from .exact import COUNTERS, impacts_per_event, scratch_sizes, step_exact
+from .grid import GRID_MIN_BALLS, first_overlap, grid_geometry
+from .layout import (
+    B_INV_MASS,
+    B_MASS,
+    B_OMEGA,
+    B_RADIUS,
+    B_VX,
+    B_X,
+    CAL_F,
+    CAL_I,
+    S_ELASTICITY,
+    S_SIGN,
+    W_CALENDAR_VALID,
+    W_GRID_NX,
+    W_GRID_X0,
     WORK_F,
     WORK_I,
-    scratch_sizes,
-    step_exact,
 )
 from .motion import BALL_FIELDS, apply_impulses
 from .scene import CONSTANT_RADIUS, WALL_NAMES, Scene, radius_from_mass
 from .substep import NAIVE, POSTERIORI, step_substeps, worst_case_impacts
+from .substep import scratch_size as substep_scratch_size
 
 MODES = ("naive", "posteriori", "exact")
 
@@ -182,7 +192,7 @@ class BatchSimulator:
         self._body = np.tile(np.arange(n, dtype=np.int64), (n_scenes, 1))
         self._time = np.zeros(n_scenes)
         self._capped = np.zeros(n_scenes, dtype=np.bool_)
-        self._counters = np.zeros(4, dtype=np.int64)
+        self._counters = np.zeros(len(COUNTERS), dtype=np.int64)
 
         bounds = scene.bounds if scene.bounds is not None else (0.0, 0.0, 0.0, 0.0)
         self._fparams = np.array([*bounds, scene.elasticity, self.collapse_ratio, 1.0, self.collapse_floor])
@@ -191,6 +201,12 @@ class BatchSimulator:
              self.max_events],
             dtype=np.int64,
         )
+        self._work_f = np.zeros((n_scenes, len(WORK_F)))
+        self._work_i = np.zeros((n_scenes, len(WORK_I)), dtype=np.int64)
+        # exact mode's event calendar and grid, kept from step to step
+        self._cal_f = np.zeros((n_scenes, n, len(CAL_F)))
+        self._cal_i = np.zeros((n_scenes, n, len(CAL_I)), dtype=np.int64)
+        self._invalidate(np.arange(n_scenes))
         self._alloc_work()
 
     # ------------------------------------------------------------------ validation
@@ -242,48 +258,62 @@ class BatchSimulator:
             fail(out, lambda s, i: f"position must keep the ball inside the reflecting border {scene.bounds}, "
                                    f"got {tuple(pos[s, i])} with radius {r[s, i]:.6g}")
         if scene.ball_collisions and n > 1:
-            d = pos[:, :, None, :] - pos[:, None, :, :]
-            dist = np.sqrt((d**2).sum(-1))
-            sigma = r[:, :, None] + r[:, None, :]
-            overlap = dist < sigma * (1.0 - _CONTACT_RTOL)
-            overlap &= ~np.eye(n, dtype=bool)
-            bad = np.argwhere(np.triu(overlap, 1))
-            if len(bad):
-                s, i, j = bad[0]
-                raise ValueError(
-                    f"{self._label(scenes[s], i)}position overlaps ball {j} "
-                    f"(centres {dist[s, i, j]:.6g} m apart, radii sum to {sigma[s, i, j]:.6g} m)"
-                )
+            for s_ in range(k):
+                i, j = first_overlap(pos[s_], r[s_], _CONTACT_RTOL)
+                if i >= 0:
+                    dist = float(np.hypot(*(pos[s_, i] - pos[s_, j])))
+                    raise ValueError(
+                        f"{self._label(scenes[s_], i)}position overlaps ball {j} "
+                        f"(centres {dist:.6g} m apart, radii sum to {r[s_, i] + r[s_, j]:.6g} m)"
+                    )
         return pos, vel, m, r
 
     # ------------------------------------------------------------------ stepping
     def _bind_views(self):
         b = self._balls
-        self._pos = b[..., 0:2]
-        self._vel = b[..., 2:4]
-        self._mass = b[..., 4]
-        self._inv_mass = b[..., 5]
-        self._radius = b[..., 6]
-        self._omega = b[..., 7]
+        self._pos = b[..., B_X:B_X + 2]
+        self._vel = b[..., B_VX:B_VX + 2]
+        self._mass = b[..., B_MASS]
+        self._inv_mass = b[..., B_INV_MASS]
+        self._radius = b[..., B_RADIUS]
+        self._omega = b[..., B_OMEGA]
 
-    def _alloc_work(self):
-        b = self._n_scenes
-        rows = max(4096, 2 * worst_case_impacts(self._n))
+    def _invalidate(self, scenes):
+        """Drop the calendar's predictions for ``scenes`` (they are made afresh at the next step)
+        and lay out their grid for the balls they now hold."""
+        reach = 1.0 if self.mode == "exact" else 2.0
+        origin_and_cells, counts = grid_geometry(self.scene.bounds, self._pos[scenes], self._radius[scenes],
+                                                 self._uses_grid(), reach)
+        self._work_f[scenes, W_GRID_X0:W_GRID_X0 + 4] = origin_and_cells
+        self._work_i[scenes, W_GRID_NX:W_GRID_NX + 2] = counts
+        self._work_i[scenes, W_CALENDAR_VALID] = 0
+
+    def _uses_grid(self):
+        """The broad phase pays only in large scenes with ball pairs (and no stick clusters)."""
+        return self.scene.ball_collisions and self._n >= GRID_MIN_BALLS and not self.scene.sticky
+
+    def _alloc_work(self, rows=None):
+        if rows is None:
+            if self.mode == "exact":
+                worst = impacts_per_event(self._n, self.scene.elasticity < 1.0)
+            else:  # with a grid, a sub-step's bound is counted from its cells; the buffer grows if needed
+                worst = 16 * self._n if self._uses_grid() else worst_case_impacts(self._n)
+            rows = max(4096, 2 * worst)
         self._imp = np.empty(rows, dtype=IMPACT_DTYPE)
         self._n_imp = np.zeros(2, dtype=np.int64)  # rows filled, scenes that reached the cap
-        self._work_f = np.zeros((b, WORK_F))  # per scene: time left in the step, sub-step start time
-        self._work_i = np.zeros((b, WORK_I), dtype=np.int64)  # per scene: events, active, stalled, sub-steps done
         # the mode's kernel and its arguments, bound once (the arrays are only ever updated in place)
         state = (self._balls, self._body, self._time, self._capped, self._fparams, self._iparams, self._imp,
                  self._n_imp, self._counters, self._work_f, self._work_i)
         if self.mode == "exact":
             nf, ni, nb = scratch_sizes(self._n)
             self._kernel = step_exact
-            self._kernel_args = state + (np.empty(nf), np.empty(ni, dtype=np.int64), np.zeros(nb, dtype=np.bool_))
+            self._kernel_args = state + (self._cal_f, self._cal_i, np.empty(nf), np.empty(ni, dtype=np.int64),
+                                         np.zeros(nb, dtype=np.bool_))
         else:
             self._kernel = step_substeps
-            self._kernel_args = (NAIVE if self.mode == "naive" else POSTERIORI, self.substeps) + state
-        self._sign = float(self._fparams[6])  # the direction _fparams are set for (see step)
+            self._kernel_args = ((NAIVE if self.mode == "naive" else POSTERIORI, self.substeps) + state
+                                 + (np.empty(substep_scratch_size(self._n), dtype=np.int64),))
+        self._sign = float(self._fparams[S_SIGN])  # the direction _fparams are set for (see step)
         self._live = LiveArrays(self._balls, self._pos, self._vel, self._mass, self._radius, self._time, self._body,
                                 self._capped)
 
@@ -309,8 +339,8 @@ class BatchSimulator:
         sign = 1.0 if dt > 0.0 else -1.0
         if sign != self._sign:  # reverse steps use 1/e
             fp = self._fparams
-            fp[4] = e if sign > 0 else 1.0 / e
-            fp[6] = sign
+            fp[S_ELASTICITY] = e if sign > 0 else 1.0 / e
+            fp[S_SIGN] = sign
             self._sign = sign
         if sign < 0:
             np.negative(self._vel, out=self._vel)
@@ -345,6 +375,9 @@ class BatchSimulator:
                 chunks.append(out)
             if not stalled:
                 return chunks
+            if not rows:  # not even one sub-step's worst case fits: a bigger buffer
+                self._alloc_work(2 * len(self._imp))
+                kernel, args = self._kernel, self._kernel_args
             fresh = False
 
     @staticmethod
@@ -424,14 +457,9 @@ class BatchSimulator:
 
     @property
     def stats(self):
-        """Work done so far: pair and wall predictions (or overlap tests), cluster predictions, events."""
-        c = self._counters
-        return {
-            "pair_tests": int(c[PAIR_TESTS]),
-            "wall_tests": int(c[WALL_TESTS]),
-            "cluster_tests": int(c[CLUSTER_TESTS]),
-            "events": int(c[EVENTS]),
-        }
+        """Work done so far: pair and wall predictions (or overlap tests), events, rotating-cluster
+        predictions, grid-cell crossings and stale calendar entries re-predicted (exact mode)."""
+        return {name: int(count) for name, count in zip(COUNTERS, self._counters, strict=True)}
 
     def kinetic_energy(self):
         """``(B,)`` total kinetic energy, J."""
@@ -484,6 +512,7 @@ class BatchSimulator:
         self._body[idx] = np.arange(self._n)
         self._omega[idx] = 0.0
         self._time[idx] = time
+        self._invalidate(idx)
 
     def get_state(self):
         """A dict of array copies that :meth:`set_state` restores exactly."""
@@ -518,6 +547,7 @@ class BatchSimulator:
         np.copyto(self._body, arrays["clusters"])
         np.copyto(self._omega, arrays["omega"])
         np.copyto(self._time, arrays["time"])
+        self._invalidate(np.arange(self._n_scenes))
 
     def copy(self):
         """An independent copy (for planning: step it ahead without touching this one)."""
@@ -525,7 +555,7 @@ class BatchSimulator:
 
     def __getstate__(self):
         state = self.__dict__.copy()
-        for key in ("_imp", "_n_imp", "_work_f", "_work_i", "_kernel", "_kernel_args", "_sign", "_live",
+        for key in ("_imp", "_n_imp", "_kernel", "_kernel_args", "_sign", "_live",
                     "_pos", "_vel", "_mass", "_inv_mass", "_radius", "_omega"):
             state.pop(key)
         return state

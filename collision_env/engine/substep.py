@@ -4,6 +4,19 @@ from __future__ import annotations
 
 from ._jit import njit
 from .exact import scene_params
+from .grid import block, cell_of
+from .layout import (
+    W_ACTIVE,
+    W_GRID_HX,
+    W_GRID_HY,
+    W_GRID_NX,
+    W_GRID_NY,
+    W_GRID_X0,
+    W_GRID_Y0,
+    W_STALLED,
+    W_SUBSTEP_START,
+    W_SUBSTEPS_DONE,
+)
 from .motion import advance_all, ball_views, has_rotation
 from .naive import resolve_naive
 from .posteriori import resolve_posteriori
@@ -13,28 +26,75 @@ NAIVE, POSTERIORI = 0, 1
 
 
 def worst_case_impacts(n):
-    """Most impacts one sub-step can record for one scene (pairs, border, containment)."""
+    """Most impacts one sub-step can record for one scene without a grid (every pair, border,
+    containment); with a grid the bound is counted from the cells (:func:`_grid_worst_case`)."""
     return n * (n - 1) // 2 + 4 * n
+
+
+def scratch_size(n):
+    """Length of :func:`step_substeps`'s int work buffer for ``n`` balls (the sub-step's grid)."""
+    return 4 * n
+
+
+@njit(inline="always")
+def _cell_lists(n, p, v, h, scratch, geo):
+    """Sort the balls into the grid's cells where they will be after the sub-step's move (before
+    it is made, so that a scene can still stall untouched), and return the lists as
+    ``(head, nxt, cell, near, nx, ny)`` for the resolvers."""
+    x0, y0, hx, hy, nx, ny = geo
+    head = scratch[0:n]
+    nxt = scratch[n:2 * n]
+    cell = scratch[2 * n:3 * n]
+    near = scratch[3 * n:4 * n]
+    if nx * ny > 1:
+        for c in range(nx * ny):
+            head[c] = -1
+        for i in range(n - 1, -1, -1):
+            c = cell_of(p[i, 0] + v[i, 0] * h, p[i, 1] + v[i, 1] * h, x0, y0, hx, hy, nx, ny)
+            cell[i] = c
+            nxt[i] = head[c]
+            head[c] = i
+    return head, nxt, cell, near, nx, ny
+
+
+@njit(inline="always")
+def _grid_worst_case(n, cells):
+    """Most impacts a sub-step can record on the grid: a pair per neighbour, and border and
+    containment impacts."""
+    head, nxt, cell, near, nx, ny = cells
+    if nx * ny == 1:
+        return n * (n - 1) // 2 + 4 * n
+    for c in range(nx * ny):
+        near[c] = 0
+    for i in range(n):
+        near[cell[i]] += 1
+    worst = 4 * n
+    for i in range(n):
+        cx0, cx1, cy0, cy1 = block(cell[i], nx, ny)
+        for cy in range(cy0, cy1 + 1):
+            for cx in range(cx0, cx1 + 1):
+                worst += near[cy * nx + cx]
+    return worst
 
 
 @njit
 def step_substeps(mode, k_total, balls, body, time, capped, fparams, iparams, imp, n_imp, counters, work_f, work_i,
-                  dt_abs, fresh):
-    """Run the remaining sub-steps of every active scene (``done[sc]`` of ``k_total`` are done).
+                  scratch, dt_abs, fresh):
+    """Run the remaining sub-steps of every active scene.
 
     Parameters as :func:`exact.step_exact` (``fresh`` starts a step for every scene; ``capped``
-    is not used: the cheap modes have no event cap); a scene stops between sub-steps when the
-    impact buffer could not hold another sub-step's worst case, and is flagged stalled. Returns
-    the number of stalled scenes.
+    is not used: the cheap modes have no event cap; ``scratch`` is an int buffer of
+    :func:`scratch_size`); a scene stops between sub-steps when the impact buffer could not
+    hold another sub-step's worst case, and is flagged stalled. Returns the number of stalled
+    scenes.
     """
     pos, vel, mass, inv_mass, radius, omega = ball_views(balls)
-    t_start = work_f[:, 1]
-    active = work_i[:, 1]
-    stalled = work_i[:, 2]
-    done = work_i[:, 3]
+    t_start = work_f[:, W_SUBSTEP_START]
+    active = work_i[:, W_ACTIVE]
+    stalled = work_i[:, W_STALLED]
+    done = work_i[:, W_SUBSTEPS_DONE]
     n_imp[0] = 0
     n = pos.shape[1]
-    worst = n * (n - 1) // 2 + 4 * n
     bounds, e, ratio, floor, sign, has_walls, pairs, dim, sticky, _ = scene_params(fparams, iparams)
     h = dt_abs / k_total
     if fresh:
@@ -53,9 +113,12 @@ def step_substeps(mode, k_total, balls, body, time, capped, fparams, iparams, im
         m = mass[sc]
         b = body[sc]
         w = omega[sc]
+        geo = (work_f[sc, W_GRID_X0], work_f[sc, W_GRID_Y0], work_f[sc, W_GRID_HX], work_f[sc, W_GRID_HY],
+               work_i[sc, W_GRID_NX], work_i[sc, W_GRID_NY])
         u_min = elastic_threshold(v, ratio, floor)
         while done[sc] < k_total:
-            if imp.shape[0] - n_imp[0] < worst:
+            cells = _cell_lists(n, p, v, h, scratch, geo)
+            if imp.shape[0] - n_imp[0] < _grid_worst_case(n, cells):
                 stalled[sc] = True
                 break
             k = done[sc] + 1
@@ -63,10 +126,10 @@ def step_substeps(mode, k_total, balls, body, time, capped, fparams, iparams, im
             advance_all(h, p, v, m, b, w, sticky and has_rotation(b, w))
             if mode == NAIVE:
                 resolve_naive(sc, t_end, p, v, m, inv_mass[sc], radius[sc], b, w, bounds, dim, e, u_min,
-                              has_walls, pairs, sticky, imp, n_imp, counters)
+                              has_walls, pairs, sticky, imp, n_imp, counters, cells)
             else:
                 resolve_posteriori(sc, t_end, sign, h, p, v, m, inv_mass[sc], radius[sc], b, w, bounds, dim, e, u_min,
-                                   has_walls, pairs, sticky, imp, n_imp, counters)
+                                   has_walls, pairs, sticky, imp, n_imp, counters, cells)
             done[sc] = k
             time[sc] = t_end
         n_stalled += stalled[sc]

@@ -33,7 +33,7 @@ INF = math.inf
 CA_MAX_ITERATIONS = 2000
 
 
-@njit
+@njit(inline="always")
 def toi_pair(dx, dy, dvx, dvy, sigma):
     """Time until two balls in straight-line motion touch, or inf."""
     b = dx * dvx + dy * dvy

@@ -1,0 +1,185 @@
+"""Exact mode's event calendar: one pending event per ball, in a binary heap of balls.
+
+This is the sorter of an event-driven simulation (the scheduler is ``exact.step_exact``, the
+neighbour search is :mod:`collision_env.engine.grid`). Following Lubachevsky (1991) and
+Smallenburg (2022, "Efficient event-driven simulations of hard spheres", EPJE 45:22), each ball
+holds only its earliest known event: a wall, a partner ball, or the crossing of a grid-cell
+boundary. The heap orders balls by event time, and simultaneous events as a scan of the balls in
+index order would meet them (:func:`order_key`); finding, updating or removing an event is
+O(log N).
+
+Invalidation is lazy (Sedgewick & Wayne, *Algorithms*, 4th ed., 6.1): every ball counts the
+changes of its trajectory, and a pair event stores its partner's count when it was predicted. An
+event whose partner has changed since is stale; when it comes to the top of the heap the ball is
+simply predicted afresh. When a prediction finds a pair event earlier than the partner's own, the
+partner's entry is overwritten too (Smallenburg's rule), so every pair's next collision is held by
+at least one of its two balls.
+
+Times in the calendar are relative to the start of the current step (the simulator rebases them
+when a step ends), so no large absolute time enters it.
+
+The per-ball fields live in the packed arrays ``cf`` (floats) and ``ci`` (ints) of one scene,
+laid out as ``layout.CAL_F`` and ``layout.CAL_I``.
+"""
+
+from __future__ import annotations
+
+from ._jit import njit
+from .layout import C_CHANGES, C_EVENT_OTHER, C_EVENT_STAMP, C_EVENT_TIME, C_HEAP, C_HEAP_SLOT
+
+#: ``event_other`` codes below zero. A ball's wall events are ``EV_WALL - wall`` (wall codes 0..3
+#: as in ``scene.WALL_NAMES``); its grid-cell crossings are ``EV_CROSS - direction`` (0: -x,
+#: 1: +x, 2: -y, 3: +y); ``EV_NONE``: nothing is pending.
+EV_WALL = -1
+EV_CROSS = -5
+EV_NONE = -9
+
+
+@njit(inline="always")
+def is_wall(code):
+    return EV_CROSS < code <= EV_WALL
+
+
+@njit(inline="always")
+def is_crossing(code):
+    return EV_NONE < code <= EV_CROSS
+
+
+#: Order keys of a cell crossing and of "nothing pending" among events at the same instant.
+_LAST = 1 << 62
+
+
+@njit(inline="always")
+def order_key(ball, code):
+    """Where ``ball``'s event ``code`` stands among events at the same instant: ``(lead, rank)``.
+
+    A pair event leads with its lower ball and ranks by the higher one; a wall event leads with
+    its ball and comes before that ball's pairs; a cell crossing (which changes no velocity, so
+    its place among ties does not matter) comes after them. Ordering ties by this key resolves
+    simultaneous events exactly as scanning balls in index order would: the lowest ball's wall,
+    then its partners by index, then the next ball.
+    """
+    if code >= 0:
+        return min(ball, code), max(ball, code)
+    if is_wall(code):
+        return ball, -1
+    return ball, _LAST if is_crossing(code) else _LAST + 1
+
+
+@njit(inline="always")
+def earlier(t, code, t_other, code_other, ball):
+    """For ``ball``: candidate event ``(t, code)`` comes strictly before ``(t_other, code_other)``."""
+    if t != t_other:
+        return t < t_other
+    lead, rk = order_key(ball, code)
+    lead_other, rk_other = order_key(ball, code_other)
+    return lead < lead_other or (lead == lead_other and rk < rk_other)
+
+
+@njit(inline="always")
+def _before(a, b, cf, ci):
+    """Ball ``a``'s event comes before ball ``b``'s (ties: see :func:`order_key`, then the ball)."""
+    ta = cf[a, C_EVENT_TIME]
+    tb = cf[b, C_EVENT_TIME]
+    if ta != tb:
+        return ta < tb
+    lead_a, rank_a = order_key(a, ci[a, C_EVENT_OTHER])
+    lead_b, rank_b = order_key(b, ci[b, C_EVENT_OTHER])
+    if lead_a != lead_b:
+        return lead_a < lead_b
+    if rank_a != rank_b:
+        return rank_a < rank_b
+    return a < b
+
+
+@njit(inline="always")
+def _place(slot, ball, ci):
+    ci[slot, C_HEAP] = ball
+    ci[ball, C_HEAP_SLOT] = slot
+
+
+@njit(inline="always")
+def _sift_up(slot, cf, ci):
+    ball = ci[slot, C_HEAP]
+    while slot > 0:
+        parent = (slot - 1) >> 1
+        above = ci[parent, C_HEAP]
+        if not _before(ball, above, cf, ci):
+            break
+        _place(slot, above, ci)
+        slot = parent
+    _place(slot, ball, ci)
+    return slot
+
+
+@njit(inline="always")
+def _sift_down(slot, n, cf, ci):
+    ball = ci[slot, C_HEAP]
+    while True:
+        child = 2 * slot + 1
+        if child >= n:
+            break
+        right = child + 1
+        if right < n and _before(ci[right, C_HEAP], ci[child, C_HEAP], cf, ci):
+            child = right
+        below = ci[child, C_HEAP]
+        if not _before(below, ball, cf, ci):
+            break
+        _place(slot, below, ci)
+        slot = child
+    _place(slot, ball, ci)
+
+
+@njit(inline="always")
+def reschedule(ball, n, cf, ci):
+    """Restore the heap order after ``ball``'s event time changed (either way)."""
+    slot = _sift_up(ci[ball, C_HEAP_SLOT], cf, ci)
+    _sift_down(slot, n, cf, ci)
+
+
+@njit(inline="always")
+def heapify(n, cf, ci):
+    """Order the heap from scratch (Floyd's O(N) construction); it keeps the balls' slots."""
+    for slot in range((n >> 1) - 1, -1, -1):
+        _sift_down(slot, n, cf, ci)
+
+
+@njit(inline="always")
+def reset_heap(n, cf, ci):
+    """Put every ball in the heap (slot = index) and order it."""
+    for i in range(n):
+        _place(i, i, ci)
+    heapify(n, cf, ci)
+
+
+@njit(inline="always")
+def next_ball(ci):
+    """The ball whose event comes first."""
+    return ci[0, C_HEAP]
+
+
+@njit(inline="always")
+def set_event(ball, t, code, stamp, cf, ci):
+    """Give ``ball`` the pending event ``(t, code)`` (``stamp``: the partner's change count);
+    the caller restores the heap order."""
+    cf[ball, C_EVENT_TIME] = t
+    ci[ball, C_EVENT_OTHER] = code
+    ci[ball, C_EVENT_STAMP] = stamp
+
+
+@njit(inline="always")
+def offer_pair(k, t, partner, n, ordered, cf, ci):
+    """Offer ball ``k`` a collision with ``partner`` at ``t``; it takes it if it comes before its
+    own pending event (Smallenburg's rule). ``ordered``: restore the heap order (not while a whole
+    scene is being predicted, before the heap is built)."""
+    if earlier(t, partner, cf[k, C_EVENT_TIME], ci[k, C_EVENT_OTHER], k):
+        set_event(k, t, partner, ci[partner, C_CHANGES], cf, ci)
+        if ordered:
+            reschedule(k, n, cf, ci)
+
+
+@njit(inline="always")
+def is_stale(ball, ci):
+    """A pair event whose partner's trajectory changed after it was predicted."""
+    other = ci[ball, C_EVENT_OTHER]
+    return other >= 0 and ci[other, C_CHANGES] != ci[ball, C_EVENT_STAMP]

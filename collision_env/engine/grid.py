@@ -1,0 +1,263 @@
+"""The broad phase: a uniform grid of cells over the scene, so that a ball meets only its neighbours.
+
+Cells are at least one largest ball diameter wide, so two balls that touch are always in the same
+or adjacent cells, and a prediction looks at the 3 x 3 block of cells around the ball instead of
+every ball (Rapaport 1980; Isobe 1999; Smallenburg 2022). In exact mode a ball's cell is kept up
+to date by cell-crossing events (the ball leaves its cell at a predicted time, like any other
+event); in the cheap modes the grid is rebuilt at every sub-step, which is O(N).
+
+Cells are numbered ``cy * nx + cx``. The grid covers the border, or, without one, the box around
+the balls' starting positions; the outermost cells reach to infinity (positions are clamped), so
+a ball far outside still has a cell and the neighbour rule still holds. The number of cells is
+at most the number of balls, so the grid costs O(N) memory.
+
+The grid is used only where it pays (the model-only-what-is-needed rule): with fewer than
+:data:`GRID_MIN_BALLS` balls, in stick scenes, or when ball pairs are not modelled, the grid has
+one cell and the neighbours of a ball are all the others.
+
+Per-ball fields (``layout.CAL_I``): ``cell``, ``cell_next``, ``cell_prev`` (doubly linked lists,
+so a ball leaves its cell in O(1)); the head of cell c is in row c of ``cell_head``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ._jit import njit
+from .layout import C_CELL, C_CELL_HEAD, C_CELL_NEXT, C_CELL_PREV
+
+#: Scenes with fewer balls keep one cell (every ball is every other's neighbour): below this size
+#: the grid's bookkeeping costs more than the pairs it saves (measured by the engine benchmark).
+GRID_MIN_BALLS = 64
+#: Cells are this much wider than the largest diameter, so that round-off in a ball's position at
+#: a cell boundary can never hide a neighbour.
+CELL_MARGIN = 1.0 + 1e-6
+
+
+def grid_geometry(bounds, positions, radii, use_grid, reach=1.0):
+    """Per-scene grid ``(x0, y0, hx, hy)`` and ``(nx, ny)`` for ``(B, N, 2)`` positions and
+    ``(B, N)`` radii; scenes with ``use_grid`` False get a single cell. The cells are at least
+    ``reach * CELL_MARGIN`` largest diameters wide, and about as many as the balls (at most that
+    many). The cheap modes use ``reach = 2``: their grid is built before a sub-step's overlaps are
+    pushed apart, and a pushed ball must still find the balls it now overlaps."""
+    n_scenes, n = radii.shape
+    if bounds is not None:
+        lo = np.broadcast_to(np.array(bounds[:2], dtype=np.float64), (n_scenes, 2))
+        hi = np.broadcast_to(np.array(bounds[2:], dtype=np.float64), (n_scenes, 2))
+    else:
+        r = radii[..., None]
+        lo = (positions - r).min(axis=1)
+        hi = (positions + r).max(axis=1)
+    size = hi - lo
+    sigma = 2.0 * reach * radii.max(axis=1) * CELL_MARGIN
+    # about one ball per cell, but never narrower than a diameter
+    width = np.maximum(sigma, np.sqrt(size[:, 0] * size[:, 1] / n))
+    counts = np.ones((n_scenes, 2), dtype=np.int64)
+    if use_grid:
+        for axis in range(2):
+            c = np.floor(size[:, axis] / width)
+            counts[:, axis] = np.clip(np.nan_to_num(c, nan=1.0, posinf=1.0), 1, n).astype(np.int64)
+        # a thin box: cells along its long axis alone
+        while np.any(counts[:, 0] * counts[:, 1] > n):
+            over = counts[:, 0] * counts[:, 1] > n
+            big = np.argmax(counts, axis=1)
+            counts[over, big[over]] -= 1
+    cell = np.where(counts > 1, size / counts, np.inf)  # one cell along an axis: no boundary there
+    return np.concatenate([lo, cell], axis=1), counts
+
+
+@njit(inline="always")
+def _axis_cell(x, x0, h, n_cells):
+    f = (x - x0) / h
+    if not f > 0.0:  # (also the one-cell case, h = inf)
+        return 0
+    if f >= n_cells:
+        return n_cells - 1
+    return int(f)
+
+
+@njit(inline="always")
+def cell_of(x, y, x0, y0, hx, hy, nx, ny):
+    """The cell holding point ``(x, y)`` (clamped into the grid)."""
+    return _axis_cell(y, y0, hy, ny) * nx + _axis_cell(x, x0, hx, nx)
+
+
+@njit(inline="always")
+def link(i, c, ci):
+    """Put ball ``i`` at the front of cell ``c``'s list."""
+    head = ci[c, C_CELL_HEAD]
+    ci[i, C_CELL] = c
+    ci[i, C_CELL_PREV] = -1
+    ci[i, C_CELL_NEXT] = head
+    if head >= 0:
+        ci[head, C_CELL_PREV] = i
+    ci[c, C_CELL_HEAD] = i
+
+
+@njit(inline="always")
+def unlink(i, ci):
+    """Take ball ``i`` out of its cell's list."""
+    prev = ci[i, C_CELL_PREV]
+    nxt = ci[i, C_CELL_NEXT]
+    if prev >= 0:
+        ci[prev, C_CELL_NEXT] = nxt
+    else:
+        ci[ci[i, C_CELL], C_CELL_HEAD] = nxt
+    if nxt >= 0:
+        ci[nxt, C_CELL_PREV] = prev
+
+
+@njit(inline="always")
+def fill_cells(n, pos, ci, x0, y0, hx, hy, nx, ny):
+    """Empty every cell and put every ball in the cell of its position."""
+    for c in range(nx * ny):
+        ci[c, C_CELL_HEAD] = -1
+    for i in range(n - 1, -1, -1):
+        link(i, cell_of(pos[i, 0], pos[i, 1], x0, y0, hx, hy, nx, ny), ci)
+
+
+@njit(inline="always")
+def block(c, nx, ny):
+    """The 3 x 3 block of cells around cell ``c``: ``(cx0, cx1, cy0, cy1)``, inclusive."""
+    cx = c % nx
+    cy = c // nx
+    return max(cx - 1, 0), min(cx + 1, nx - 1), max(cy - 1, 0), min(cy + 1, ny - 1)
+
+
+@njit(inline="always")
+def crossing(x, y, vx, vy, c, x0, y0, hx, hy, nx, ny):
+    """Time until a ball at ``(x, y)`` moving at ``(vx, vy)`` leaves cell ``c`` for a neighbour, and
+    the direction (0: -x, 1: +x, 2: -y, 3: +y; -1: it never does). The outermost cells reach to
+    infinity, so there is no crossing out of the grid."""
+    cx = c % nx
+    cy = c // nx
+    best = math.inf
+    direction = -1
+    if vx > 0.0 and cx < nx - 1:
+        best = max((x0 + (cx + 1) * hx - x) / vx, 0.0)
+        direction = 1
+    elif vx < 0.0 and cx > 0:
+        best = max((x0 + cx * hx - x) / vx, 0.0)
+        direction = 0
+    if vy > 0.0 and cy < ny - 1:
+        t = max((y0 + (cy + 1) * hy - y) / vy, 0.0)
+        if t < best:
+            best = t
+            direction = 3
+    elif vy < 0.0 and cy > 0:
+        t = max((y0 + cy * hy - y) / vy, 0.0)
+        if t < best:
+            best = t
+            direction = 2
+    return best, direction
+
+
+@njit(inline="always")
+def neighbour_cell(c, direction, nx):
+    """The cell a ball enters when it leaves cell ``c`` in ``direction``."""
+    if direction == 0:
+        return c - 1
+    if direction == 1:
+        return c + 1
+    if direction == 2:
+        return c - nx
+    return c + nx
+
+
+@njit
+def first_overlap(pos, radius, rtol):
+    """The first pair ``(i, j)``, ``i < j`` in lexicographic order, whose disks overlap by more than
+    ``rtol`` of their radii sum, or ``(-1, -1)``; O(N) expected time on a grid of the balls' box."""
+    n = pos.shape[0]
+    if n < 2:
+        return -1, -1
+    x0 = pos[0, 0]
+    y0 = pos[0, 1]
+    x1 = x0
+    y1 = y0
+    r_max = 0.0
+    for i in range(n):
+        x0 = min(x0, pos[i, 0])
+        x1 = max(x1, pos[i, 0])
+        y0 = min(y0, pos[i, 1])
+        y1 = max(y1, pos[i, 1])
+        r_max = max(r_max, radius[i])
+    h = 2.0 * r_max * CELL_MARGIN
+    nx = min(max(int((x1 - x0) / h), 1), n)
+    ny = min(max(int((y1 - y0) / h), 1), max(n // nx, 1))
+    hx = (x1 - x0) / nx if nx > 1 else math.inf
+    hy = (y1 - y0) / ny if ny > 1 else math.inf
+    hx = max(hx, h)
+    hy = max(hy, h)
+    head = np.full(nx * ny, -1, dtype=np.int64)
+    nxt = np.empty(n, dtype=np.int64)
+    cell = np.empty(n, dtype=np.int64)
+    for i in range(n - 1, -1, -1):
+        c = cell_of(pos[i, 0], pos[i, 1], x0, y0, hx, hy, nx, ny)
+        cell[i] = c
+        nxt[i] = head[c]
+        head[c] = i
+    best_i = -1
+    best_j = -1
+    for i in range(n):
+        cx0, cx1, cy0, cy1 = block(cell[i], nx, ny)
+        for cy in range(cy0, cy1 + 1):
+            for cx in range(cx0, cx1 + 1):
+                j = head[cy * nx + cx]
+                while j >= 0:
+                    if j > i:
+                        dx = pos[j, 0] - pos[i, 0]
+                        dy = pos[j, 1] - pos[i, 1]
+                        sigma = radius[i] + radius[j]
+                        if math.sqrt(dx * dx + dy * dy) < sigma * (1.0 - rtol):
+                            if best_i < 0 or j < best_j:
+                                best_i = i
+                                best_j = j
+                    j = nxt[j]
+        if best_i >= 0:
+            return best_i, best_j
+    return -1, -1
+
+
+# ---------------------------------------------------------------------------- cheap modes
+@njit(inline="always")
+def fill_cell_lists(n, pos, head, nxt, cell, x0, y0, hx, hy, nx, ny):
+    """A throw-away grid of the current positions (the cheap modes rebuild it every sub-step):
+    ``head`` (n_cells,), ``nxt`` and ``cell`` (N,); each cell's list runs in ascending index."""
+    for c in range(nx * ny):
+        head[c] = -1
+    for i in range(n - 1, -1, -1):
+        c = cell_of(pos[i, 0], pos[i, 1], x0, y0, hx, hy, nx, ny)
+        cell[i] = c
+        nxt[i] = head[c]
+        head[c] = i
+
+
+@njit(inline="always")
+def later_neighbours(i, n, head, nxt, cell, nx, ny, out):
+    """The balls ``j > i`` in the 3 x 3 cells around ball ``i``, ascending, into ``out``; returns
+    how many. With one cell that is every ``j > i``, so the cheap modes visit pairs in the same
+    index order with or without a grid."""
+    m = 0
+    if nx * ny == 1:
+        for j in range(i + 1, n):
+            out[m] = j
+            m += 1
+        return m
+    cx0, cx1, cy0, cy1 = block(cell[i], nx, ny)
+    for cy in range(cy0, cy1 + 1):
+        for cx in range(cx0, cx1 + 1):
+            j = head[cy * nx + cx]
+            while j >= 0:
+                if j > i:
+                    # insertion into the sorted prefix (a handful of neighbours)
+                    q = m
+                    while q > 0 and out[q - 1] > j:
+                        out[q] = out[q - 1]
+                        q -= 1
+                    out[q] = j
+                    m += 1
+                j = nxt[j]
+    return m

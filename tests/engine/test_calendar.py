@@ -1,0 +1,180 @@
+"""Exact mode's persistent calendar and the grid broad phase.
+
+Every invalidation path is checked against a simulator built afresh from the same state (which
+predicts everything from scratch): a nudge between steps, ``set_state``, a reversal of time, a
+ball crossing many grid cells in one step, and a batch of 1024 scenes. The grid is checked
+against all pairs, in exact mode and in the cheap modes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import collision_env.engine.simulator as simulator_module
+from collision_env.engine import BatchSimulator, Scene, Simulator
+from collision_env.engine.grid import GRID_MIN_BALLS
+
+
+def gas(n, phi=0.3, r=0.01, seed=0, speed=1.0):
+    """``n`` disks of radius ``r`` on a square lattice in a box at area fraction ``phi``."""
+    side = np.sqrt(n * np.pi * r * r / phi)
+    m = int(np.ceil(np.sqrt(n)))
+    g = (np.arange(m) + 0.5) * side / m - side / 2
+    xx, yy = np.meshgrid(g, g)
+    pos = np.stack([xx.ravel(), yy.ravel()], 1)[:n]
+    vel = np.random.default_rng(seed).normal(size=(n, 2)) * speed / np.sqrt(2)
+    return Scene(bounds=(-side / 2, -side / 2, side / 2, side / 2)), pos, vel, np.full(n, r)
+
+
+def fresh_copy(sim):
+    """A simulator that has never predicted anything, in ``sim``'s state."""
+    new = Simulator(sim.scene, sim.positions, sim.velocities, sim.masses, radii=sim.radii, mode=sim.mode,
+                    max_events=sim.batch.max_events)
+    new.set_state(sim.get_state())
+    return new
+
+
+def rows(impacts):
+    return [(i.ball, i.other, i.wall) for i in impacts], np.array([i.time for i in impacts])
+
+
+def assert_same_impacts(a, b):
+    keys_a, times_a = rows(a)
+    keys_b, times_b = rows(b)
+    assert keys_a == keys_b
+    np.testing.assert_allclose(times_a, times_b, rtol=0, atol=1e-12)
+
+
+def step_both(sim, other, dt, steps):
+    for _ in range(steps):
+        assert_same_impacts(sim.step(dt), other.step(dt))
+    np.testing.assert_allclose(sim.positions, other.positions, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(sim.velocities, other.velocities, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("n", [6, 120])
+def test_nudge_between_steps_matches_a_fresh_simulator(n):
+    scene, pos, vel, radii = gas(n)
+    sim = Simulator(scene, pos, vel, np.ones(n), radii=radii)
+    for _ in range(10):
+        sim.step(1 / 60)
+    dv = np.zeros((n, 2))
+    dv[n // 2] = (0.7, -0.3)
+    sim.nudge(dv)
+    step_both(sim, fresh_copy(sim), 1 / 60, 20)
+
+
+@pytest.mark.parametrize("n", [6, 120])
+def test_set_state_matches_a_fresh_simulator(n):
+    scene, pos, vel, radii = gas(n)
+    sim = Simulator(scene, pos, vel, np.ones(n), radii=radii)
+    saved = sim.get_state()
+    for _ in range(15):
+        sim.step(1 / 60)
+    sim.set_state(saved)  # back to the start: every prediction made since is void
+    reference = Simulator(scene, pos, vel, np.ones(n), radii=radii)
+    step_both(sim, reference, 1 / 60, 20)
+
+
+@pytest.mark.parametrize("n", [6, 120])
+def test_reversal_of_time_matches_a_fresh_simulator(n):
+    scene, pos, vel, radii = gas(n)
+    sim = Simulator(scene, pos, vel, np.ones(n), radii=radii)
+    for _ in range(10):
+        sim.step(1 / 60)
+    step_both(sim, fresh_copy(sim), -1 / 60, 5)
+    step_both(sim, fresh_copy(sim), 1 / 60, 5)
+
+
+def test_forward_then_back_returns_to_the_start_with_the_calendar_kept():
+    scene, pos, vel, radii = gas(150, phi=0.1)
+    sim = Simulator(scene, pos, vel, np.ones(150), radii=radii)
+    for _ in range(12):
+        sim.step(1 / 120)
+    for _ in range(12):
+        sim.step(-1 / 120)
+    np.testing.assert_allclose(sim.positions, pos, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(sim.velocities, vel, rtol=0, atol=1e-9)
+
+
+def without_grid(monkeypatch):
+    monkeypatch.setattr(simulator_module, "GRID_MIN_BALLS", 10**9)
+
+
+def test_a_ball_crossing_many_cells_in_one_step(monkeypatch):
+    scene, pos, vel, radii = gas(200, phi=0.05)
+    vel[:] = 0.0
+    vel[0] = (37.0, 11.0)  # a bullet: ~20 cells per step
+    sim = Simulator(scene, pos, vel, np.ones(200), radii=radii)
+    assert sim.batch._work_i[0, simulator_module.W_GRID_NX] > 10
+    without_grid(monkeypatch)
+    reference = Simulator(scene, pos, vel, np.ones(200), radii=radii)
+    assert reference.batch._work_i[0, simulator_module.W_GRID_NX] == 1
+    step_both(sim, reference, 1 / 30, 10)
+    assert sim.stats["cell_crossings"] > 100
+    assert sim.stats["events"] > 20
+
+
+@pytest.mark.parametrize("mode", ["naive", "posteriori", "exact"])
+def test_grid_agrees_with_all_pairs(mode, monkeypatch):
+    scene, pos, vel, radii = gas(150)
+    sim = Simulator(scene, pos, vel, np.ones(150), radii=radii, mode=mode)
+    without_grid(monkeypatch)
+    reference = Simulator(scene, pos, vel, np.ones(150), radii=radii, mode=mode)
+    step_both(sim, reference, 1 / 120, 30)
+    assert sim.stats["pair_tests"] < reference.stats["pair_tests"] / 3
+
+
+def test_batch_of_1024_scenes_matches_fresh_simulators():
+    rng = np.random.default_rng(3)
+    b, n = 1024, 4
+    scene = Scene()
+    x = np.linspace(-1.5, 1.5, n)
+    pos = np.stack([np.broadcast_to(x, (b, n)), rng.uniform(-0.7, 0.7, (b, n))], -1)
+    vel = rng.normal(size=(b, n, 2))
+    masses = np.ones(n)
+    batch = BatchSimulator(scene, pos, vel, masses, radii=np.full(n, 0.1))
+    for step in range(30):
+        if step % 7 == 3:  # nudge a third of the scenes, as a vector env's actions do
+            dv = np.zeros((b, n, 2))
+            dv[::3, 0] = rng.normal(size=(len(dv[::3]), 2))
+            batch.nudge(dv)
+        state = batch.get_state()
+        reference = BatchSimulator(scene, state["positions"], state["velocities"], masses, radii=np.full(n, 0.1))
+        reference.set_state(state)
+        got, want = batch.step(1 / 60), reference.step(1 / 60)
+        np.testing.assert_array_equal(got[["scene", "ball", "other", "wall"]], want[["scene", "ball", "other", "wall"]])
+        np.testing.assert_allclose(got["time"], want["time"], rtol=0, atol=1e-12)
+        np.testing.assert_allclose(batch.positions, reference.positions, rtol=0, atol=1e-12)
+
+
+def test_predictions_survive_from_step_to_step():
+    """Steps without events cost no prediction: the calendar is kept."""
+    sim = Simulator(Scene(), [[-1.0, 0.0], [1.0, 0.5]], [[0.01, 0.0], [0.0, 0.01]], [1.0, 1.0])
+    sim.step(1 / 60)
+    before = sim.stats
+    for _ in range(100):
+        sim.step(1 / 60)
+    after = sim.stats
+    assert after["events"] == before["events"]
+    assert after["pair_tests"] == before["pair_tests"]
+    assert after["wall_tests"] == before["wall_tests"]
+
+
+def test_memory_and_construction_are_linear_in_the_balls():
+    n = 20_000
+    scene, pos, vel, radii = gas(n)
+    sim = Simulator(scene, pos, vel, np.ones(n), radii=radii)
+    arrays = [v for v in vars(sim.batch).values() if isinstance(v, np.ndarray)]
+    arrays += [a for a in sim.batch._kernel_args if isinstance(a, np.ndarray)]
+    per_ball = sum({id(a): a.nbytes for a in arrays}.values()) / n
+    assert per_ball < 2048
+    assert GRID_MIN_BALLS < n
+
+
+def test_overlap_found_by_the_grid_names_both_balls():
+    scene, pos, vel, radii = gas(300)
+    pos[250] = pos[7] + (0.015, 0.0)
+    with pytest.raises(ValueError, match=r"ball 7: position overlaps ball 250"):
+        Simulator(scene, pos, vel, np.ones(300), radii=radii)
