@@ -25,7 +25,7 @@ laid out as ``layout.CAL_F`` and ``layout.CAL_I``.
 from __future__ import annotations
 
 from ._jit import njit
-from .layout import C_CHANGES, C_EVENT_OTHER, C_EVENT_STAMP, C_EVENT_TIME, C_HEAP, C_HEAP_SLOT
+from .layout import C_CHANGES, C_EVENT_OTHER, C_EVENT_STAMP, C_EVENT_TIME, C_HEAP, C_HEAP_SLOT, C_HEAP_TIME
 
 #: ``event_other`` codes below zero. A ball's wall events are ``EV_WALL - wall`` (wall codes 0..3
 #: as in ``scene.WALL_NAMES``); its grid-cell crossings are ``EV_CROSS - direction`` (0: -x,
@@ -77,10 +77,9 @@ def earlier(t, code, t_other, code_other, ball):
 
 
 @njit(inline="always")
-def _before(a, b, cf, ci):
-    """Ball ``a``'s event comes before ball ``b``'s (ties: see :func:`order_key`, then the ball)."""
-    ta = cf[a, C_EVENT_TIME]
-    tb = cf[b, C_EVENT_TIME]
+def _before(ta, a, tb, b, ci):
+    """Ball ``a``'s event at ``ta`` comes before ball ``b``'s at ``tb`` (ties: see
+    :func:`order_key`, then the ball)."""
     if ta != tb:
         return ta < tb
     lead_a, rank_a = order_key(a, ci[a, C_EVENT_OTHER])
@@ -92,42 +91,46 @@ def _before(a, b, cf, ci):
     return a < b
 
 
+# The heap keeps each slot's event time beside it (``heap_time``), so that sifting compares
+# neighbouring rows instead of chasing every ball's own row (a cache miss per level at scale).
 @njit(inline="always")
-def _place(slot, ball, ci):
+def _place(slot, ball, t, cf, ci):
     ci[slot, C_HEAP] = ball
+    cf[slot, C_HEAP_TIME] = t
     ci[ball, C_HEAP_SLOT] = slot
 
 
 @njit(inline="always")
 def _sift_up(slot, cf, ci):
     ball = ci[slot, C_HEAP]
+    t = cf[ball, C_EVENT_TIME]
     while slot > 0:
         parent = (slot - 1) >> 1
-        above = ci[parent, C_HEAP]
-        if not _before(ball, above, cf, ci):
+        if not _before(t, ball, cf[parent, C_HEAP_TIME], ci[parent, C_HEAP], ci):
             break
-        _place(slot, above, ci)
+        _place(slot, ci[parent, C_HEAP], cf[parent, C_HEAP_TIME], cf, ci)
         slot = parent
-    _place(slot, ball, ci)
+    _place(slot, ball, t, cf, ci)
     return slot
 
 
 @njit(inline="always")
 def _sift_down(slot, n, cf, ci):
     ball = ci[slot, C_HEAP]
+    t = cf[ball, C_EVENT_TIME]
     while True:
         child = 2 * slot + 1
         if child >= n:
             break
         right = child + 1
-        if right < n and _before(ci[right, C_HEAP], ci[child, C_HEAP], cf, ci):
+        if right < n and _before(cf[right, C_HEAP_TIME], ci[right, C_HEAP], cf[child, C_HEAP_TIME],
+                                 ci[child, C_HEAP], ci):
             child = right
-        below = ci[child, C_HEAP]
-        if not _before(below, ball, cf, ci):
+        if not _before(cf[child, C_HEAP_TIME], ci[child, C_HEAP], t, ball, ci):
             break
-        _place(slot, below, ci)
+        _place(slot, ci[child, C_HEAP], cf[child, C_HEAP_TIME], cf, ci)
         slot = child
-    _place(slot, ball, ci)
+    _place(slot, ball, t, cf, ci)
 
 
 @njit(inline="always")
@@ -139,7 +142,7 @@ def reschedule(ball, n, cf, ci):
 
 @njit(inline="always")
 def heapify(n, cf, ci):
-    """Order the heap from scratch (Floyd's O(N) construction); it keeps the balls' slots."""
+    """Order the heap from scratch (Floyd's O(N) construction), from the balls' event times."""
     for slot in range((n >> 1) - 1, -1, -1):
         _sift_down(slot, n, cf, ci)
 
@@ -148,7 +151,7 @@ def heapify(n, cf, ci):
 def reset_heap(n, cf, ci):
     """Put every ball in the heap (slot = index) and order it."""
     for i in range(n):
-        _place(i, i, ci)
+        _place(i, i, cf[i, C_EVENT_TIME], cf, ci)
     heapify(n, cf, ci)
 
 

@@ -54,6 +54,7 @@ from .layout import (
     C_EVENT_OTHER,
     C_EVENT_STAMP,
     C_EVENT_TIME,
+    C_HEAP_TIME,
     C_REF_TIME,
     C_SEEN_VX,
     C_SEEN_VY,
@@ -575,6 +576,7 @@ def _finish(t_end, pos, vel, mass, body, omega, rot, sticky, cf, ci):
     _sync_all(t_end, pos, vel, mass, body, omega, rot, sticky, cf)
     for i in range(n):
         cf[i, C_EVENT_TIME] -= t_end
+        cf[i, C_HEAP_TIME] -= t_end  # (row i: heap slot i, the same times rebased the same way)
         cf[i, C_REF_TIME] = 0.0
         cf[i, C_SEEN_X] = pos[i, 0]
         cf[i, C_SEEN_Y] = pos[i, 1]

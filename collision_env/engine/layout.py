@@ -30,9 +30,10 @@ B_X, B_Y, B_VX, B_VY, B_MASS, B_INV_MASS, B_RADIUS, B_OMEGA = range(8)
 #: Per-ball calendar floats: the time of the ball's next event (relative to the step's start);
 #: the time its stored position refers to (balls are moved lazily, when an event touches them);
 #: the position and velocity it had when the last step ended (a change made between steps, by a
-#: nudge or an env, is found by comparing against them).
-CAL_F = ("event_time", "ref_time", "seen_x", "seen_y", "seen_vx", "seen_vy")
-C_EVENT_TIME, C_REF_TIME, C_SEEN_X, C_SEEN_Y, C_SEEN_VX, C_SEEN_VY = range(6)
+#: nudge or an env, is found by comparing against them); and, in row s, the event time of the
+#: ball in heap slot s.
+CAL_F = ("event_time", "ref_time", "seen_x", "seen_y", "seen_vx", "seen_vy", "heap_time")
+C_EVENT_TIME, C_REF_TIME, C_SEEN_X, C_SEEN_Y, C_SEEN_VX, C_SEEN_VY, C_HEAP_TIME = range(7)
 
 #: Per-ball calendar ints: what the next event is (a partner ball >= 0, or an ``calendar.EV_*``
 #: code); the partner's change counter when the event was predicted (a mismatch makes the event
