@@ -25,7 +25,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import statistics
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -33,6 +32,7 @@ from pathlib import Path
 
 from agents.config import UsageError, as_int, check_env_id, hyperparams_for, read_run, run_cli
 from agents.evaluate import pct
+from collision_env.bench.machine import cpus, machine, timestamp, versions
 
 DEFAULT_ENVS = ("CollisionEnv/OneBallTarget-v0", "CollisionEnv/Line1D-v0")
 DEFAULT_MODES = ("naive:1", "naive:4", "posteriori:1", "posteriori:4", "exact:1")
@@ -263,7 +263,7 @@ def plot(rows: list, path: Path) -> Path | None:
 
 def render(data: dict, docs: Path, readme: Path | None) -> None:
     """Write the tables (and plot) from the study's JSON, and the README block."""
-    from collision_env._readme import write_block
+    from collision_env.bench.readme import write_block
 
     docs.mkdir(parents=True, exist_ok=True)
     meta = data["meta"]
@@ -315,7 +315,7 @@ def main(argv: list[str] | None = None) -> dict:
     docs = Path(args.docs)
     readme = Path(args.readme) if args.readme else None
     if readme is not None:  # a README without the block's markers would only be found after the study
-        from collision_env._readme import markers
+        from collision_env.bench.readme import markers
 
         start, end = markers(README_BLOCK)
         text = readme.read_text() if readme.is_file() else ""
@@ -367,9 +367,9 @@ def main(argv: list[str] | None = None) -> dict:
     if args.part in ("presets", "both"):
         print("baselines ...")
         base = _run_all(baselines, [{"env_id": e, "episodes": args.episodes} for e in presets], args.jobs, print)
-    data = {"meta": {"date": time.strftime("%Y-%m-%d %H:%M"), "machine": f"{platform.machine()} {platform.system()}",
-                     "cpus": os.cpu_count(), "jobs": args.jobs, "minutes": (time.perf_counter() - start) / 60,
-                     "python": platform.python_version()},
+    data = {"meta": {"date": timestamp(), "machine": machine(), "cpus": cpus(), "jobs": args.jobs,
+                     "minutes": (time.perf_counter() - start) / 60,
+                     "versions": versions(["gymnasium", "stable_baselines3", "torch"])},
             "rows": rows, "baselines": base}
     docs.mkdir(parents=True, exist_ok=True)
     (docs / "study.json").write_text(json.dumps(data, indent=1))

@@ -32,7 +32,6 @@ callback settings are the defaults then (options given on the command line still
 from __future__ import annotations
 
 import argparse
-import platform
 import shutil
 import time
 from pathlib import Path
@@ -58,6 +57,7 @@ from agents.config import (
     wants_progress,
     write_yaml,
 )
+from collision_env.bench.machine import versions
 
 DEFAULT_ENV = "CollisionEnv/OneBallTarget-v0"
 VEC_ENVS = ("native", "dummy", "subproc")
@@ -136,21 +136,6 @@ def _callbacks(run_dir: Path, eval_env, eval_seed: int, n_envs: int, eval_freq: 
     return out
 
 
-def _versions() -> dict:
-    import gymnasium
-    import numpy
-    import stable_baselines3
-    import torch
-
-    import collision_env
-    from collision_env.engine import BACKEND
-
-    versions = {"python": platform.python_version(), "numpy": numpy.__version__, "gymnasium": gymnasium.__version__,
-                "stable_baselines3": stable_baselines3.__version__, "torch": torch.__version__,
-                "collision_env": collision_env.__version__, "engine_backend": BACKEND}
-    return {name: str(v) for name, v in versions.items()}  # torch's version is a str subclass
-
-
 def run_label(env_id: str, mode: str, substeps: int, seed: int) -> str:
     """``oneballtarget-posteriori4-s0``: what a run folder's name starts with."""
     name = env_id.split("/")[-1].rsplit("-v", 1)[0].lower()
@@ -215,7 +200,7 @@ def train(env_id: str = DEFAULT_ENV, *, timesteps: float | None = None, n_envs: 
         "env_id": env_id, "env_kwargs": kwargs, "episode_steps": steps, "seed": seed, "n_envs": n_envs,
         "n_timesteps": timesteps, "vec_env": vec_env, "callbacks": callbacks_cfg, "threads": threads,
         "hyperparams": {**hp, "n_envs": n_envs, "n_timesteps": timesteps, "env_kwargs": dict(kwargs)},
-        "hyperparams_file": str(hyperparams), "versions": _versions(),
+        "hyperparams_file": str(hyperparams), "versions": versions(["gymnasium", "stable_baselines3", "torch"]),
     }
     write_yaml(run_dir / CONFIG_FILE, config)
 

@@ -1,16 +1,30 @@
-"""The speed/accuracy study (issue 5): what each mode costs, how far it is from exact, and where it breaks.
+"""Benchmarks: what each fidelity mode costs, how far it is from exact, and how it compares with its peers.
 
-- :mod:`.scenes`: the benchmark scenes (PhET presets, gases, a corner shot, Newton's cradle, the pi
-  billiard, an inelastic pile-up), each a function returning ``(scene, positions, velocities,
-  masses, radii)``.
-- :mod:`.metrics`: impact matching against the exact reference, conservation and validity checks,
-  statistical checks for long runs.
-- :mod:`.engines`: one stepping interface over this engine's modes and the peers (pymunk, billiards).
-- :mod:`.sweep`: mode x control step x number of balls x scene, peers in the same run.
-- :mod:`.extremes`: every mode over the stress grid (``python -m collision_env.bench.extremes``).
-- :mod:`.stats`, :mod:`.envrates`, :mod:`.report`: long-run statistics, env steps per second, and
-  the CSV / Markdown / plots / generated summary.
+Every section is a module with a ``main(argv)``, runnable on its own
+(``python -m collision_env.bench.<section>``) or through the package
+(``python -m collision_env.bench <section> ...``); :data:`SECTIONS` lists them, and
+``python -m collision_env.bench`` alone runs the study.
 
-Run ``python -m collision_env.bench --quick`` (about half a minute) or without ``--quick`` (the
-full study); outputs go to ``docs/bench/``.
+- :mod:`.study`: mode x control step x number of balls x scene, peers in the same run, plus the
+  stress grid, long-run statistics and env rates; outputs go to ``docs/bench/``.
+- :mod:`.engine`: exact mode against billiards on a gas, the cost per step of each mode against
+  pymunk, batched against looped stepping.
+- :mod:`.envs`: env steps per second of every registered id against Gymnasium's CartPole.
+- :mod:`.extremes`: every mode over the stress grid.
+
+What they share:
+
+- :mod:`.peers`: one adapter class per peer engine (pymunk, billiards) behind one interface;
+  :mod:`.engines` adds this engine's modes to it.
+- :mod:`.scenes` (the benchmark cases), :mod:`.metrics` (impact matching, conservation and
+  validity checks), :mod:`.timing` (repeated timers), :mod:`.machine` (what a run ran on),
+  :mod:`.readme` (the README's generated blocks).
 """
+
+#: section name -> (module, what it measures)
+SECTIONS: dict[str, tuple[str, str]] = {
+    "study": ("collision_env.bench.study", "error against cost: every mode and peer, every scene (docs/bench/)"),
+    "engine": ("collision_env.bench.engine", "exact mode against billiards; cost per step against pymunk; batching"),
+    "envs": ("collision_env.bench.envs", "env steps per second of every registered id against CartPole"),
+    "extremes": ("collision_env.bench.extremes", "every mode over the stress grid"),
+}

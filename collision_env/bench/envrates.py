@@ -1,12 +1,13 @@
 """Environment steps per second for each registered env id and mode, with CartPole as the anchor.
 
-Measured in the same run as the sweep (random actions, resets at episode ends). Returns a string
-saying why instead when the environments are not importable or registered.
+Measured in the same run as the sweep with the env benchmark's timers
+(:mod:`collision_env.bench.envs`: random actions, resets at episode ends). Returns a string saying
+why instead when the environments are not importable or registered.
 """
 
 from __future__ import annotations
 
-import time
+from .envs import single_env_us, vector_env_steps_per_s
 
 #: env id -> the sweep scene it matches most closely
 MATCHING_SCENE = {
@@ -20,25 +21,18 @@ MATCHING_SCENE = {
 MODES = (("naive", 1), ("posteriori", 1), ("posteriori", 8), ("exact", 1))
 
 
-def _rate(make, steps):
-    env = make()
+def _rates(make_single, make_vector, seconds: float) -> tuple[float, float]:
+    """Steps per second of a single env and env-steps per second of a vector env, from the env timers."""
+    env = make_single()
     try:
-        env.reset(seed=0)
-        env.action_space.seed(0)
-        actions = [env.action_space.sample() for _ in range(min(steps, 256))]
-        def run(n):
-            for k in range(n):
-                out = env.step(actions[k % len(actions)])
-                term, trunc = out[2], out[3]
-                if not hasattr(term, "__len__") and (term or trunc):  # vector envs reset themselves
-                    env.reset()
-
-        run(min(20, steps))  # warm-up
-        t0 = time.perf_counter()
-        run(steps)
-        return time.perf_counter() - t0
+        single = 1e6 / single_env_us(env, seconds)
     finally:
         env.close()
+    venv = make_vector()
+    try:
+        return single, vector_env_steps_per_s(venv, seconds)
+    finally:
+        venv.close()
 
 
 def env_rates(quick: bool, log=print):
@@ -53,22 +47,19 @@ def env_rates(quick: bool, log=print):
     ids = [i for i in ids if i in gym.registry]
     if not ids:
         return "left out: no collision_env environment ids are registered yet"
-    steps, vsteps, nvec = (300, 30, 64) if quick else (2000, 200, 64)
-    rows = []
-    anchors = [("CartPole-v1", "anchor", "—")]
-    for env_id, scene, mode in anchors:
-        single = _rate(lambda env_id=env_id: gym.make(env_id), steps)
-        vec = _rate(lambda env_id=env_id: gym.make_vec(env_id, num_envs=nvec, vectorization_mode="vector_entry_point"),
-                    vsteps)
-        rows.append({"env": env_id, "scene": scene, "mode": mode, "single_steps_per_s": steps / single,
-                     "vector_steps_per_s": vsteps * nvec / vec})
+    seconds, nvec = (0.01, 64) if quick else (0.05, 64)
+
+    def vector(env_id, **kw):
+        return lambda: gym.make_vec(env_id, num_envs=nvec, vectorization_mode="vector_entry_point", **kw)
+
+    single, vec = _rates(lambda: gym.make("CartPole-v1"), vector("CartPole-v1"), seconds)
+    rows = [{"env": "CartPole-v1", "scene": "anchor", "mode": "—", "single_steps_per_s": single,
+             "vector_steps_per_s": vec}]
     for env_id in ids:
         for mode, k in MODES:
             kw = {"mode": mode, "substeps": k}
             try:
-                single = _rate(lambda env_id=env_id, kw=kw: gym.make(env_id, **kw), steps)
-                vec = _rate(lambda env_id=env_id, kw=kw: gym.make_vec(
-                    env_id, num_envs=nvec, vectorization_mode="vector_entry_point", **kw), vsteps)
+                single, vec = _rates(lambda env_id=env_id, kw=kw: gym.make(env_id, **kw), vector(env_id, **kw), seconds)
             except Exception as exc:  # an env that cannot run a mode is a result
                 rows.append({"env": env_id, "scene": MATCHING_SCENE.get(env_id, ""), "mode": f"{mode} k={k}",
                              "single_steps_per_s": float("nan"), "vector_steps_per_s": float("nan"),
@@ -76,7 +67,7 @@ def env_rates(quick: bool, log=print):
                 continue
             label = mode if mode != "posteriori" else f"posteriori k={k}"
             rows.append({"env": env_id, "scene": MATCHING_SCENE.get(env_id, "—"), "mode": label,
-                         "single_steps_per_s": steps / single, "vector_steps_per_s": vsteps * nvec / vec})
+                         "single_steps_per_s": single, "vector_steps_per_s": vec})
         log(f"  env {env_id}: done")
     return rows
 

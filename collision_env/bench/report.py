@@ -21,7 +21,7 @@ ROUND_OFF = 1e-9
 #: Error levels (in radii) the summary's rules are stated for.
 LEVELS = (1e-6, 1e-3, 1e-1)
 PLOT_FLOOR = 1e-16
-#: the README block this study rewrites (see ``collision_env._readme``)
+#: the README block this study rewrites (see :mod:`collision_env.bench.readme`)
 README_BLOCK = "bench:study"
 
 

@@ -2,8 +2,8 @@
 
 The builders are deterministic (seeded) and take the number of balls where that makes sense;
 :data:`SCENES` lists them with the ball counts the sweep uses, a default horizon and whether the
-scene is chaotic (then the sweep cuts the horizon at about 5 collisions per ball, research note
-section 4.3, so that a final-state comparison against the exact reference still means something).
+scene is chaotic (then the sweep cuts the horizon at about 5 collisions per ball, before chaos
+amplifies round-off, so that a final-state comparison against the exact reference still means something).
 
 | scene | what it is | balls |
 |---|---|---|

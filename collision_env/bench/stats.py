@@ -22,7 +22,8 @@ import time
 import numpy as np
 
 from . import metrics as M
-from .engines import BilliardsRunner, EngineRunner, PymunkRunner
+from .engines import EngineRunner
+from .peers import make_peer
 from .scenes import SCENES
 from .sweep import record_run
 
@@ -33,12 +34,8 @@ STAT_FIELDS = ("gas", "n", "packing", "family", "dt", "tunnel_scale", "horizon",
 
 def _runners():
     out = [EngineRunner("naive"), EngineRunner("posteriori", 1), EngineRunner("posteriori", 8), EngineRunner("exact")]
-    for cls, kw in ((PymunkRunner, {"iterations": 10}), (BilliardsRunner, {})):
-        try:
-            out.append(cls(**kw))
-        except ImportError:
-            pass
-    return out
+    peers = (make_peer("pymunk", iterations=10), make_peer("billiards"))
+    return out + [peer for peer in peers if not isinstance(peer, str)]
 
 
 def gas_statistics(quick: bool, log=print) -> list[dict]:

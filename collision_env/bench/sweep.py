@@ -5,7 +5,8 @@ For every scene and ball count:
 1. **Reference.** Exact mode runs the scene's horizon (in 400 steps, with a high event cap). For a
    chaotic scene the horizon is then cut where the balls have had 5 collisions each on average
    (between two impacts), so that a final-state comparison still measures the mode and not the
-   chaos (research note section 4.3); exact mode is rerun over that horizon and its impacts, final
+   chaos (a hard-disk gas is chaotic, Dellago, Hoover & Posch, Phys. Rev. E 65, 056216, 2002: round-off
+   grows by orders of magnitude per collision per ball); exact mode is rerun over that horizon and its impacts, final
    state and peak speed are the reference.
 2. **Runs.** Every runner (this engine's modes, the installed peers) at every control step
    ``dt <= horizon``: one recorded run (impacts and the state after every step) for the accuracy
@@ -30,7 +31,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import metrics as M
-from .engines import EngineRunner, Runner, collect, engine_runners, peer_runners
+from .engines import EngineRunner, engine_runners, peer_runners
+from .peers import Runner, collect
 from .scenes import SCENES, Case, SceneSpec, pi_collisions
 
 DT_QUICK = (0.001, 0.01, 0.1)

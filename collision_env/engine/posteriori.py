@@ -1,11 +1,11 @@
-"""Posteriori mode: the seed note's overlap-time reconstruction (PhET's first engine).
+"""Posteriori mode: the overlap-time reconstruction of PhET Collision Lab's first engine (B. Li, 2020).
 
 Move every ball by the (sub)step; then, for each overlap found, reconstruct how long ago contact
 happened, rewind to it, respond there, and re-advance by the same time with the new velocities.
 
 - Ball-ball, pairs in index order: the root of ``|dv|^2 t^2 - 2 (dr.dv) t + (|dr|^2 - sigma^2) = 0``
   that lies in the past (``t >= 0``), taken in its cancellation-free form.
-- Ball-border, as BRIEF section 3.2 writes it: ``ds = r - r_closest`` with ``r_closest`` the
+- Ball-border, as PhET's ``getBallToBorderCollisionOverlapTime``: ``ds = r - r_closest``, ``r_closest`` the
   centre clamped into the bounds eroded by the radius, and ``t = |ds|^2 / (v . ds)``;
   ``v . ds = 0`` gives ``t = 0`` instead of a division by zero. Every axis on which the ball is
   outside is reflected. This is exact for one wall; past a corner it returns a
@@ -45,7 +45,7 @@ def _move(i, dt, pos, vel, mass, body, omega):
 
 @njit
 def overlap_time_pair(dx, dy, dvx, dvy, sigma):
-    """How long ago an overlapping pair touched: the non-negative root of the seed's quadratic."""
+    """How long ago an overlapping pair touched: the non-negative root of PhET's quadratic."""
     a = dvx * dvx + dvy * dvy
     if a == 0.0:
         return 0.0
@@ -59,7 +59,7 @@ def overlap_time_pair(dx, dy, dvx, dvy, sigma):
 
 @njit(inline="always")
 def overlap_time_border(x, y, vx, vy, r, bounds, dim):
-    """The seed note's ``|ds|^2 / (v . ds)``, with the overshoot vector ``ds`` it uses."""
+    """PhET's ``|ds|^2 / (v . ds)``, with the overshoot vector ``ds`` it uses."""
     cx = min(max(x, bounds[0] + r), bounds[2] - r)
     cy = min(max(y, bounds[1] + r), bounds[3] - r) if dim == 2 else y
     dsx = x - cx

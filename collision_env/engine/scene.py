@@ -10,6 +10,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 #: PhET Collision Lab's 2D play area, (xmin, ymin, xmax, ymax) in metres.
 PLAY_AREA_2D = (-2.0, -1.0, 2.0, 1.0)
@@ -25,7 +26,7 @@ WALL_NAMES = ("left", "right", "bottom", "top")
 WALL_LEFT, WALL_RIGHT, WALL_BOTTOM, WALL_TOP = 0, 1, 2, 3
 
 
-def radius_from_mass(mass):
+def radius_from_mass(mass: ArrayLike) -> np.ndarray:
     """PhET's mass-to-radius rule, ``r = (3 m / (4 pi rho))^(1/3)`` with rho = 35 kg/m^3."""
     return np.cbrt(3.0 * np.asarray(mass, dtype=np.float64) / (4.0 * math.pi * BALL_DENSITY))
 
@@ -57,7 +58,7 @@ class Scene:
     inelastic: str = "slip"
     ball_collisions: bool = True
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if self.bounds is not None:
             try:
                 b = tuple(float(v) for v in self.bounds)

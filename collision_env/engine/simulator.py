@@ -10,10 +10,12 @@ from __future__ import annotations
 import copy
 import math
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ._jit import BACKEND, njit
 from .exact import COUNTERS, impacts_per_event, scratch_sizes, step_exact
@@ -28,7 +30,10 @@ from .layout import (
     CAL_F,
     CAL_I,
     S_ELASTICITY,
+    S_PAIRS,
     S_SIGN,
+    SCENE_F,
+    SCENE_I,
     W_CALENDAR_VALID,
     W_GRID_NX,
     W_GRID_X0,
@@ -133,8 +138,8 @@ class BatchSimulator:
         ``None`` for PhET's mass-to-radius rule, ``"constant"`` for PhET's constant size
         (0.15 m), or explicit radii, ``(B, N)`` or ``(N,)``.
     mode:
-        ``"exact"`` (event-driven, machine precision at any dt), ``"posteriori"`` (the seed's
-        overlap-time reconstruction) or ``"naive"`` (move, then reflect overlaps).
+        ``"exact"`` (event-driven, machine precision at any dt), ``"posteriori"`` (PhET Collision
+        Lab's first engine's overlap-time reconstruction) or ``"naive"`` (move, then reflect overlaps).
     substeps:
         Equal sub-steps per step for naive and posteriori (their speed/accuracy knob). Exact mode
         is exact at any step, so it takes only 1.
@@ -148,8 +153,9 @@ class BatchSimulator:
         (see :mod:`collision_env.engine.response`).
     """
 
-    def __init__(self, scene, positions, velocities, masses, radii=None, *, mode="exact", substeps=1,
-                 max_events=10_000, collapse_ratio=1e-9, collapse_floor=1e-15):
+    def __init__(self, scene: Scene, positions: ArrayLike, velocities: ArrayLike, masses: ArrayLike,
+                 radii: ArrayLike | str | None = None, *, mode: str = "exact", substeps: int = 1,
+                 max_events: int = 10_000, collapse_ratio: float = 1e-9, collapse_floor: float = 1e-15) -> None:
         if not isinstance(scene, Scene):
             raise ValueError(f"scene: expected a collision_env.engine.Scene, got {type(scene).__name__}")
         if mode not in MODES:
@@ -195,12 +201,12 @@ class BatchSimulator:
         self._counters = np.zeros(len(COUNTERS), dtype=np.int64)
 
         bounds = scene.bounds if scene.bounds is not None else (0.0, 0.0, 0.0, 0.0)
-        self._fparams = np.array([*bounds, scene.elasticity, self.collapse_ratio, 1.0, self.collapse_floor])
-        self._iparams = np.array(
-            [scene.bounds is not None, scene.ball_collisions and n > 1, scene.dimension, scene.sticky,
-             self.max_events],
-            dtype=np.int64,
-        )
+        scene_f = dict(zip(("xmin", "ymin", "xmax", "ymax"), bounds, strict=True), elasticity=scene.elasticity,
+                       collapse_ratio=self.collapse_ratio, sign=1.0, collapse_floor=self.collapse_floor)
+        scene_i = dict(has_walls=scene.bounds is not None, pairs=scene.ball_collisions and n > 1,
+                       dim=scene.dimension, sticky=scene.sticky, max_events=self.max_events)
+        self._fparams = np.array([scene_f[name] for name in SCENE_F])
+        self._iparams = np.array([scene_i[name] for name in SCENE_I], dtype=np.int64)
         self._work_f = np.zeros((n_scenes, len(WORK_F)))
         self._work_i = np.zeros((n_scenes, len(WORK_I)), dtype=np.int64)
         # exact mode's event calendar and grid, kept from step to step
@@ -317,7 +323,7 @@ class BatchSimulator:
         self._live = LiveArrays(self._balls, self._pos, self._vel, self._mass, self._radius, self._time, self._body,
                                 self._capped)
 
-    def step(self, dt):
+    def step(self, dt: float) -> np.ndarray:
         """Advance every scene by ``dt`` seconds (``dt < 0`` runs time backwards).
 
         Returns the impacts inside the step as an array of :data:`IMPACT_DTYPE`, ordered by scene
@@ -391,40 +397,40 @@ class BatchSimulator:
 
     # ------------------------------------------------------------------ state access
     @property
-    def num_scenes(self):
+    def num_scenes(self) -> int:
         return self._n_scenes
 
     @property
-    def num_balls(self):
+    def num_balls(self) -> int:
         return self._n
 
     @property
-    def positions(self):
+    def positions(self) -> np.ndarray:
         return self._pos.copy()
 
     @property
-    def velocities(self):
+    def velocities(self) -> np.ndarray:
         return self._vel.copy()
 
     @property
-    def masses(self):
+    def masses(self) -> np.ndarray:
         return self._mass.copy()
 
     @property
-    def radii(self):
+    def radii(self) -> np.ndarray:
         return self._radius.copy()
 
     @property
-    def time(self):
+    def time(self) -> np.ndarray:
         return self._time.copy()
 
     @property
-    def clusters(self):
+    def clusters(self) -> np.ndarray:
         """``(B, N)``: the index of the ball rooting each ball's rigid cluster (itself if free)."""
         return self._body.copy()
 
     @property
-    def cap_reached(self):
+    def cap_reached(self) -> np.ndarray:
         """``(B,)`` bool: the event cap stopped that scene's last step early."""
         return self._capped.copy()
 
@@ -443,34 +449,34 @@ class BatchSimulator:
         return self._live
 
     @property
-    def models(self):
+    def models(self) -> dict[str, Any]:
         """What the engine computes for this scene, and nothing else."""
         return {
             "mode": self.mode,
             "substeps": self.substeps,
             "dimension": self.scene.dimension,
             "walls": self.scene.bounds is not None,
-            "ball_pairs": bool(self._iparams[1]),
+            "ball_pairs": bool(self._iparams[S_PAIRS]),
             "clusters": self.scene.sticky,
             "backend": BACKEND,
         }
 
     @property
-    def stats(self):
+    def stats(self) -> dict[str, int]:
         """Work done so far: pair and wall predictions (or overlap tests), events, rotating-cluster
         predictions, grid-cell crossings and stale calendar entries re-predicted (exact mode)."""
         return {name: int(count) for name, count in zip(COUNTERS, self._counters, strict=True)}
 
-    def kinetic_energy(self):
+    def kinetic_energy(self) -> np.ndarray:
         """``(B,)`` total kinetic energy, J."""
         return 0.5 * (self._mass * (self._vel**2).sum(-1)).sum(-1)
 
-    def momentum(self):
+    def momentum(self) -> np.ndarray:
         """``(B, 2)`` total momentum, kg m/s."""
         return (self._mass[..., None] * self._vel).sum(1)
 
     # ------------------------------------------------------------------ changing the state
-    def nudge(self, dv, check=True):
+    def nudge(self, dv: ArrayLike, check: bool = True) -> None:
         """Change every ball's velocity by ``dv`` (``(B, N, 2)``), as an impulse ``m dv``.
 
         A member of a stuck cluster passes the impulse to the whole cluster (linear and angular).
@@ -490,7 +496,8 @@ class BatchSimulator:
                 raise ValueError(f"{self._label(s, i)}nudge y must be 0 in a 1D scene, got {dv[s, i, 1]}")
         apply_impulses(self._balls, self._body, dv, self.scene.sticky)
 
-    def set_scenes(self, index, positions, velocities, masses=None, radii=None, time=0.0):
+    def set_scenes(self, index: ArrayLike, positions: ArrayLike, velocities: ArrayLike, masses: ArrayLike | None = None,
+                   radii: ArrayLike | str | None = None, time: ArrayLike = 0.0) -> None:
         """Start the scenes picked by ``index`` (indices or a ``(B,)`` bool mask) afresh.
 
         ``positions``/``velocities`` are ``(K, N, 2)`` for the K scenes picked; ``masses`` and
@@ -514,7 +521,7 @@ class BatchSimulator:
         self._time[idx] = time
         self._invalidate(idx)
 
-    def get_state(self):
+    def get_state(self) -> dict[str, np.ndarray]:
         """A dict of array copies that :meth:`set_state` restores exactly."""
         return {
             "positions": self._pos.copy(),
@@ -526,7 +533,7 @@ class BatchSimulator:
             "time": self._time.copy(),
         }
 
-    def set_state(self, state):
+    def set_state(self, state: Mapping[str, ArrayLike]) -> None:
         """Restore a state from :meth:`get_state` (shapes are checked; values are trusted)."""
         shapes = {"positions": self._pos.shape, "velocities": self._vel.shape, "masses": self._mass.shape,
                   "radii": self._radius.shape, "clusters": self._body.shape, "omega": self._omega.shape,
@@ -549,7 +556,7 @@ class BatchSimulator:
         np.copyto(self._time, arrays["time"])
         self._invalidate(np.arange(self._n_scenes))
 
-    def copy(self):
+    def copy(self) -> BatchSimulator:
         """An independent copy (for planning: step it ahead without touching this one)."""
         return copy.deepcopy(self)
 
@@ -575,33 +582,34 @@ class BatchSimulator:
 
 
 class Simulator:
-    """One scene: the public surface of BRIEF section 5.
+    """One scene: the engine's public surface for a single simulation.
 
     ``Simulator(scene, positions (N,2), velocities (N,2), masses (N,), radii=None, mode="exact",
     substeps=1)``; :meth:`step` returns a list of :class:`Impact` in time order. Everything is a
     batch of one over :class:`BatchSimulator`; keyword arguments pass through to it.
     """
 
-    def __init__(self, scene, positions, velocities, masses, radii=None, mode="exact", substeps=1, **options):
+    def __init__(self, scene: Scene, positions: ArrayLike, velocities: ArrayLike, masses: ArrayLike,
+                 radii: ArrayLike | str | None = None, mode: str = "exact", substeps: int = 1, **options: Any) -> None:
         if np.ndim(positions) != 2:
             raise ValueError(f"positions: expected shape (N, 2), got {np.shape(positions)}")
         self._batch = BatchSimulator(scene, [positions], [velocities], masses, radii, mode=mode, substeps=substeps,
                                      **options)
 
     @property
-    def batch(self):
+    def batch(self) -> BatchSimulator:
         """The underlying batch of one."""
         return self._batch
 
     @property
-    def scene(self):
+    def scene(self) -> Scene:
         return self._batch.scene
 
     @property
-    def mode(self):
+    def mode(self) -> str:
         return self._batch.mode
 
-    def step(self, dt):
+    def step(self, dt: float) -> list[Impact]:
         """Advance by ``dt`` seconds (negative: backwards). Returns the step's impacts in time order."""
         rows = self._batch.step(dt)
         return [
@@ -626,17 +634,17 @@ class Simulator:
     models = property(lambda self: self._batch.models)
     stats = property(lambda self: self._batch.stats)
 
-    def kinetic_energy(self):
+    def kinetic_energy(self) -> float:
         return float(self._batch.kinetic_energy()[0])
 
-    def momentum(self):
+    def momentum(self) -> np.ndarray:
         return self._batch.momentum()[0]
 
-    def nudge(self, dv):
+    def nudge(self, dv: ArrayLike) -> None:
         """Change each ball's velocity by ``dv`` (``(N, 2)``), as an impulse (clusters included)."""
         self._batch.nudge([dv])
 
-    def set_balls(self, positions=None, velocities=None):
+    def set_balls(self, positions: ArrayLike | None = None, velocities: ArrayLike | None = None) -> None:
         """Replace positions and/or velocities (validated; on error nothing changes). Time is kept."""
         b = self._batch
         b.set_scenes(
@@ -646,14 +654,14 @@ class Simulator:
             time=b._time[0],
         )
 
-    def get_state(self):
+    def get_state(self) -> dict[str, np.ndarray]:
         """A dict of array copies (no batch axis) that :meth:`set_state` restores exactly."""
         return {key: value[0] for key, value in self._batch.get_state().items()}
 
-    def set_state(self, state):
+    def set_state(self, state: Mapping[str, ArrayLike]) -> None:
         self._batch.set_state({key: np.asarray(value)[None] for key, value in state.items()})
 
-    def copy(self):
+    def copy(self) -> Simulator:
         """An independent copy (``copy.copy`` and ``copy.deepcopy`` give one too)."""
         new = object.__new__(Simulator)
         new._batch = self._batch.copy()
@@ -662,7 +670,7 @@ class Simulator:
     __copy__ = copy
 
 
-def warm_up():
+def warm_up() -> None:
     """Compile (or load from numba's on-disk cache) every engine kernel, so later steps are timed fairly.
 
     Numba compiles a kernel at its first call, which can take tens of seconds on a cold cache; call

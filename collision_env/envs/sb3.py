@@ -52,7 +52,7 @@ class CollisionSB3VecEnv(VecEnv):
         self._actions = None
 
     # ------------------------------------------------------------------------------------- #
-    def reset(self):
+    def reset(self) -> np.ndarray:
         seeds = None if all(s is None for s in self._seeds) else list(self._seeds)
         options = None
         if any(self._options):
@@ -68,7 +68,7 @@ class CollisionSB3VecEnv(VecEnv):
     def step_async(self, actions: np.ndarray) -> None:
         self._actions = actions
 
-    def step_wait(self):
+    def step_wait(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[dict[str, Any]]]:
         obs, reward, term, trunc, info = self.venv.step(np.asarray(self._actions, dtype=np.float32))
         dones = term | trunc
         n = self.num_envs
@@ -100,7 +100,7 @@ class CollisionSB3VecEnv(VecEnv):
         self.venv.close()
 
     # ------------------------------------------------------------------------------------- #
-    def get_images(self):
+    def get_images(self) -> list[np.ndarray | None]:
         frames = self.venv.render()
         return list(frames) if frames is not None else [None] * self.num_envs
 

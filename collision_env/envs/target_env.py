@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import copy
-from typing import Any
+from typing import Any, SupportsFloat
 
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
+from numpy.typing import ArrayLike
 
+from collision_env.engine import BatchSimulator
 from collision_env.envs import _kernels as K
 from collision_env.envs._config import PRESETS, TaskConfig, make_config
 from collision_env.envs._core import Impacts, TaskCore
@@ -137,7 +139,8 @@ class CollisionTargetEnv(gym.Env):
                 S[K.S_ENERGY], S[K.S_NUDGE])
 
     # ------------------------------------------------------------------------------------- #
-    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+    def reset(self, *, seed: int | None = None,
+              options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
         super().reset(seed=seed)
         core = self._core
         core.reset_scenes(np.zeros(1, dtype=np.int64), [self.np_random])
@@ -152,7 +155,7 @@ class CollisionTargetEnv(gym.Env):
             self.render()
         return obs[0], info
 
-    def step(self, action):
+    def step(self, action: ArrayLike) -> tuple[np.ndarray, SupportsFloat, bool, bool, dict[str, Any]]:
         a = self._action  # (1, A) float64, the kernel's input (reused: the kernel only reads it)
         if getattr(action, "shape", None) == self.action_space.shape:
             a[0] = action
@@ -174,7 +177,7 @@ class CollisionTargetEnv(gym.Env):
         return obs[0], reward, term, trunc, info
 
     # ------------------------------------------------------------------------------------- #
-    def render(self):
+    def render(self) -> np.ndarray | None:
         if self.render_mode is None:
             env_id = self.spec.id if self.spec is not None else "..."
             gym.logger.warn(
@@ -195,7 +198,7 @@ class CollisionTargetEnv(gym.Env):
             self._renderer = Renderer(self.config, trails=self._trails)
         return self._renderer
 
-    def close(self):
+    def close(self) -> None:
         if self._renderer is not None:
             self._renderer.close()
             self._renderer = None
@@ -222,10 +225,10 @@ class CollisionTargetEnv(gym.Env):
         return self._core
 
     @property
-    def simulator(self):
+    def simulator(self) -> BatchSimulator:
         """The engine's :class:`~collision_env.engine.BatchSimulator` (one scene) behind this env."""
         return self._core.batch
 
 
-def preset_names() -> list:
+def preset_names() -> list[str]:
     return sorted(PRESETS)

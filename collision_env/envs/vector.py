@@ -20,6 +20,7 @@ from gymnasium.error import ResetNeeded
 from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
+from numpy.typing import ArrayLike
 
 from collision_env.envs._config import TaskConfig, make_config
 from collision_env.envs._core import Impacts, TaskCore
@@ -111,7 +112,8 @@ class CollisionTargetVectorEnv(VectorEnv):
             info["_" + key] = np.ones(n, dtype=bool)
         return info
 
-    def reset(self, *, seed: int | list | None = None, options: dict[str, Any] | None = None):
+    def reset(self, *, seed: int | list[int] | None = None,
+              options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
         options = dict(options) if options else {}
         mask = options.pop("reset_mask", None)
         if mask is None:
@@ -145,7 +147,7 @@ class CollisionTargetVectorEnv(VectorEnv):
     def _fresh_obs(self):
         return np.zeros((self.num_envs, self._core.obs_dim), dtype=np.float32)
 
-    def step(self, actions):
+    def step(self, actions: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         if self._rngs[0] is None:
             raise ResetNeeded("call reset() before step() on the vector env")
         a = np.asarray(actions, dtype=np.float64)
@@ -229,7 +231,7 @@ class CollisionTargetVectorEnv(VectorEnv):
             else:
                 r.record(self._core, i, imp[imp["scene"] == i])
 
-    def render(self):
+    def render(self) -> tuple[np.ndarray, ...] | None:
         """A tuple with one ``(H, W, 3)`` uint8 frame per sub-env (``render_mode="rgb_array"``)."""
         if self.render_mode is None:
             return None

@@ -169,6 +169,6 @@ def test_ks_rayleigh_accepts_rayleigh_and_rejects_equal_speeds():
 def test_enskog_rate_values():
     assert M.henderson_g(0.0) == 1.0
     assert M.henderson_g(0.5) == pytest.approx((1 - 7 / 32) / 0.25)
-    # the research note's 50-disk check: n = 50/4, sigma = 0.04, eta = 0.0157, kT = 0.5 -> 1.29 per s
+    # a 50-disk gas in a 2 m box: n = 50/4, sigma = 0.04, eta = 0.0157, kT = 0.5 -> 1.29 per s
     eta = 50 * math.pi * 0.02**2 / 4.0
     assert M.enskog_rate(50 / 4.0, 0.04, eta, 0.5, 1.0) == pytest.approx(1.29, abs=0.01)

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 from collision_env.bench import report
-from collision_env.bench.engines import BilliardsRunner, EngineRunner, PymunkRunner, collect
+from collision_env.bench.engines import EngineRunner
 from collision_env.bench.extremes import Cell, _check_corner, _check_graze, _corner, _two_ball_graze, run_cell
+from collision_env.bench.peers import BilliardsRunner, PymunkRunner, collect
 from collision_env.bench.scenes import SCENES, pi_billiard, pi_collisions
 from collision_env.bench.sweep import schedule, sweep_case
 

@@ -7,7 +7,7 @@ from collision_env.engine import Scene, Simulator
 
 
 def test_posteriori_corner_error():
-    # A ball that crosses both walls of a corner within one step: the seed's |ds|^2 / (v.ds) returns
+    # A ball that crosses both walls of a corner within one step: PhET's |ds|^2 / (v.ds) returns
     # a projection-weighted mix of the two crossing times, not the first one.
     r = 0.1
     scene = Scene()

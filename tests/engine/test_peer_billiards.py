@@ -21,7 +21,7 @@ What is comparable, and what is not:
   (mapped from the obstacle to our wall names).
 - Round-off differs (billiards keeps absolute times and writes its formulas differently), and a
   hard-disk gas is chaotic: a difference of 1e-16 grows by orders of magnitude per collision per
-  ball. So the runs stop at about 5 collisions per ball (research note section 4.3), between two
+  ball (Dellago, Hoover & Posch, Phys. Rev. E 65, 056216, 2002). So the runs stop at ~5 collisions per ball, between two
   events, where the two codes still agree to round-off times that growth.
 """
 

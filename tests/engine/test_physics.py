@@ -1,4 +1,4 @@
-"""The checks of BRIEF section 7: analytic expected values for exact mode."""
+"""Analytic expected values for exact mode: closed-form collision times, velocities and counts."""
 
 import math
 

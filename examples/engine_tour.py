@@ -1,4 +1,4 @@
-"""A short tour of the engine: ``python -m collision_env.demo``.
+"""A short tour of the engine: ``python examples/engine_tour.py``.
 
 Runs PhET's Intro head-on collision, Galperin's pi billiard and a small gas in each fidelity mode,
 and prints what the engine reports (impact times, points, counts, energy drift, cost).

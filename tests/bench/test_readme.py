@@ -1,6 +1,6 @@
 """The README's generated blocks are rewritten only between their own markers."""
 
-from collision_env._readme import markers, replace_block
+from collision_env.bench.readme import markers, replace_block
 
 
 def test_block_replaced_only_between_its_markers(tmp_path):

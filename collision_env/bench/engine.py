@@ -2,16 +2,16 @@
 
 Run it as::
 
-    python -m collision_env.engine.bench            # full run, a few minutes
-    python -m collision_env.engine.bench --quick    # about 10 s (plus ~30 s of numba compile when cold)
-    python -m collision_env.engine.bench --json bench.json --markdown bench.md
-    python -m collision_env.engine.bench --render bench.json --markdown bench.md   # tables only
+    python -m collision_env.bench.engine            # full run, a few minutes
+    python -m collision_env.bench.engine --quick    # about 10 s (plus ~30 s of numba compile when cold)
+    python -m collision_env.bench.engine --json bench.json --markdown bench.md
+    python -m collision_env.bench.engine --render bench.json --markdown bench.md   # tables only
 
 It is not a test: it measures and prints. Three parts, each printed as a Markdown table:
 
 1. **Gas**: exact mode's events per second against the ``billiards`` package (PyPI 0.5.0, pure
-   Python, event-driven) on a 50-disk elastic gas (r = 0.02 in [-1, 1]^2, T = 20 s, the research
-   note's setup; the full run adds its 200-disk gas over 5 s), both from the same initial state,
+   Python, event-driven) on a 50-disk elastic gas (r = 0.02 in [-1, 1]^2, T = 20 s; the full run
+   adds a 200-disk gas over 5 s), both from the same initial state,
    once as a single long step and once in frames of 1/60 s. The same section checks the
    trajectories: over a short horizon (about 3 collisions per ball, before chaos amplifies
    round-off) the collision sequences must be the same, and it reports the largest position
@@ -20,6 +20,9 @@ It is not a test: it measures and prints. Three parts, each printed as a Markdow
 2. **Per step**: microseconds per ``Simulator.step(1/60)`` for each mode (naive, posteriori with
    1 and 4 substeps, exact) at 1, 2, 4, 16 and 64 balls in the default play area, with pymunk
    (a C engine, impulse solver, no time of impact) stepping the same balls as a peer.
+
+The peers are the benchmark package's adapters (:mod:`collision_env.bench.peers`), the same
+set-ups the study measures.
 3. **Batch**: scene-steps per second of one :class:`BatchSimulator` of 1024 scenes of 4 balls
    against a Python loop over 1024 single :class:`Simulator` objects holding the same scenes
    (and a check that both end in the same state).
@@ -35,19 +38,22 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import platform
-import statistics
 import sys
 import time
 
 import numpy as np
 
-from collision_env._readme import write_block
+from collision_env.engine import PLAY_AREA_2D, BatchSimulator, Scene, Simulator, warm_up
 
-from . import BACKEND, PLAY_AREA_2D, BatchSimulator, Scene, Simulator, warm_up
+from .machine import cpus, machine, timestamp, versions
+from .metrics import as_impacts
+from .peers import make_peer
+from .readme import write_block
+from .scenes import Case
+from .timing import repeat, summary
 
 GAS_CASES = ((50, 20.0),)  # (disks, horizon in s); the full run adds GAS_CASES_FULL
-GAS_CASES_FULL = ((200, 5.0),)  # the research note's second gas (billiards: ~0.7 k events/s)
+GAS_CASES_FULL = ((200, 5.0),)  # billiards manages about 1 k events/s here: seconds per run
 GAS_RADIUS = 0.02
 GAS_HALF = 1.0
 GAS_CHECK_COLLISIONS_PER_BALL = 3
@@ -60,23 +66,6 @@ BATCH_BALLS = 4
 
 
 # ---------------------------------------------------------------------------------------- helpers
-def _repeat(fn, repeats, reset=None):
-    """Run ``fn()`` ``repeats`` times (after an untimed ``reset()``); return the durations (s)."""
-    out = []
-    for _ in range(repeats):
-        if reset is not None:
-            reset()
-        t0 = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - t0)
-    return out
-
-
-def _summary(durations, per=1.0):
-    """Best and median of ``durations`` divided by ``per`` (e.g. seconds per step)."""
-    return {"best": min(durations) / per, "median": statistics.median(durations) / per, "repeats": len(durations)}
-
-
 def random_balls(rng, n, bounds, radius, speed=1.0, gap=1.05):
     """``n`` non-overlapping balls of ``radius`` inside ``bounds``, random directions at ``speed``.
 
@@ -97,132 +86,92 @@ def random_balls(rng, n, bounds, radius, speed=1.0, gap=1.05):
     return pos, vel
 
 
-def _versions():
-    out = {"python": platform.python_version(), "numpy": np.__version__, "backend": BACKEND}
-    for name in ("numba", "billiards", "pymunk"):
-        try:
-            module = __import__(name)
-        except ImportError:
-            out[name] = None
-            continue
-        out[name] = str(getattr(module, "__version__", getattr(module, "version", "?")))
-    return out
-
-
 # ---------------------------------------------------------------------------------------- 1. gas
-def _billiards_box(billiards):
-    w = billiards.InfiniteWall
-    h = GAS_HALF
-    return [w((-h, -h), (h, -h)), w((h, -h), (h, h)), w((h, h), (-h, h)), w((-h, h), (-h, -h))]
-
-
-def _billiards_table(billiards, pos, vel, radius):
-    table = billiards.Billiard(_billiards_box(billiards))
-    for i in range(len(pos)):
-        table.add_ball(pos[i].copy(), vel[i].copy(), radius, 1.0)
-    return table
-
-
-def _billiards_pairs(events, billiards):
-    """Events as comparable keys: ``(i, j)`` for a ball pair, ``(i, -1)`` for a wall."""
-    out = []
-    for _, i, other in events:
-        if isinstance(other, billiards.obstacles.Obstacle):
-            out.append((int(i), -1))
-        else:
-            out.append((min(int(i), int(other)), max(int(i), int(other))))
-    return out
-
-
-def _our_pairs(impacts):
-    return [(h.ball, -1) if h.other is None else (min(h.ball, h.other), max(h.ball, h.other)) for h in impacts]
+def _pairs(impacts) -> list[tuple[int, int]]:
+    """Impacts as comparable keys: ``(i, j)`` (i < j) for a ball pair, ``(i, -1)`` for a wall."""
+    rows = as_impacts(impacts)
+    return [(int(b), -1) if o < 0 else (int(min(b, o)), int(max(b, o))) for b, o in zip(rows["ball"], rows["other"],
+                                                                                          strict=True)]
 
 
 def bench_gas(quick, n=50, horizon=20.0):
     """Exact mode against billiards on an ``n``-disk gas over ``horizon`` s; see the module doc."""
-    try:
-        import billiards
-    except ImportError:
-        return {"skipped": "billiards is not installed (pip install 'collision_env[peers]')"}
+    peer = make_peer("billiards")
+    if isinstance(peer, str):
+        return {"skipped": f"billiards is {peer}: pip install 'collision_env[peers]'"}
     rng = np.random.default_rng(2024)
     pos, vel = random_balls(rng, n, (-GAS_HALF, -GAS_HALF, GAS_HALF, GAS_HALF), GAS_RADIUS, gap=1.0001)
     masses = np.ones(n)
     radii = np.full(n, GAS_RADIUS)
     scene = Scene(bounds=(-GAS_HALF, -GAS_HALF, GAS_HALF, GAS_HALF), elasticity=1.0)
+    case = Case(scene, pos, vel, masses, radii)
     n_frames = round(horizon / FRAME)
     peer_repeats, our_repeats = (3, 10) if quick else (7, 50)
     if n > 100:  # billiards takes seconds per run here
         peer_repeats = 3
 
-    # billiards: the set-up (its O(N^2) first prediction) is outside the timing, as ours is
-    peer_result = {}
-
+    # the peer's set-up (its O(N^2) first prediction) is outside the timing, as ours is
     def peer_one_step():
-        table = peer_result["table"] = _billiards_table(billiards, pos, vel, GAS_RADIUS)
-        t0 = time.perf_counter()
-        peer_result["events"] = table.evolve(horizon)
-        return time.perf_counter() - t0
+        peer.step(horizon, record=False)
 
     def peer_frames():
-        table = peer_result["frames_table"] = _billiards_table(billiards, pos, vel, GAS_RADIUS)
-        t0 = time.perf_counter()
-        count = 0
-        for k in range(1, n_frames + 1):
-            count += len(table.evolve(k * FRAME))
-        peer_result["frames_events"] = count
-        return time.perf_counter() - t0
+        for _ in range(n_frames):
+            peer.step(FRAME, record=False)
 
     ours = {}
 
+    def new_sim(max_events=10_000):
+        ours["sim"] = Simulator(scene, pos, vel, masses, radii=radii, mode="exact", max_events=max_events)
+
     def our_one_step():
-        sim = ours["sim"] = Simulator(scene, pos, vel, masses, radii=radii, mode="exact", max_events=10**7)
-        t0 = time.perf_counter()
-        ours["impacts"] = sim.step(horizon)
-        return time.perf_counter() - t0
+        ours["impacts"] = ours["sim"].step(horizon)
 
     def our_frames():
-        sim = ours["frames_sim"] = Simulator(scene, pos, vel, masses, radii=radii, mode="exact")
-        t0 = time.perf_counter()
         for _ in range(n_frames):
-            sim.step(FRAME)
-        return time.perf_counter() - t0
+            ours["sim"].step(FRAME)
 
+    new_sim(10**7)
     our_one_step()  # warm-up
-    peer_t = [peer_one_step() for _ in range(peer_repeats)]
-    peer_frame_t = [peer_frames() for _ in range(max(1, peer_repeats - 1))]
-    our_t = [our_one_step() for _ in range(our_repeats)]
-    our_frame_t = [our_frames() for _ in range(our_repeats)]
-
-    peer_events = len(peer_result["events"])
+    peer_t = repeat(peer_one_step, peer_repeats, lambda: peer.start(case))
+    peer_events = peer.impact_count
+    peer_frame_t = repeat(peer_frames, max(1, peer_repeats - 1), lambda: peer.start(case))
+    peer_frame_events = peer.impact_count
+    our_t = repeat(our_one_step, our_repeats, lambda: new_sim(10**7))
     our_events = ours["sim"].stats["events"]
-    our_frame_events = ours["frames_sim"].stats["events"]
-    peer_frame_events = peer_result["frames_events"]
+    long_ours = _pairs(ours["impacts"])
+    long_our_positions = ours["sim"].positions
+    our_frame_t = repeat(our_frames, our_repeats, new_sim)
+    our_frame_events = ours["sim"].stats["events"]
+
+    # the peer's impacts over the full horizon, recorded (untimed)
+    peer.start(case)
+    events = peer.step(horizon)
+    long_peer = _pairs(events)
+    long_peer_positions = peer.state()[0]
 
     # trajectory check over a short horizon (before chaos): same sequence, position difference
-    events = peer_result["events"]
-    involved = np.cumsum([1 if pair[1] < 0 else 2 for pair in _billiards_pairs(events, billiards)])
+    involved = np.cumsum([1 if pair[1] < 0 else 2 for pair in long_peer])
     k = int(np.searchsorted(involved, GAS_CHECK_COLLISIONS_PER_BALL * n))
-    t_check = 0.5 * (events[k][0] + events[k + 1][0])
-    table = _billiards_table(billiards, pos, vel, GAS_RADIUS)
-    peer_short = table.evolve(t_check)
+    t_check = 0.5 * (events["time"][k] + events["time"][k + 1])
+    peer.start(case)
+    peer_short = peer.step(t_check)
     sim = Simulator(scene, pos, vel, masses, radii=radii, mode="exact")
     our_short = sim.step(t_check)
-    same_sequence = _our_pairs(our_short) == _billiards_pairs(peer_short, billiards)
+    same_sequence = _pairs(our_short) == _pairs(peer_short)
     time_diff = (
-        max(abs(a.time - b[0]) for a, b in zip(our_short, peer_short, strict=True)) if same_sequence else None
+        max(abs(a.time - b) for a, b in zip(our_short, peer_short["time"], strict=True)) if same_sequence else None
     )
+    peer_pos, peer_vel = peer.state()
     check = {
         "horizon_s": t_check,
         "collisions_per_ball": float(involved[k - 1] / n) if k > 0 else 0.0,
         "events": len(peer_short),
         "same_sequence": same_sequence,
         "max_time_diff_s": time_diff,
-        "max_position_diff_m": float(np.abs(sim.positions - table.balls_position).max()),
-        "max_velocity_diff_m_s": float(np.abs(sim.velocities - table.balls_velocity).max()),
+        "max_position_diff_m": float(np.abs(sim.positions - peer_pos).max()),
+        "max_velocity_diff_m_s": float(np.abs(sim.velocities - peer_vel).max()),
     }
     # at the full horizon the runs are chaotic: report the drift, and how long the sequences agree
-    long_ours = _our_pairs(ours["impacts"])
-    long_peer = _billiards_pairs(events, billiards)
     agree = (i for i, (a, b) in enumerate(zip(long_ours, long_peer, strict=False)) if a != b)
     prefix = next(agree, min(len(long_ours), len(long_peer)))
     full = {
@@ -231,15 +180,15 @@ def bench_gas(quick, n=50, horizon=20.0):
         "events_ours": our_events,
         "events_billiards": peer_events,
         "sequences_agree_for_events": prefix,
-        "max_position_diff_m": float(np.abs(ours["sim"].positions - peer_result["table"].balls_position).max()),
+        "max_position_diff_m": float(np.abs(long_our_positions - long_peer_positions).max()),
     }
     rows = []
     for label, ours_t, ours_n, peer_t_, peer_n in (
         (f"one step of {horizon:g} s", our_t, our_events, peer_t, peer_events),
         (f"{n_frames} frames of 1/60 s", our_frame_t, our_frame_events, peer_frame_t, peer_frame_events),
     ):
-        o = _summary(ours_t)
-        p = _summary(peer_t_)
+        o = summary(ours_t)
+        p = summary(peer_t_)
         rows.append({
             "how": label,
             "ours_events": int(ours_n),
@@ -256,33 +205,9 @@ def bench_gas(quick, n=50, horizon=20.0):
 
 
 # ---------------------------------------------------------------------------------------- 2. per step
-def _pymunk_space(pymunk, pos, vel, radius, bounds):
-    space = pymunk.Space()
-    space.gravity = (0.0, 0.0)
-    xmin, ymin, xmax, ymax = bounds
-    corners = [(xmin, ymin), (xmax, ymin), (xmax, ymax), (xmin, ymax)]
-    for a, b in zip(corners, corners[1:] + corners[:1], strict=True):
-        seg = pymunk.Segment(space.static_body, a, b, 0.0)
-        seg.elasticity = 1.0
-        seg.friction = 0.0
-        space.add(seg)
-    for p, v in zip(pos, vel, strict=True):
-        body = pymunk.Body(1.0, pymunk.moment_for_circle(1.0, 0.0, radius))
-        body.position = tuple(p)
-        body.velocity = tuple(v)
-        shape = pymunk.Circle(body, radius)
-        shape.elasticity = 1.0
-        shape.friction = 0.0
-        space.add(body, shape)
-    return space
-
-
 def bench_per_step(quick):
     """Microseconds per ``step(1/60)`` of each mode at each ball count (and pymunk's)."""
-    try:
-        import pymunk
-    except ImportError:
-        pymunk = None
+    pymunk = make_peer("pymunk")
     steps, repeats = (200, 5) if quick else (1000, 25)
     rng = np.random.default_rng(7)
     rows = []
@@ -307,20 +232,20 @@ def bench_per_step(quick):
                     impacts[0] += len(sim.step(FRAME))
 
             before = sim.stats["events"]
-            s = _summary(_repeat(run, repeats, reset), per=steps / 1e6)
+            s = summary(repeat(run, repeats, reset), per=steps / 1e6)
             s["impacts_per_step"] = impacts[0] / steps
             s["events_per_step"] = (sim.stats["events"] - before) / (steps * repeats)
             row["modes"][f"{mode}/{k}"] = s
-        if pymunk is not None:
-            space = _pymunk_space(pymunk, pos, vel, STEP_RADIUS, PLAY_AREA_2D)
+        if not isinstance(pymunk, str):
+            pymunk.start(Case(Scene(), pos, vel, masses, radii))
             for _ in range(3):
-                space.step(FRAME)
+                pymunk.step(FRAME, record=False)
 
-            def run_pymunk(space=space):
+            def run_pymunk():
                 for _ in range(steps):
-                    space.step(FRAME)
+                    pymunk.step(FRAME, record=False)
 
-            row["modes"]["pymunk"] = _summary(_repeat(run_pymunk, repeats), per=steps / 1e6)
+            row["modes"]["pymunk"] = summary(repeat(run_pymunk, repeats), per=steps / 1e6)
         rows.append(row)
     return {"dt": FRAME, "radius": STEP_RADIUS, "bounds": list(PLAY_AREA_2D), "rows": rows}
 
@@ -363,8 +288,8 @@ def bench_batch(quick):
 
         run_batch()  # warm-up
         run_loop()
-        tb = _summary(_repeat(run_batch, repeats, reset_batch), per=steps * b)
-        tl = _summary(_repeat(run_loop, repeats, reset_loop), per=steps * b)
+        tb = summary(repeat(run_batch, repeats, reset_batch), per=steps * b)
+        tl = summary(repeat(run_loop, repeats, reset_loop), per=steps * b)
         diff = max(float(np.abs(batch.positions[s] - singles[s].positions).max()) for s in range(b))
         rows.append({
             "mode": f"{mode}/{k}",
@@ -401,7 +326,7 @@ def render_markdown(results):
     lines = [
         "## Engine benchmark",
         "",
-        f"`python -m collision_env.engine.bench{' --quick' if meta['quick'] else ''}` on {meta['machine']}, "
+        f"`python -m collision_env.bench.engine{' --quick' if meta['quick'] else ''}` on {meta['machine']}, "
         f"{meta['cpus']} CPUs, Python {v['python']}, numpy {v['numpy']}, numba {v['numba']}, "
         f"billiards {v['billiards']}, pymunk {v['pymunk']}; engine backend `{v['backend']}`; "
         f"{meta['date']}, {meta['duration_s']:.0f} s. Times are the best of several repeats (median in "
@@ -461,7 +386,7 @@ def render_markdown(results):
             lines.append(f"| {r['balls']} | " + " | ".join(cells) + f" | {ratio:.2f} | {peer} | "
                          f"{m['exact/1']['impacts_per_step']:.3f} |")
         lines += ["", "Mode names are `mode/substeps`; pymunk is the C peer (impulse solver, no time of impact) "
-                  "stepping the same balls.", ""]
+                  "stepping the same balls, set up as the study's `pymunk it=10`.", ""]
     bt = results.get("batch")
     if bt:
         lines += [
@@ -498,18 +423,12 @@ def run(quick=False, parts=("gas", "per_step", "batch"), log=print):
     if "batch" in parts:
         log("batch of 1024 against a loop ...")
         results["batch"] = bench_batch(quick)
-    try:
-        import os
-
-        cpus = len(os.sched_getaffinity(0))
-    except (AttributeError, OSError):  # pragma: no cover
-        cpus = os.cpu_count()
     results["meta"] = {
         "quick": quick,
-        "versions": _versions(),
-        "machine": f"{platform.machine()} {platform.system()}",
-        "cpus": cpus,
-        "date": time.strftime("%Y-%m-%d %H:%M"),
+        "versions": versions(["numba", "billiards", "pymunk"]),
+        "machine": machine(),
+        "cpus": cpus(),
+        "date": timestamp(),
         "duration_s": time.perf_counter() - t0,
     }
     return results
@@ -532,7 +451,7 @@ def _jsonable(obj):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m collision_env.engine.bench", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m collision_env.bench.engine", description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="fewer repeats: about 30 s instead of a few minutes")
     parser.add_argument("--json", metavar="PATH", help="write the raw figures to PATH")
     parser.add_argument("--markdown", metavar="PATH", help="write the tables to PATH")

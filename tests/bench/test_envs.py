@@ -1,7 +1,7 @@
 """The env benchmark runs end to end and writes its tables into the README block (smoke test)."""
 
-from collision_env._readme import markers
-from collision_env.envs import bench
+from collision_env.bench import envs as bench
+from collision_env.bench.readme import markers
 
 
 def test_env_benchmark_writes_markdown_and_readme_block(tmp_path, capsys):

@@ -1,0 +1,50 @@
+"""Timers shared by every benchmark: repeated runs summarised by their best and median.
+
+The machines these run on are shared and noisy, so a figure is the best of several repeats (the
+least disturbed one), with the median beside it, and what matters is the ratio against a peer
+measured in the same run.
+"""
+
+from __future__ import annotations
+
+import statistics
+import time
+from collections.abc import Callable
+
+
+def repeat(fn: Callable[[], object], repeats: int, reset: Callable[[], object] | None = None) -> list[float]:
+    """Run ``fn()`` ``repeats`` times, each after an untimed ``reset()``; return the durations (s)."""
+    out = []
+    for _ in range(repeats):
+        if reset is not None:
+            reset()
+        t0 = time.perf_counter()
+        fn()
+        out.append(time.perf_counter() - t0)
+    return out
+
+
+def summary(durations: list[float], per: float = 1.0) -> dict:
+    """Best and median of ``durations`` divided by ``per`` (e.g. seconds per step).
+
+    >>> summary([3.0, 1.0, 2.0], per=2.0)
+    {'best': 0.5, 'median': 1.0, 'repeats': 3}
+    """
+    return {"best": min(durations) / per, "median": statistics.median(durations) / per, "repeats": len(durations)}
+
+
+def best_rate(chunk: Callable[[], int], seconds: float, slices: int) -> float:
+    """Units per second of ``chunk()`` (which returns how many units it did), best of ``slices`` slices.
+
+    Each slice repeats ``chunk`` until ``seconds / slices`` have passed.
+    """
+    best = 0.0
+    for _ in range(slices):
+        done, t0 = 0, time.perf_counter()
+        while True:
+            done += chunk()
+            elapsed = time.perf_counter() - t0
+            if elapsed >= seconds / slices:
+                break
+        best = max(best, done / elapsed)
+    return best
