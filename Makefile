@@ -34,6 +34,7 @@ bench: $(STAMP)
 figures: $(STAMP)
 	$(PY) -m collision_env.bench --readme README.md
 	$(PY) -m collision_env.bench.engine --markdown docs/bench/engine.md --readme README.md
+	$(PY) -m collision_env.bench.scale --markdown docs/bench/scale.md --readme README.md
 	$(PY) -m collision_env.bench.envs --markdown docs/bench/envs_bench.md --readme README.md
 	$(PY) scripts/render_presets.py
 

@@ -11,6 +11,8 @@ Every section is a module with a ``main(argv)``, runnable on its own
   pymunk, batched against looped stepping.
 - :mod:`.envs`: env steps per second of every registered id against Gymnasium's CartPole.
 - :mod:`.extremes`: every mode over the stress grid.
+- :mod:`.scale`: exact mode on hard-disk gases of 10^2 to 10^5 disks in frames: events per second,
+  memory per disk, and the validity of each run.
 
 What they share:
 
@@ -27,4 +29,5 @@ SECTIONS: dict[str, tuple[str, str]] = {
     "engine": ("collision_env.bench.engine", "exact mode against billiards; cost per step against pymunk; batching"),
     "envs": ("collision_env.bench.envs", "env steps per second of every registered id against CartPole"),
     "extremes": ("collision_env.bench.extremes", "every mode over the stress grid"),
+    "scale": ("collision_env.bench.scale", "exact mode on gases of 10^2 to 10^5 disks: events/s, memory, validity"),
 }

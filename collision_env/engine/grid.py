@@ -31,6 +31,9 @@ from .layout import C_CELL, C_CELL_HEAD, C_CELL_NEXT, C_CELL_PREV
 #: Scenes with fewer balls keep one cell (every ball is every other's neighbour): below this size
 #: the grid's bookkeeping costs more than the pairs it saves (measured by the engine benchmark).
 GRID_MIN_BALLS = 64
+#: Balls per cell the grid aims at (cells are never narrower than a diameter): fewer cells cost
+#: more pair predictions per event, more cells more cell crossings.
+BALLS_PER_CELL = 1.0
 #: Cells are this much wider than the largest diameter, so that round-off in a ball's position at
 #: a cell boundary can never hide a neighbour.
 CELL_MARGIN = 1.0 + 1e-6
@@ -53,7 +56,7 @@ def grid_geometry(bounds, positions, radii, use_grid, reach=1.0):
     size = hi - lo
     sigma = 2.0 * reach * radii.max(axis=1) * CELL_MARGIN
     # about one ball per cell, but never narrower than a diameter
-    width = np.maximum(sigma, np.sqrt(size[:, 0] * size[:, 1] / n))
+    width = np.maximum(sigma, np.sqrt(BALLS_PER_CELL * size[:, 0] * size[:, 1] / n))
     counts = np.ones((n_scenes, 2), dtype=np.int64)
     if use_grid:
         for axis in range(2):

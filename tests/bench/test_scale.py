@@ -1,0 +1,24 @@
+"""The scale benchmark's measurements and checks, on a small gas (the full sizes run from the script)."""
+
+from __future__ import annotations
+
+from collision_env.bench import scale
+
+
+def test_a_gas_on_the_grid_stays_valid_and_collides_at_enskogs_rate():
+    row = scale.bench_size(400, log=lambda *_: None)
+    assert row["overlaps"] == 0 and row["outside"] == 0
+    assert row["energy_rel_change"] < 1e-9
+    assert 0.7 < row["rate_ratio"] < 1.3  # a small box: walls and finite size shift it a little
+    assert row["cell_crossings"] > 0  # the grid is in use
+    assert row["pair_tests"] < 60  # neighbours only, not all 399 others
+    assert row["peak_bytes_per_disk"] < 2048
+
+
+def test_the_report_renders_every_size():
+    results = {"machine": "m", "cpus": 2, "timestamp": "t", "versions": {"numpy": "1", "numba": "2"},
+               "first_call_s": 1.0, "seconds": 3.0,
+               "sizes": [scale.bench_size(n, log=lambda *_: None) for n in (100, 200)],
+               "frames": scale.bench_frames(n=20, horizon=1.0, repeats=1)}
+    text = scale.render_markdown(results)
+    assert "| 100 |" in text and "| 200 |" in text and "frames keep" in text

@@ -1,0 +1,35 @@
+"""Every packed array's field tuple and its index constants agree (one place names each field)."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+
+from collision_env.engine import layout
+
+
+@pytest.mark.parametrize("name", sorted(layout.LAYOUTS))
+def test_each_field_has_the_constant_of_its_position(name):
+    fields = layout.LAYOUTS[name]
+    prefix = {"BALL": "B_", "CAL_F": "C_", "CAL_I": "C_", "SCENE_F": "S_", "SCENE_I": "S_", "WORK_F": "W_",
+              "WORK_I": "W_"}[name]
+    assert len(set(fields)) == len(fields)
+    for position, field in enumerate(fields):
+        constant = prefix + re.sub(r"\W", "_", field).upper()
+        assert getattr(layout, constant) == position, (name, field)
+
+
+def test_engine_arrays_are_as_wide_as_their_layouts():
+    from collision_env.engine import Scene, Simulator
+
+    sim = Simulator(Scene(), [[0.0, 0.0], [1.0, 0.0]], [[1.0, 0.0], [0.0, 0.0]], [1.0, 1.0])
+    b = sim.batch
+    assert b._balls.shape[-1] == len(layout.BALL)
+    assert b._cal_f.shape[-1] == len(layout.CAL_F)
+    assert b._cal_i.shape[-1] == len(layout.CAL_I)
+    assert b._fparams.shape == (len(layout.SCENE_F),)
+    assert b._iparams.shape == (len(layout.SCENE_I),)
+    assert b._work_f.shape[-1] == len(layout.WORK_F)
+    assert b._work_i.shape[-1] == len(layout.WORK_I)
+    assert b._fparams[layout.S_XMAX] == 2.0 and b._iparams[layout.S_DIM] == 2
