@@ -210,6 +210,35 @@ def sweep_case(spec: SceneSpec, n: int, runners, dts, *, min_time: float, max_re
     return rows
 
 
+#: The cost-only runs at large ball counts: one control step, a short horizon, and the peers
+#: whose cost per event grows with N (billiards predicts all pairs) left out past this size.
+COST_DT = 0.01
+COST_HORIZON = 0.5
+ALL_PAIRS_PEER_MAX_BALLS = 256
+
+
+def cost_case(spec: SceneSpec, n: int, runners, *, min_time: float, max_repeats: int) -> list[dict]:
+    """Every runner's cost per step on one scene at a large ball count (status "timed": no accuracy)."""
+    case = spec.case(n)
+    steps = schedule(COST_HORIZON, COST_DT)
+    rows = []
+    for runner in runners:
+        base = {"scene": spec.name, "n": n, "elasticity": case.scene.elasticity, "engine": runner.engine,
+                "family": runner.family, "mode": getattr(runner, "mode", None) or "", "substeps": runner.substeps,
+                "iterations": runner.iterations if runner.iterations is not None else "", "dt": COST_DT,
+                "h": COST_DT / runner.substeps, "horizon": COST_HORIZON, "steps": len(steps)}
+        why = runner.unsupported(case)
+        if why is None and runner.engine == "billiards" and n > ALL_PAIRS_PEER_MAX_BALLS:
+            why = f"predicts all pairs at every event: minutes per run past {ALL_PAIRS_PEER_MAX_BALLS} balls"
+        if why:
+            rows.append({**base, "status": "unsupported", "note": why})
+            continue
+        wall = timed_run(runner, case, steps, min_time, max_repeats)
+        rows.append({**base, "status": "timed", "wall_s": wall, "wall_per_sim_s": wall / COST_HORIZON,
+                     "us_per_step": wall / len(steps) * 1e6, "note": "cost only"})
+    return rows
+
+
 def warm_up():
     """Compile or load every kernel before anything is timed."""
     for spec_name, n in (("explore_2d", 2), ("inelastic", 2), ("newtons_cradle", 4), ("inelastic_pileup", 4)):
@@ -249,4 +278,12 @@ def run_sweep(quick: bool, scenes=None, peers=True, log=print) -> tuple[list[dic
         t0 = time.perf_counter()
         rows += sweep_case(spec, n, runners, dts, min_time=min_time, max_repeats=max_repeats, log=log)
         log(f"  {spec.name:17s} n={n:3d}  {time.perf_counter() - t0:6.1f} s")
+    if not quick:
+        for name, spec in SCENES.items():
+            if scenes and name not in scenes:
+                continue
+            for n in spec.cost_counts:
+                t0 = time.perf_counter()
+                rows += cost_case(spec, n, runners, min_time=min_time, max_repeats=max_repeats)
+                log(f"  {spec.name:17s} n={n:5d}  {time.perf_counter() - t0:6.1f} s (cost only)")
     return rows, missing
