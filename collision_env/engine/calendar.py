@@ -4,7 +4,7 @@ This is the sorter of an event-driven simulation (the scheduler is ``exact.step_
 neighbour search is :mod:`collision_env.engine.grid`). Following Lubachevsky (1991) and
 Smallenburg (2022, "Efficient event-driven simulations of hard spheres", EPJE 45:22), each ball
 holds only its earliest known event: a wall, a partner ball, or the crossing of a grid-cell
-boundary. The heap orders balls by event time, and simultaneous events as a scan of the balls in
+boundary. A 4-ary heap orders balls by event time, and simultaneous events as a scan of the balls in
 index order would meet them (:func:`order_key`); finding, updating or removing an event is
 O(log N).
 
@@ -19,13 +19,15 @@ Times in the calendar are relative to the start of the current step (the simulat
 when a step ends), so no large absolute time enters it.
 
 The per-ball fields live in the packed arrays ``cf`` (floats) and ``ci`` (ints) of one scene,
-laid out as ``layout.CAL_F`` and ``layout.CAL_I``.
+laid out as ``layout.CAL_F`` and ``layout.CAL_I``; the heap itself in ``hp`` (``layout.HEAP``).
 """
 
 from __future__ import annotations
 
 from ._jit import njit
-from .layout import C_CHANGES, C_EVENT_OTHER, C_EVENT_STAMP, C_EVENT_TIME, C_HEAP, C_HEAP_SLOT, C_HEAP_TIME
+import numpy as np
+
+from .layout import C_CHANGES, C_EVENT_OTHER, C_EVENT_STAMP, C_EVENT_TIME, C_HEAP_SLOT, H_BALL, H_TIME
 
 #: ``event_other`` codes below zero. A ball's wall events are ``EV_WALL - wall`` (wall codes 0..3
 #: as in ``scene.WALL_NAMES``); its grid-cell crossings are ``EV_CROSS - direction`` (0: -x,
@@ -91,74 +93,87 @@ def _before(ta, a, tb, b, ci):
     return a < b
 
 
-# The heap keeps each slot's event time beside it (``heap_time``), so that sifting compares
-# neighbouring rows instead of chasing every ball's own row (a cache miss per level at scale).
+#: Children per node of the heap: a 4-ary heap is half as deep as a binary one, and a node's
+#: children lie side by side in ``hp`` (one or two cache lines), which is what a heap of 10^5
+#: balls is bound by.
+ARITY = 4
+
+
+# The heap lives in ``hp`` (``layout.HEAP``: the event time and the ball of each slot), so that
+# sifting reads neighbouring rows instead of chasing every ball's own row.
 @njit(inline="always")
-def _place(slot, ball, t, cf, ci):
-    ci[slot, C_HEAP] = ball
-    cf[slot, C_HEAP_TIME] = t
+def _place(slot, ball, t, ci, hp):
+    hp[slot, H_TIME] = t
+    hp[slot, H_BALL] = ball
     ci[ball, C_HEAP_SLOT] = slot
 
 
 @njit(inline="always")
-def _sift_up(slot, cf, ci):
-    ball = ci[slot, C_HEAP]
+def _ball_at(slot, hp):
+    return np.int64(hp[slot, H_BALL])
+
+
+@njit(inline="always")
+def _sift_up(slot, cf, ci, hp):
+    ball = _ball_at(slot, hp)
     t = cf[ball, C_EVENT_TIME]
     while slot > 0:
-        parent = (slot - 1) >> 1
-        if not _before(t, ball, cf[parent, C_HEAP_TIME], ci[parent, C_HEAP], ci):
+        parent = (slot - 1) // ARITY
+        above = _ball_at(parent, hp)
+        if not _before(t, ball, hp[parent, H_TIME], above, ci):
             break
-        _place(slot, ci[parent, C_HEAP], cf[parent, C_HEAP_TIME], cf, ci)
+        _place(slot, above, hp[parent, H_TIME], ci, hp)
         slot = parent
-    _place(slot, ball, t, cf, ci)
+    _place(slot, ball, t, ci, hp)
     return slot
 
 
 @njit(inline="always")
-def _sift_down(slot, n, cf, ci):
-    ball = ci[slot, C_HEAP]
+def _sift_down(slot, n, cf, ci, hp):
+    ball = _ball_at(slot, hp)
     t = cf[ball, C_EVENT_TIME]
     while True:
-        child = 2 * slot + 1
-        if child >= n:
+        first = ARITY * slot + 1
+        if first >= n:
             break
-        right = child + 1
-        if right < n and _before(cf[right, C_HEAP_TIME], ci[right, C_HEAP], cf[child, C_HEAP_TIME],
-                                 ci[child, C_HEAP], ci):
-            child = right
-        if not _before(cf[child, C_HEAP_TIME], ci[child, C_HEAP], t, ball, ci):
+        child = first
+        for c in range(first + 1, min(first + ARITY, n)):
+            if _before(hp[c, H_TIME], _ball_at(c, hp), hp[child, H_TIME], _ball_at(child, hp), ci):
+                child = c
+        below = _ball_at(child, hp)
+        if not _before(hp[child, H_TIME], below, t, ball, ci):
             break
-        _place(slot, ci[child, C_HEAP], cf[child, C_HEAP_TIME], cf, ci)
+        _place(slot, below, hp[child, H_TIME], ci, hp)
         slot = child
-    _place(slot, ball, t, cf, ci)
+    _place(slot, ball, t, ci, hp)
 
 
 @njit(inline="always")
-def reschedule(ball, n, cf, ci):
+def reschedule(ball, n, cf, ci, hp):
     """Restore the heap order after ``ball``'s event time changed (either way)."""
-    slot = _sift_up(ci[ball, C_HEAP_SLOT], cf, ci)
-    _sift_down(slot, n, cf, ci)
+    slot = _sift_up(ci[ball, C_HEAP_SLOT], cf, ci, hp)
+    _sift_down(slot, n, cf, ci, hp)
 
 
 @njit(inline="always")
-def heapify(n, cf, ci):
+def heapify(n, cf, ci, hp):
     """Order the heap from scratch (Floyd's O(N) construction), from the balls' event times."""
-    for slot in range((n >> 1) - 1, -1, -1):
-        _sift_down(slot, n, cf, ci)
+    for slot in range((n - 2) // ARITY, -1, -1):
+        _sift_down(slot, n, cf, ci, hp)
 
 
 @njit(inline="always")
-def reset_heap(n, cf, ci):
+def reset_heap(n, cf, ci, hp):
     """Put every ball in the heap (slot = index) and order it."""
     for i in range(n):
-        _place(i, i, cf[i, C_EVENT_TIME], cf, ci)
-    heapify(n, cf, ci)
+        _place(i, i, cf[i, C_EVENT_TIME], ci, hp)
+    heapify(n, cf, ci, hp)
 
 
 @njit(inline="always")
-def next_ball(ci):
+def next_ball(hp):
     """The ball whose event comes first."""
-    return ci[0, C_HEAP]
+    return _ball_at(0, hp)
 
 
 @njit(inline="always")
@@ -171,14 +186,14 @@ def set_event(ball, t, code, stamp, cf, ci):
 
 
 @njit(inline="always")
-def offer_pair(k, t, partner, n, ordered, cf, ci):
+def offer_pair(k, t, partner, n, ordered, cf, ci, hp):
     """Offer ball ``k`` a collision with ``partner`` at ``t``; it takes it if it comes before its
     own pending event (Smallenburg's rule). ``ordered``: restore the heap order (not while a whole
     scene is being predicted, before the heap is built)."""
     if earlier(t, partner, cf[k, C_EVENT_TIME], ci[k, C_EVENT_OTHER], k):
         set_event(k, t, partner, ci[partner, C_CHANGES], cf, ci)
         if ordered:
-            reschedule(k, n, cf, ci)
+            reschedule(k, n, cf, ci, hp)
 
 
 @njit(inline="always")

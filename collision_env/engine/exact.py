@@ -54,12 +54,12 @@ from .layout import (
     C_EVENT_OTHER,
     C_EVENT_STAMP,
     C_EVENT_TIME,
-    C_HEAP_TIME,
     C_REF_TIME,
     C_SEEN_VX,
     C_SEEN_VY,
     C_SEEN_X,
     C_SEEN_Y,
+    H_TIME,
     S_COLLAPSE_FLOOR,
     S_COLLAPSE_RATIO,
     S_DIM,
@@ -451,7 +451,7 @@ def _wall_time(i, pos, vel, radius, bounds, dim, cf):
 # ---------------------------------------------------------------------------- predict
 @njit(inline="always")
 def _predict(i, now, horizon, rebuild, pos, vel, mass, radius, body, omega, rot, sticky, bounds, has_walls, pairs,
-             dim, geo, cf, ci, ki, kj, counters):
+             dim, geo, cf, ci, hp, ki, kj, counters):
     """Find ball ``i``'s next event and schedule it.
 
     Looks at its wall, its partners in the 3 x 3 cells around it and its next cell crossing, from
@@ -500,7 +500,7 @@ def _predict(i, now, horizon, rebuild, pos, vel, mass, radius, body, omega, rot,
                                 best_t = t
                                 best_code = k
                                 best_stamp = ci[k, C_CHANGES]
-                            cal.offer_pair(k, t, i, n, not rebuild, cf, ci)
+                            cal.offer_pair(k, t, i, n, not rebuild, cf, ci, hp)
                     k = ci[k, C_CELL_NEXT]
         if nx * ny > 1:
             tau, direction = grid.crossing(pos[i, 0], pos[i, 1], vel[i, 0], vel[i, 1], ci[i, C_CELL], x0, y0,
@@ -511,7 +511,7 @@ def _predict(i, now, horizon, rebuild, pos, vel, mass, radius, body, omega, rot,
                 best_code = cal.EV_CROSS - direction
     cal.set_event(i, best_t, best_code, best_stamp, cf, ci)
     if not rebuild:
-        cal.reschedule(i, n, cf, ci)
+        cal.reschedule(i, n, cf, ci, hp)
 
 
 # ---------------------------------------------------------------------------- begin
@@ -569,20 +569,20 @@ def _verified_time(i, code, pos, vel, radius, bounds, dim, cf):
 
 # ---------------------------------------------------------------------------- finish
 @njit(inline="always")
-def _finish(t_end, pos, vel, mass, body, omega, rot, sticky, cf, ci):
+def _finish(t_end, pos, vel, mass, body, omega, rot, sticky, cf, ci, hp):
     """End the step at step time ``t_end``: every ball there, the calendar's times made relative to
     it (the next step starts at 0), and the state remembered for the next step's change check."""
     n = pos.shape[0]
     _sync_all(t_end, pos, vel, mass, body, omega, rot, sticky, cf)
     for i in range(n):
         cf[i, C_EVENT_TIME] -= t_end
-        cf[i, C_HEAP_TIME] -= t_end  # (row i: heap slot i, the same times rebased the same way)
+        hp[i, H_TIME] -= t_end  # (row i: heap slot i, the same times rebased the same way)
         cf[i, C_REF_TIME] = 0.0
         cf[i, C_SEEN_X] = pos[i, 0]
         cf[i, C_SEEN_Y] = pos[i, 1]
         cf[i, C_SEEN_VX] = vel[i, 0]
         cf[i, C_SEEN_VY] = vel[i, 1]
-    cal.heapify(n, cf, ci)  # rebasing can round two times into a tie the heap must order by index
+    cal.heapify(n, cf, ci, hp)  # rebasing can round two times into a tie the heap must order by index
 
 
 # ---------------------------------------------------------------------------- resolve
@@ -672,14 +672,14 @@ def _resolve_pair(sc, t_abs, bi, bj, pos, vel, mass, inv_mass, radius, body, ome
 # ---------------------------------------------------------------------------- the scheduler
 @njit
 def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, counters, work_f, work_i, cal_f, cal_i,
-               scratch_f, scratch_i, scratch_b, dt_abs, fresh):
+               cal_heap, scratch_f, scratch_i, scratch_b, dt_abs, fresh):
     """Advance every active scene of the batch by its remaining time (see module doc).
 
     ``balls`` is the (B, N, 8) per-ball state (``layout.BALL``), ``body_all`` the (B, N) cluster
     roots, ``time`` the (B,) clocks; ``fparams``/``iparams`` the scene parameters
     (``layout.SCENE_F``/``SCENE_I``); ``work_f``/``work_i`` the per-scene bookkeeping and grid
-    geometry (``layout.WORK_F``/``WORK_I``); ``cal_f``/``cal_i`` the persistent calendar and grid
-    (``layout.CAL_F``/``CAL_I``). ``fresh`` starts a step of ``dt_abs`` for every scene;
+    geometry (``layout.WORK_F``/``WORK_I``); ``cal_f``/``cal_i``/``cal_heap`` the persistent
+    calendar, grid and event queue (``layout.CAL_F``/``CAL_I``/``HEAP``). ``fresh`` starts a step of ``dt_abs`` for every scene;
     otherwise the call resumes the scenes flagged active.
     Impacts go to ``imp`` rows (``simulator.IMPACT_DTYPE``) from row 0, ``n_imp[0]`` rows in all; a
     scene that finds the buffer full stops where it is and is flagged stalled, so the caller can
@@ -726,6 +726,7 @@ def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, coun
         omega = omega_all[sc]
         cf = cal_f[sc]
         ci = cal_i[sc]
+        hp = cal_heap[sc]
         geo = (work_f[sc, W_GRID_X0], work_f[sc, W_GRID_Y0], work_f[sc, W_GRID_HX], work_f[sc, W_GRID_HY],
                work_i[sc, W_GRID_NX], work_i[sc, W_GRID_NY])
         nx = geo[4]
@@ -749,14 +750,14 @@ def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, coun
             # predict (the one place where predictions are made: what begin or the last event listed)
             for q in range(n_pending):
                 _predict(pending[q], now, horizon_end - now, whole, pos, vel, mass, radius, body, omega, rot, sticky,
-                         bounds, has_walls, pairs, dim, geo, cf, ci, ki, kj, counters)
+                         bounds, has_walls, pairs, dim, geo, cf, ci, hp, ki, kj, counters)
             if whole:
-                cal.reset_heap(n, cf, ci)
+                cal.reset_heap(n, cf, ci, hp)
                 work_i[sc, W_CALENDAR_VALID] = True
                 whole = False
             n_pending = 0
             # pop
-            bi = cal.next_ball(ci)
+            bi = cal.next_ball(hp)
             t = cf[bi, C_EVENT_TIME]
             code = ci[bi, C_EVENT_OTHER]
             if not t <= horizon_end:
@@ -783,7 +784,7 @@ def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, coun
                         n_pending = 1
                     else:
                         cf[bi, C_EVENT_TIME] = t_check
-                        cal.reschedule(bi, n, cf, ci)
+                        cal.reschedule(bi, n, cf, ci, hp)
                     continue
                 t = t_check
             if work_i[sc, W_EVENTS] >= max_events:
@@ -828,7 +829,7 @@ def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, coun
         # finish
         stopped = capped[sc] or work_i[sc, W_STALLED]
         t_end = now if stopped else horizon_end
-        _finish(t_end, pos, vel, mass, body, omega, rot, sticky, cf, ci)
+        _finish(t_end, pos, vel, mass, body, omega, rot, sticky, cf, ci, hp)
         time[sc] = t0 + sign * t_end
         work_f[sc, W_REMAINING] = horizon_end - t_end
         n_stalled += work_i[sc, W_STALLED]

@@ -10,7 +10,8 @@ Per ball, ``(B, N, len(fields))``:
 
 - :data:`BALL` (float64): the physical state, see :mod:`collision_env.engine.motion`.
 - :data:`CAL_F` / :data:`CAL_I` (float64 / int64): exact mode's persistent event calendar and
-  cell grid, see :mod:`collision_env.engine.calendar` and :mod:`collision_env.engine.grid`.
+  cell grid, see :mod:`collision_env.engine.calendar` and :mod:`collision_env.engine.grid`;
+  :data:`HEAP` (float64): the calendar's event queue.
 
 Per scene:
 
@@ -30,20 +31,22 @@ B_X, B_Y, B_VX, B_VY, B_MASS, B_INV_MASS, B_RADIUS, B_OMEGA = range(8)
 #: Per-ball calendar floats: the time of the ball's next event (relative to the step's start);
 #: the time its stored position refers to (balls are moved lazily, when an event touches them);
 #: the position and velocity it had when the last step ended (a change made between steps, by a
-#: nudge or an env, is found by comparing against them); and, in row s, the event time of the
-#: ball in heap slot s.
-CAL_F = ("event_time", "ref_time", "seen_x", "seen_y", "seen_vx", "seen_vy", "heap_time")
-C_EVENT_TIME, C_REF_TIME, C_SEEN_X, C_SEEN_Y, C_SEEN_VX, C_SEEN_VY, C_HEAP_TIME = range(7)
+#: nudge or an env, is found by comparing against them).
+CAL_F = ("event_time", "ref_time", "seen_x", "seen_y", "seen_vx", "seen_vy")
+C_EVENT_TIME, C_REF_TIME, C_SEEN_X, C_SEEN_Y, C_SEEN_VX, C_SEEN_VY = range(6)
 
 #: Per-ball calendar ints: what the next event is (a partner ball >= 0, or an ``calendar.EV_*``
 #: code); the partner's change counter when the event was predicted (a mismatch makes the event
-#: stale); the ball's own change counter; the event queue (a binary heap of balls, and each ball's
-#: slot in it); the ball's grid cell, the next and previous ball in that cell's list; and, in the
-#: first ``n_cells`` rows, the first ball of each cell (row c holds cell c's head).
-CAL_I = ("event_other", "event_stamp", "changes", "heap", "heap_slot", "cell", "cell_next", "cell_prev",
-         "cell_head")
-(C_EVENT_OTHER, C_EVENT_STAMP, C_CHANGES, C_HEAP, C_HEAP_SLOT, C_CELL, C_CELL_NEXT, C_CELL_PREV,
- C_CELL_HEAD) = range(9)
+#: stale); the ball's own change counter; its slot in the event queue's heap; the ball's grid
+#: cell, the next and previous ball in that cell's list; and, in the first ``n_cells`` rows, the
+#: first ball of each cell (row c holds cell c's head).
+CAL_I = ("event_other", "event_stamp", "changes", "heap_slot", "cell", "cell_next", "cell_prev", "cell_head")
+C_EVENT_OTHER, C_EVENT_STAMP, C_CHANGES, C_HEAP_SLOT, C_CELL, C_CELL_NEXT, C_CELL_PREV, C_CELL_HEAD = range(8)
+
+#: The event queue's heap, one row per slot (float64): the event time held there and the ball
+#: (an integer stored as a float, so that a node and its children share cache lines).
+HEAP = ("time", "ball")
+H_TIME, H_BALL = range(2)
 
 #: Scene floats: the border (m; zeros when there is none), the restitution used this step (1/e
 #: when running backwards), the collapse regulariser's ratio and floor (m/s), and the direction
@@ -69,5 +72,5 @@ WORK_I = ("events", "active", "stalled", "substeps_done", "calendar_valid", "gri
 W_EVENTS, W_ACTIVE, W_STALLED, W_SUBSTEPS_DONE, W_CALENDAR_VALID, W_GRID_NX, W_GRID_NY = range(7)
 
 #: Every packed layout, by name (for documentation and the layout test).
-LAYOUTS = {"BALL": BALL, "CAL_F": CAL_F, "CAL_I": CAL_I, "SCENE_F": SCENE_F, "SCENE_I": SCENE_I,
+LAYOUTS = {"BALL": BALL, "CAL_F": CAL_F, "CAL_I": CAL_I, "HEAP": HEAP, "SCENE_F": SCENE_F, "SCENE_I": SCENE_I,
            "WORK_F": WORK_F, "WORK_I": WORK_I}

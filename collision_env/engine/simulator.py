@@ -29,6 +29,7 @@ from .layout import (
     B_X,
     CAL_F,
     CAL_I,
+    HEAP,
     S_ELASTICITY,
     S_PAIRS,
     S_SIGN,
@@ -212,6 +213,7 @@ class BatchSimulator:
         # exact mode's event calendar and grid, kept from step to step
         self._cal_f = np.zeros((n_scenes, n, len(CAL_F)))
         self._cal_i = np.zeros((n_scenes, n, len(CAL_I)), dtype=np.int64)
+        self._cal_heap = np.zeros((n_scenes, n, len(HEAP)))
         self._invalidate(np.arange(n_scenes))
         self._alloc_work()
 
@@ -313,7 +315,7 @@ class BatchSimulator:
         if self.mode == "exact":
             nf, ni, nb = scratch_sizes(self._n)
             self._kernel = step_exact
-            self._kernel_args = state + (self._cal_f, self._cal_i, np.empty(nf), np.empty(ni, dtype=np.int64),
+            self._kernel_args = state + (self._cal_f, self._cal_i, self._cal_heap, np.empty(nf), np.empty(ni, dtype=np.int64),
                                          np.zeros(nb, dtype=np.bool_))
         else:
             self._kernel = step_substeps

@@ -12,7 +12,7 @@ from collision_env.engine import layout
 @pytest.mark.parametrize("name", sorted(layout.LAYOUTS))
 def test_each_field_has_the_constant_of_its_position(name):
     fields = layout.LAYOUTS[name]
-    prefix = {"BALL": "B_", "CAL_F": "C_", "CAL_I": "C_", "SCENE_F": "S_", "SCENE_I": "S_", "WORK_F": "W_",
+    prefix = {"BALL": "B_", "CAL_F": "C_", "CAL_I": "C_", "HEAP": "H_", "SCENE_F": "S_", "SCENE_I": "S_", "WORK_F": "W_",
               "WORK_I": "W_"}[name]
     assert len(set(fields)) == len(fields)
     for position, field in enumerate(fields):
@@ -28,6 +28,7 @@ def test_engine_arrays_are_as_wide_as_their_layouts():
     assert b._balls.shape[-1] == len(layout.BALL)
     assert b._cal_f.shape[-1] == len(layout.CAL_F)
     assert b._cal_i.shape[-1] == len(layout.CAL_I)
+    assert b._cal_heap.shape[-1] == len(layout.HEAP)
     assert b._fparams.shape == (len(layout.SCENE_F),)
     assert b._iparams.shape == (len(layout.SCENE_I),)
     assert b._work_f.shape[-1] == len(layout.WORK_F)
