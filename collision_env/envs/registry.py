@@ -41,8 +41,14 @@ from collision_env.envs.target_env import CollisionTargetEnv
 from collision_env.envs.vector import CollisionTargetVectorEnv
 
 #: The sections every task's docstring has, in this order.
-DOC_SECTIONS = ("## Description", "## Action Space", "## Observation Space", "## Rewards", "## Starting State",
-                "## Episode End")
+DOC_SECTIONS = (
+    "## Description",
+    "## Action Space",
+    "## Observation Space",
+    "## Rewards",
+    "## Starting State",
+    "## Episode End",
+)
 
 #: The hyperparameter entry an id without one of its own falls back to.
 DEFAULT_HYPERPARAMS = "default"
@@ -91,8 +97,12 @@ def register_env(env_id: str, single: type, vector: type, bench_scene: str, task
     """Register ``env_id`` with Gymnasium (single and vector entry points) and in ``REGISTERED``."""
     steps = make_config(single.preset).n_steps
     if env_id not in _gym_registry:  # re-importing (e.g. importlib.reload) must not re-register
-        _gym_register(id=env_id, entry_point=_entry_point(single), vector_entry_point=_entry_point(vector),
-                      max_episode_steps=steps)
+        _gym_register(
+            id=env_id,
+            entry_point=_entry_point(single),
+            vector_entry_point=_entry_point(vector),
+            max_episode_steps=steps,
+        )
     REGISTERED[env_id] = RegisteredEnv(env_id, single, vector, bench_scene, task)
 
 
@@ -126,11 +136,15 @@ def register_task(env_class: type) -> type:
     except (TypeError, ValueError) as err:
         raise ValueError(f"{name}.task.config: {err}") from None
 
-    vector = type(f"{name[:-3]}VectorEnv", (CollisionTargetVectorEnv,), {
-        "__doc__": f"Native vector version of :class:`{name}` (see :class:`CollisionTargetVectorEnv`).",
-        "__module__": env_class.__module__,
-        "preset": task.preset,
-    })
+    vector = type(
+        f"{name[:-3]}VectorEnv",
+        (CollisionTargetVectorEnv,),
+        {
+            "__doc__": f"Native vector version of :class:`{name}` (see :class:`CollisionTargetVectorEnv`).",
+            "__module__": env_class.__module__,
+            "preset": task.preset,
+        },
+    )
     setattr(sys.modules[env_class.__module__], vector.__name__, vector)
     env_class.preset = task.preset
     PRESETS[task.preset] = dict(task.config)

@@ -58,8 +58,11 @@ def _index_sets(cell: str, n_balls: int, n_slots: int, dim: int) -> list:
 def _field_groups(n_balls: int, n_slots: int) -> list:
     """For every observation index: (section, instance, row of its layout)."""
     out = []
-    for section, count, columns in (("ball", n_balls, BALL_OBS), ("target", n_slots, TARGET_OBS),
-                                    ("global", 1, GLOBAL_OBS)):
+    for section, count, columns in (
+        ("ball", n_balls, BALL_OBS),
+        ("target", n_slots, TARGET_OBS),
+        ("global", 1, GLOBAL_OBS),
+    ):
         rows = rows_of(columns)
         for instance in range(count):
             for col in range(len(columns)):
@@ -95,11 +98,14 @@ def test_docstring_observation_table_agrees_with_the_layout(cls):
     _check_table(cls.__doc__, gym.make(env_id).unwrapped.config)
 
 
-@pytest.mark.parametrize("edits", [
-    ("| 9-12  |", "| 9-11  |"),  # an entry left out
-    ("| 4     | ball mass", "| 4, 5  | ball mass"),  # an entry named twice
-    ("| 8     |", "| 8, 9  |", "| 9-12  |", "| 10-12 |"),  # a row across layout rows, not whole ones
-])
+@pytest.mark.parametrize(
+    "edits",
+    [
+        ("| 9-12  |", "| 9-11  |"),  # an entry left out
+        ("| 4     | ball mass", "| 4, 5  | ball mass"),  # an entry named twice
+        ("| 8     |", "| 8, 9  |", "| 9-12  |", "| 10-12 |"),  # a row across layout rows, not whole ones
+    ],
+)
 def test_a_table_that_disagrees_with_the_layout_is_caught(edits):
     from collision_env.envs import OneBallTargetEnv, make_config
 
@@ -123,15 +129,27 @@ def test_observation_entries_sit_where_the_layout_says(env_id):
     xc, yc, xh, yh = (xmin + xmax) / 2, (ymin + ymax) / 2, (xmax - xmin) / 2, (ymax - ymin) / 2
     nb, nt = len(BALL_OBS), len(TARGET_OBS)
     for i in range(cfg.n_balls):
-        block = obs[nb * i:nb * (i + 1)]
+        block = obs[nb * i : nb * (i + 1)]
         assert block[BALL_OBS.x] == pytest.approx(np.clip((core.pos[0, i, 0] - xc) / xh, -1, 1), abs=1e-6)
+        assert block[BALL_OBS.y] == pytest.approx(np.clip((core.pos[0, i, 1] - yc) / yh, -1, 1), abs=1e-6)
         assert block[BALL_OBS.vy] == pytest.approx(np.clip(core.vel[0, i, 1] / (2 * cfg.max_speed), -1, 1), abs=1e-6)
         assert block[BALL_OBS.mass] == pytest.approx(core.masses[0, i] / 3.0, abs=1e-6)
     for s in range(cfg.target_slots):
-        block = obs[nb * cfg.n_balls + nt * s:nb * cfg.n_balls + nt * (s + 1)]
+        block = obs[nb * cfg.n_balls + nt * s : nb * cfg.n_balls + nt * (s + 1)]
         k = min(int(core.cur[0]), cfg.n_targets - 1) if cfg.sequential else s
         wall = WALL_NAMES[int(core.t_wall[0, k])]
-        assert block[getattr(TARGET_OBS, f"wall_{wall}")] == 1.0 and block[TARGET_OBS.wall_left:][:4].sum() == 1.0
-    tail = obs[-len(GLOBAL_OBS):]
+        assert block[getattr(TARGET_OBS, f"wall_{wall}")] == 1.0 and block[TARGET_OBS.wall_left :][:4].sum() == 1.0
+    tail = obs[-len(GLOBAL_OBS) :]
     assert tail[GLOBAL_OBS.steps_left] == pytest.approx(1 - int(core.steps[0]) / cfg.n_steps, abs=1e-6)
-    assert tail[GLOBAL_OBS.targets_left] == pytest.approx(1 - int(core.C[0, SCENE_INTS.targets_hit]) / cfg.n_targets, abs=1e-6)
+    hit = int(core.C[0, SCENE_INTS.targets_hit])
+    assert tail[GLOBAL_OBS.targets_left] == pytest.approx(1 - hit / cfg.n_targets, abs=1e-6)
+
+
+def test_architecture_notes_name_every_layout():
+    from pathlib import Path
+
+    from collision_env.envs import _layout
+
+    text = (Path(__file__).parents[2] / "ARCHITECTURE.md").read_text()
+    names = [n for n, v in vars(_layout).items() if isinstance(v, tuple) and hasattr(type(v), "layout_rows")]
+    assert len(names) >= 10 and all(f"`{n}`" in text for n in names), names

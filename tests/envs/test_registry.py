@@ -55,8 +55,17 @@ class TwoBallRelayEnv(CollisionTargetEnv):
     task = Task(
         env_id=TINY_ID,
         preset="test_two_ball_relay",
-        config=dict(n_balls=2, controlled=(0,), scorers="others", n_targets=2, sequential=True, time_limit=5.0,
-                    mass_range=(0.5, 1.5), speed_range=(0.2, 0.6), others_speed_range=(0.0, 0.2)),
+        config=dict(
+            n_balls=2,
+            controlled=(0,),
+            scorers="others",
+            n_targets=2,
+            sequential=True,
+            time_limit=5.0,
+            mass_range=(0.5, 1.5),
+            speed_range=(0.2, 0.6),
+            others_speed_range=(0.0, 0.2),
+        ),
         bench_scene="2 balls (test)",
         hyperparams_like="CollisionEnv/Line1D-v0",
     )
@@ -64,8 +73,12 @@ class TwoBallRelayEnv(CollisionTargetEnv):
 
 def _unregister(cls) -> None:
     task = cls.task
-    for table, key in ((REGISTERED, task.env_id), (gym_registry, task.env_id), (PRESETS, task.preset),
-                       (PRESET_IDS, task.preset)):
+    for table, key in (
+        (REGISTERED, task.env_id),
+        (gym_registry, task.env_id),
+        (PRESETS, task.preset),
+        (PRESET_IDS, task.preset),
+    ):
         table.pop(key, None)
     vector_name = cls.__name__[:-3] + "VectorEnv"
     if hasattr(sys.modules[cls.__module__], vector_name):
@@ -132,17 +145,23 @@ def test_shipped_ids_come_from_the_registry():
         assert spec.vector_entry_point == f"{reg.vector.__module__}:{reg.vector.__name__}"
 
 
-@pytest.mark.parametrize("change, message", [
-    (dict(config=dict(n_balls=0)), "task.config: n_balls"),
-    (dict(config=dict(n_ball=2)), "task.config: unexpected keyword"),
-    (dict(env_id="CollisionEnv/OneBallTarget-v0"), "already registered"),
-    (dict(preset="one_ball"), "already a preset"),
-])
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        (dict(config=dict(n_balls=0)), "task.config: n_balls"),
+        (dict(config=dict(n_ball=2)), "task.config: unexpected keyword"),
+        (dict(env_id="CollisionEnv/OneBallTarget-v0"), "already registered"),
+        (dict(preset="one_ball"), "already a preset"),
+    ],
+)
 def test_a_bad_entry_is_rejected_and_registers_nothing(change, message):
     import dataclasses
 
-    bad = type("BadEnv", (TwoBallRelayEnv,), {"__doc__": TwoBallRelayEnv.__doc__,
-                                              "task": dataclasses.replace(TwoBallRelayEnv.task, **change)})
+    bad = type(
+        "BadEnv",
+        (TwoBallRelayEnv,),
+        {"__doc__": TwoBallRelayEnv.__doc__, "task": dataclasses.replace(TwoBallRelayEnv.task, **change)},
+    )
     before = (dict(REGISTERED), dict(PRESETS), dict(PRESET_IDS), len(gym_registry))
     with pytest.raises(ValueError, match=message):
         register_task(bad)
