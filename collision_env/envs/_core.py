@@ -146,9 +146,10 @@ class EpisodeSampler:
         self.ctrl_mask = np.zeros(n, dtype=bool)
         self.ctrl_mask[list(cfg.controlled)] = True
         self.walls = np.array([WALL_NAMES.index(w) for w in cfg.target_walls], dtype=np.int64)
-        self.E = packed(EPISODE_FLOATS, np.float64, xmin=cfg.bounds[0], ymin=cfg.bounds[1], xmax=cfg.bounds[2],
-                        ymax=cfg.bounds[3], speed_low=cfg.speed_range[0], speed_high=cfg.speed_range[1],
-                        others_low=cfg.others_speed_range[0], others_high=cfg.others_speed_range[1],
+        xmin, ymin, xmax, ymax = cfg.bounds
+        (speed_low, speed_high), (others_low, others_high) = cfg.speed_range, cfg.others_speed_range
+        self.E = packed(EPISODE_FLOATS, np.float64, xmin=xmin, ymin=ymin, xmax=xmax, ymax=ymax, speed_low=speed_low,
+                        speed_high=speed_high, others_low=others_low, others_high=others_high,
                         half_width=0.5 * cfg.target_width, window=-1.0 if cfg.window is None else cfg.window,
                         time_limit=cfg.time_limit)
         self.F = packed(EPISODE_INTS, np.int64, dimension=cfg.dimension, n_balls=n, n_targets=k,
