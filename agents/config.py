@@ -121,21 +121,25 @@ def is_run_config(data: dict) -> bool:
 
 
 def hyperparams_for(env_id: str, path: str | Path = HYPERPARAMS) -> dict:
-    """The entry of ``env_id`` in the file at ``path`` (or its ``default``), as a fresh dict.
+    """The entry of ``env_id`` in the file at ``path``, as a fresh dict.
 
-    A run folder's ``config.yml`` is accepted too, for its own env id only.
+    Without one, the entry the task registry names for it (its ``hyperparams_like`` id), else
+    ``default``. A run folder's ``config.yml`` is accepted too, for its own env id only.
     """
+    from collision_env.envs.registry import DEFAULT_HYPERPARAMS, hyperparams_fallback
+
     data = load_yaml(path)
     if is_run_config(data):
         if data["env_id"] != env_id:
             raise UsageError(f"{path} is the config of a {data['env_id']} run, not of {env_id}")
-        entry = data["hyperparams"]
-    elif env_id in data:
-        entry = data[env_id]
-    elif "default" in data:
-        entry = data["default"]
-    else:
-        raise UsageError(f"{path}: no entry for {env_id!r} and no 'default' entry")
+        return _entry(path, env_id, data["hyperparams"])
+    for key in (env_id, hyperparams_fallback(env_id), DEFAULT_HYPERPARAMS):
+        if key in data:
+            return _entry(path, env_id, data[key])
+    raise UsageError(f"{path}: no entry for {env_id!r} and no {DEFAULT_HYPERPARAMS!r} entry")
+
+
+def _entry(path: str | Path, env_id: str, entry: Any) -> dict:
     if not isinstance(entry, dict):
         raise UsageError(f"{path}: the entry for {env_id!r} is not a mapping")
     return dict(entry)

@@ -33,6 +33,7 @@ from pathlib import Path
 from agents.config import UsageError, as_int, check_env_id, hyperparams_for, read_run, run_cli
 from agents.evaluate import pct
 from collision_env.bench.machine import cpus, machine, timestamp, versions
+from collision_env.engine import MODES
 
 DEFAULT_ENVS = ("CollisionEnv/OneBallTarget-v0", "CollisionEnv/Line1D-v0")
 DEFAULT_MODES = ("naive:1", "naive:4", "posteriori:1", "posteriori:4", "exact:1")
@@ -42,8 +43,8 @@ README_BLOCK = "agents:study"
 
 def parse_mode(spec: str) -> tuple[str, int]:
     mode, _, k = spec.partition(":")
-    if mode not in ("naive", "posteriori", "exact"):
-        raise UsageError(f"--modes: expected mode:substeps with mode naive|posteriori|exact, got {spec!r}")
+    if mode not in MODES:
+        raise UsageError(f"--modes: expected mode:substeps with mode {'|'.join(MODES)}, got {spec!r}")
     try:
         substeps = int(k or 1)
     except ValueError:

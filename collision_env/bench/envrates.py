@@ -7,17 +7,12 @@ why instead when the environments are not importable or registered.
 
 from __future__ import annotations
 
+from collision_env.envs.registry import bench_scenes
+
 from .envs import single_env_us, vector_env_steps_per_s
 
-#: env id -> the sweep scene it matches most closely
-MATCHING_SCENE = {
-    "CollisionEnv/OneBallTarget-v0": "explore_2d n=1 / dilute_gas n=1",
-    "CollisionEnv/Line1D-v0": "explore_1d (3 balls)",
-    "CollisionEnv/Billiards-v0": "4 balls, e = 0.95 (rack)",
-    "CollisionEnv/InelasticCluster-v0": "inelastic (stick)",
-    "CollisionEnv/MultiBall-v0": "3 balls, no ball-ball collisions, e = 0.8",
-    "CollisionEnv/Target-v0": "generic (one_ball preset)",
-}
+#: env id -> the sweep scene it matches most closely (each task's registry entry names it)
+MATCHING_SCENE = bench_scenes()
 MODES = (("naive", 1), ("posteriori", 1), ("posteriori", 8), ("exact", 1))
 
 

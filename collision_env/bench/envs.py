@@ -24,6 +24,7 @@ import gymnasium as gym
 import numpy as np
 
 import collision_env
+from collision_env.engine import MODES
 
 from .machine import cpus, machine, timestamp, versions
 from .readme import write_block
@@ -92,7 +93,7 @@ def main(argv=None) -> None:
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--seconds", type=float, default=1.0, help="time per measurement (s)")
     parser.add_argument("--num-envs", type=int, default=1024, help="sub-envs of the vector env")
-    parser.add_argument("--modes", nargs="+", default=["exact"], choices=["exact", "posteriori", "naive"],
+    parser.add_argument("--modes", nargs="+", default=["exact"], choices=MODES,
                         help="engine modes to time the envs in")
     parser.add_argument("--ids", nargs="+", default=list(collision_env.ENV_IDS), help="env ids")
     parser.add_argument("--markdown", metavar="PATH", help="also write the tables to PATH")

@@ -24,9 +24,9 @@ laid out as ``layout.CAL_F`` and ``layout.CAL_I``; the heap itself in ``hp`` (``
 
 from __future__ import annotations
 
-from ._jit import njit
 import numpy as np
 
+from ._jit import njit
 from .layout import C_CHANGES, C_EVENT_OTHER, C_EVENT_STAMP, C_EVENT_TIME, C_HEAP_SLOT, H_BALL, H_TIME
 
 #: ``event_other`` codes below zero. A ball's wall events are ``EV_WALL - wall`` (wall codes 0..3

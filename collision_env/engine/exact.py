@@ -679,8 +679,8 @@ def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, coun
     roots, ``time`` the (B,) clocks; ``fparams``/``iparams`` the scene parameters
     (``layout.SCENE_F``/``SCENE_I``); ``work_f``/``work_i`` the per-scene bookkeeping and grid
     geometry (``layout.WORK_F``/``WORK_I``); ``cal_f``/``cal_i``/``cal_heap`` the persistent
-    calendar, grid and event queue (``layout.CAL_F``/``CAL_I``/``HEAP``). ``fresh`` starts a step of ``dt_abs`` for every scene;
-    otherwise the call resumes the scenes flagged active.
+    calendar, grid and event queue (``layout.CAL_F``/``CAL_I``/``HEAP``). ``fresh`` starts a step
+    of ``dt_abs`` for every scene; otherwise the call resumes the scenes flagged active.
     Impacts go to ``imp`` rows (``simulator.IMPACT_DTYPE``) from row 0, ``n_imp[0]`` rows in all; a
     scene that finds the buffer full stops where it is and is flagged stalled, so the caller can
     empty the buffer and call again for those scenes. Returns the number of stalled scenes;

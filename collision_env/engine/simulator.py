@@ -315,8 +315,8 @@ class BatchSimulator:
         if self.mode == "exact":
             nf, ni, nb = scratch_sizes(self._n)
             self._kernel = step_exact
-            self._kernel_args = state + (self._cal_f, self._cal_i, self._cal_heap, np.empty(nf), np.empty(ni, dtype=np.int64),
-                                         np.zeros(nb, dtype=np.bool_))
+            scratch = (np.empty(nf), np.empty(ni, dtype=np.int64), np.zeros(nb, dtype=np.bool_))
+            self._kernel_args = state + (self._cal_f, self._cal_i, self._cal_heap) + scratch
         else:
             self._kernel = step_substeps
             self._kernel_args = ((NAIVE if self.mode == "naive" else POSTERIORI, self.substeps) + state

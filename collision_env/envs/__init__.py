@@ -3,31 +3,32 @@
 Every registered id (``collision_env.ENV_IDS``) is a preset of one task class,
 :class:`CollisionTargetEnv`, configured by a :class:`TaskConfig`; :class:`CollisionTargetVectorEnv`
 is the native vector env on the batched engine and :class:`CollisionSB3VecEnv` (in
-``collision_env.envs.sb3``) adapts it to stable-baselines3.
+``collision_env.envs.sb3``) adapts it to stable-baselines3. Each preset's env file registers its
+task (``collision_env.envs.registry``); importing a file here is what ships it.
 """
 
-from collision_env.envs._config import PRESETS, TaskConfig, make_config
+# The preset files are imported in the order their ids are listed (registration order), not sorted.
+from collision_env.envs._config import PRESETS, TaskConfig, make_config  # noqa: I001
 from collision_env.envs._core import EpisodeSampler, Impacts, sample_episode
+from collision_env.envs.one_ball import OneBallTargetEnv, OneBallTargetVectorEnv
+from collision_env.envs.line_1d import Line1DEnv, Line1DVectorEnv
 from collision_env.envs.billiards import BilliardsEnv, BilliardsVectorEnv
 from collision_env.envs.inelastic_cluster import InelasticClusterEnv, InelasticClusterVectorEnv
-from collision_env.envs.line_1d import Line1DEnv, Line1DVectorEnv
 from collision_env.envs.multi_ball import MultiBallEnv, MultiBallVectorEnv
-from collision_env.envs.one_ball import OneBallTargetEnv, OneBallTargetVectorEnv
+from collision_env.envs.registry import PRESET_IDS, REGISTERED, Task, register_env, register_task
 from collision_env.envs.target_env import CollisionTargetEnv
 from collision_env.envs.vector import CollisionTargetVectorEnv
 
-#: preset name -> registered id
-PRESET_IDS = {
-    "one_ball": "CollisionEnv/OneBallTarget-v0",
-    "line_1d": "CollisionEnv/Line1D-v0",
-    "billiards": "CollisionEnv/Billiards-v0",
-    "inelastic_cluster": "CollisionEnv/InelasticCluster-v0",
-    "multi_ball": "CollisionEnv/MultiBall-v0",
-}
+#: The generic env: any preset by name, any TaskConfig field by keyword.
+GENERIC_ID = "CollisionEnv/Target-v0"
+register_env(GENERIC_ID, CollisionTargetEnv, CollisionTargetVectorEnv,
+             bench_scene=f"generic ({CollisionTargetEnv.preset} preset)")
 
 __all__ = [
+    "GENERIC_ID",
     "PRESETS",
     "PRESET_IDS",
+    "REGISTERED",
     "BilliardsEnv",
     "BilliardsVectorEnv",
     "CollisionTargetEnv",
@@ -41,8 +42,10 @@ __all__ = [
     "MultiBallVectorEnv",
     "OneBallTargetEnv",
     "OneBallTargetVectorEnv",
+    "Task",
     "TaskConfig",
     "make_config",
+    "register_task",
     "EpisodeSampler",
     "sample_episode",
 ]

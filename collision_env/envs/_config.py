@@ -2,9 +2,10 @@
 
 One :class:`TaskConfig` describes a whole task: the scene the engine simulates, how balls and targets
 are placed at reset, which balls the agent nudges and whose impacts count, the rewards, the control
-step, and the engine's fidelity knobs. Each preset (``PRESETS``) is just a ``TaskConfig``; the generic
-env takes a preset name plus any field as a keyword override. Construction validates every field and
-raises ``ValueError`` naming it, so bad keyword arguments fail at ``gym.make`` time.
+step, and the engine's fidelity knobs. Each preset (``PRESETS``, filled from the task registry) is just
+a ``TaskConfig``; the generic env takes a preset name plus any field as a keyword override.
+Construction validates every field and raises ``ValueError`` naming it, so bad keyword arguments
+fail at ``gym.make`` time.
 """
 
 from __future__ import annotations
@@ -15,17 +16,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from collision_env.engine import MODES
 from collision_env.engine.scene import PLAY_AREA_1D, PLAY_AREA_2D, WALL_NAMES, radius_from_mass
+from collision_env.envs._layout import BALL_OBS, GLOBAL_OBS, TARGET_OBS
 
-MODES = ("exact", "posteriori", "naive")
 SCORERS = ("any", "controlled", "others", "cluster")
 LAYOUTS = ("random", "rack")
 RADIUS_RULES = ("mass", "constant")
 
-#: Number of observation entries per ball, per target slot and global (see the env docstrings).
-BALL_FEATURES = 6
-TARGET_FEATURES = 10
-GLOBAL_FEATURES = 2
+#: Number of observation entries per ball, per target slot and global (the layouts in ``_layout``).
+BALL_FEATURES = len(BALL_OBS)
+TARGET_FEATURES = len(TARGET_OBS)
+GLOBAL_FEATURES = len(GLOBAL_OBS)
 
 
 def _pair(name, value, *, low=None, allow_equal=True):
@@ -91,7 +93,7 @@ class TaskConfig:
     Episode:
         ``time_limit`` (s of simulated time; the env truncates after round(time_limit / dt) steps).
     Engine:
-        ``mode`` ("exact" | "posteriori" | "naive"), ``substeps`` (>= 1), ``max_events`` (event cap
+        ``mode`` (one of ``collision_env.engine.MODES``), ``substeps`` (>= 1), ``max_events`` (event cap
         per step and scene).
     """
 
@@ -266,47 +268,9 @@ class TaskConfig:
 
 
 # --------------------------------------------------------------------------------------------- #
-# Presets: each registered env id is one of these, reachable as well through the generic env.
-
-PRESETS: dict[str, dict] = {
-    # 1. One ball in 2D, one target at a time (three per episode). Dense, documented shaping.
-    "one_ball": dict(
-        dimension=2, elasticity=1.0, n_balls=1, mass_range=(1.0, 1.0), radius="mass",
-        speed_range=(0.3, 0.8), controlled=(0,), n_targets=3, sequential=True, target_width=0.6,
-        scorers="any", hit_reward=1.0, success_bonus=1.0, miss_penalty=0.05, action_cost=0.02,
-        shaping=1.0, max_dv=0.15, max_speed=2.0,
-    ),
-    # 2. PhET Explore 1D: three balls on a line, the leftmost is nudged; end-wall impacts in windows.
-    "line_1d": dict(
-        dimension=1, elasticity=1.0, n_balls=3, mass_range=(0.5, 2.0), radius="mass",
-        speed_range=(0.0, 0.5), others_speed_range=(0.0, 0.5), controlled=(0,), n_targets=2,
-        sequential=False, window=2.0, scorers="any", hit_reward=1.0, success_bonus=1.0,
-        miss_penalty=0.0, action_cost=0.02, shaping=0.0, max_dv=0.1, max_speed=1.5,
-    ),
-    # 3. Billiards: a cue ball and three object balls (constant radius, e = 0.95); only object
-    #    balls score, so the skill is ball-ball transfer.
-    "billiards": dict(
-        dimension=2, elasticity=0.95, n_balls=4, mass_range=(1.0, 1.0), radius="constant",
-        layout="rack", speed_range=(0.0, 0.0), others_speed_range=(0.0, 0.0), controlled=(0,),
-        n_targets=2, sequential=False, target_width=0.6, scorers="others", hit_reward=1.0,
-        success_bonus=1.0, miss_penalty=0.0, action_cost=0.02, shaping=0.0, max_dv=0.2, max_speed=2.0,
-    ),
-    # 4. PhET Inelastic (e = 0, stick): ram the resting ball, then steer the cluster onto the target.
-    "inelastic_cluster": dict(
-        dimension=2, elasticity=0.0, inelastic="stick", n_balls=2, mass_range=(0.5, 1.5),
-        radius="mass", speed_range=(0.0, 0.3), others_speed_range=(0.0, 0.0), controlled=(0,),
-        n_targets=1, sequential=True, target_width=0.8, scorers="cluster", hit_reward=1.0,
-        success_bonus=1.0, miss_penalty=0.0, action_cost=0.02, shaping=0.0, max_dv=0.15, max_speed=1.5,
-    ),
-    # 5. Three balls, all nudged, that pass through each other (no ball-ball collisions), explicit
-    #    radius, walls with e = 0.8; three targets at once, any ball may take any target.
-    "multi_ball": dict(
-        dimension=2, elasticity=0.8, ball_collisions=False, n_balls=3, mass_range=(0.5, 1.5), radius=0.12,
-        speed_range=(0.2, 0.6), controlled=(0, 1, 2), n_targets=3, sequential=False, target_width=0.6,
-        scorers="any", hit_reward=1.0, success_bonus=1.0, miss_penalty=0.02, action_cost=0.01, shaping=0.5,
-        max_dv=0.15, max_speed=2.0,
-    ),
-}
+#: Preset name -> its ``TaskConfig`` fields. Each task's env file declares its preset, and
+#: ``collision_env.envs.registry.register_task`` enters it here (and registers its id).
+PRESETS: dict[str, dict] = {}
 
 
 def make_config(preset: str | None = "one_ball", **overrides) -> TaskConfig:

@@ -11,10 +11,20 @@ from __future__ import annotations
 
 import numpy as np
 
+from collision_env.engine.scene import WALL_NAMES
 from collision_env.envs import _kernels as K
 from collision_env.envs._config import TaskConfig
-
-_WALL_CODE = {"left": 0, "right": 1, "bottom": 2, "top": 3}
+from collision_env.envs._layout import (
+    EPISODE_FLOATS,
+    EPISODE_INTS,
+    PARAMS,
+    SCENE_FLOATS,
+    SCENE_INTS,
+    SWITCHES,
+    TARGET_GEOMETRY,
+    TARGET_INTS,
+    TARGET_PENDING,
+)
 
 
 class Impacts:
@@ -101,6 +111,20 @@ class Episodes:
         self.t_geo = t_geo
 
 
+def packed(columns: tuple, dtype, **values) -> np.ndarray:
+    """A vector laid out as ``columns`` (a ``_layout`` layout) with every field given by name."""
+    missing = sorted(set(columns._fields) - set(values))
+    unknown = sorted(set(values) - set(columns._fields))
+    if missing or unknown:
+        raise ValueError(f"{type(columns).__name__}: missing {missing}, unknown {unknown}")
+    out = np.zeros(len(columns), dtype=dtype)
+    for name, value in values.items():
+        out[getattr(columns, name)] = value
+    return out
+
+
+#: Mass scale of the observation, kg (it reads mass / 3 kg).
+MASS_SCALE = 3.0
 #: placement tries per ball inside one block of random numbers
 PLACEMENT_TRIES = 16
 #: blocks drawn for one episode before giving up (only very crowded configs come near this)
@@ -121,17 +145,15 @@ class EpisodeSampler:
         self.M = K.block_size(n, k, PLACEMENT_TRIES)
         self.ctrl_mask = np.zeros(n, dtype=bool)
         self.ctrl_mask[list(cfg.controlled)] = True
-        self.walls = np.array([_WALL_CODE[w] for w in cfg.target_walls], dtype=np.int64)
-        E = np.zeros(K.E_LEN)
-        E[K.E_XMIN:K.E_YMAX + 1] = cfg.bounds
-        E[K.E_MLO], E[K.E_MHI] = cfg.mass_range
-        E[K.E_SLO], E[K.E_SHI] = cfg.speed_range
-        E[K.E_OLO], E[K.E_OHI] = cfg.others_speed_range
-        E[K.E_HW] = 0.5 * cfg.target_width
-        E[K.E_WINDOW] = -1.0 if cfg.window is None else cfg.window
-        E[K.E_TLIMIT] = cfg.time_limit
-        self.E = E
-        self.F = np.array([cfg.dimension, n, k, int(cfg.layout == "rack"), PLACEMENT_TRIES], dtype=np.int64)
+        self.walls = np.array([WALL_NAMES.index(w) for w in cfg.target_walls], dtype=np.int64)
+        xmin, ymin, xmax, ymax = cfg.bounds
+        (speed_low, speed_high), (others_low, others_high) = cfg.speed_range, cfg.others_speed_range
+        self.E = packed(EPISODE_FLOATS, np.float64, xmin=xmin, ymin=ymin, xmax=xmax, ymax=ymax, speed_low=speed_low,
+                        speed_high=speed_high, others_low=others_low, others_high=others_high,
+                        half_width=0.5 * cfg.target_width, window=-1.0 if cfg.window is None else cfg.window,
+                        time_limit=cfg.time_limit)
+        self.F = packed(EPISODE_INTS, np.int64, dimension=cfg.dimension, n_balls=n, n_targets=k,
+                        rack=int(cfg.layout == "rack"), tries=PLACEMENT_TRIES)
 
     def _build(self, U: np.ndarray) -> tuple:
         cfg = self.cfg
@@ -142,7 +164,7 @@ class EpisodeSampler:
         pos = np.zeros((r, n, 2))
         vel = np.zeros((r, n, 2))
         t_wall = np.zeros((r, k), dtype=np.int64)
-        t_geo = np.zeros((r, k, 4))
+        t_geo = np.zeros((r, k, len(TARGET_GEOMETRY)))
         ok = np.zeros(r, dtype=bool)
         K.build_episodes(U, self.ctrl_mask, self.walls, self.E, self.F, pos, vel, masses, radii, t_wall, t_geo, ok)
         return Episodes(pos, vel, masses, radii, t_wall, t_geo), ok
@@ -190,35 +212,24 @@ class TaskCore:
         self.num_scenes = B
         self.scene = Scene(bounds=cfg.bounds, elasticity=cfg.elasticity, dimension=cfg.dimension,
                            inelastic=cfg.inelastic, ball_collisions=cfg.ball_collisions)
-        self.P = np.zeros(K.P_LEN)
-        self.P[K.P_XMIN:K.P_YMAX + 1] = cfg.bounds
-        self.P[K.P_HIT] = cfg.hit_reward
-        self.P[K.P_MISS] = cfg.miss_penalty
-        self.P[K.P_BONUS] = cfg.success_bonus
-        self.P[K.P_SHAPING] = cfg.shaping
-        self.P[K.P_VSCALE] = 2.0 * cfg.max_speed
-        self.P[K.P_MSCALE] = 3.0
-        self.P[K.P_TLIMIT] = cfg.time_limit
-        self.P[K.P_MAXDV] = cfg.max_dv
-        self.P[K.P_MAXSPEED] = cfg.max_speed
-        self.P[K.P_ACTCOST] = cfg.action_cost
-        self.Q = np.zeros(K.Q_LEN, dtype=np.int64)
-        self.Q[K.Q_SEQ] = int(cfg.sequential)
-        self.Q[K.Q_CLUSTER] = int(cfg.scorers == "cluster")
-        self.Q[K.Q_DIM] = cfg.dimension
-        self.Q[K.Q_NSTEPS] = cfg.n_steps
+        xmin, ymin, xmax, ymax = cfg.bounds
+        self.P = packed(PARAMS, np.float64, xmin=xmin, ymin=ymin, xmax=xmax, ymax=ymax, hit_reward=cfg.hit_reward,
+                        miss_penalty=cfg.miss_penalty, success_bonus=cfg.success_bonus, shaping=cfg.shaping,
+                        vscale=2.0 * cfg.max_speed, mscale=MASS_SCALE, time_limit=cfg.time_limit,
+                        max_dv=cfg.max_dv, max_speed=cfg.max_speed, action_cost=cfg.action_cost)
         self._cluster_scoring = cfg.scorers == "cluster"
-        self.Q[K.Q_STICKY] = int(self.scene.sticky)
+        self.Q = packed(SWITCHES, np.int64, sequential=int(cfg.sequential), cluster=int(self._cluster_scoring),
+                        dimension=cfg.dimension, n_steps=cfg.n_steps, sticky=int(self.scene.sticky))
         self.ctrl = np.array(cfg.controlled, dtype=np.int64)
         self.qual = cfg.scoring_mask
         self.obs_dim = cfg.obs_dim
         self.action_dim = cfg.action_dim
 
         # task state, one row per scene
-        self.S = np.zeros((B, K.S_LEN))
-        self.C = np.zeros((B, K.C_LEN), dtype=np.int64)
-        self.T = np.zeros((B, Kt, K.T_LEN), dtype=np.int64)
-        self.t_geo = np.zeros((B, Kt, 4))
+        self.S = np.zeros((B, len(SCENE_FLOATS)))
+        self.C = np.zeros((B, len(SCENE_INTS)), dtype=np.int64)
+        self.T = np.zeros((B, Kt, len(TARGET_INTS)), dtype=np.int64)
+        self.t_geo = np.zeros((B, Kt, len(TARGET_GEOMETRY)))
         self.body = np.tile(np.arange(N, dtype=np.int64), (B, 1))
         self._dv = np.zeros((B, N, 2))  # scratch: the nudge (rewritten every step)
 
@@ -234,10 +245,11 @@ class TaskCore:
         self.impact_dtype = IMPACT_DTYPE
 
     # views into the packed state (writable: they share memory with it)
-    t_wall = property(lambda self: self.T[..., K.T_WALL], doc="(B, K) target walls (codes 0..3).")
-    t_status = property(lambda self: self.T[..., K.T_STATUS], doc="(B, K) 0 pending, 1 hit, 2 failed.")
-    cur = property(lambda self: self.C[:, K.C_CUR], doc="(B,) index of the current (sequential) target.")
-    steps = property(lambda self: self.C[:, K.C_STEPS], doc="(B,) control steps taken this episode.")
+    t_wall = property(lambda self: self.T[..., TARGET_INTS.wall], doc="(B, K) target walls (engine wall codes).")
+    t_status = property(lambda self: self.T[..., TARGET_INTS.status],
+                        doc="(B, K) 0 pending, 1 hit, 2 failed (``_layout.TARGET_PENDING`` ...).")
+    cur = property(lambda self: self.C[:, SCENE_INTS.current], doc="(B,) index of the current (sequential) target.")
+    steps = property(lambda self: self.C[:, SCENE_INTS.steps], doc="(B,) control steps taken this episode.")
     # the engine's state: live views, to read (the renderer and the scripted policies do, per sub-env)
     pos = property(lambda self: self.batch.live_arrays().positions, doc="(B, N, 2) ball centres, m.")
     vel = property(lambda self: self.batch.live_arrays().velocities, doc="(B, N, 2) ball velocities, m/s.")
@@ -247,11 +259,11 @@ class TaskCore:
 
     # ------------------------------------------------------------------------------------- #
     def _write_episode(self, idx: np.ndarray, eps: Episodes) -> None:
-        self.T[idx, :, K.T_WALL] = eps.t_wall
-        self.T[idx, :, K.T_STATUS] = 0
+        self.T[idx, :, TARGET_INTS.wall] = eps.t_wall
+        self.T[idx, :, TARGET_INTS.status] = TARGET_PENDING
         self.t_geo[idx] = eps.t_geo
-        self.C[idx, K.C_CUR] = 0
-        self.C[idx, K.C_STEPS] = 0
+        self.C[idx, SCENE_INTS.current] = 0
+        self.C[idx, SCENE_INTS.steps] = 0
         self.body[idx] = np.arange(self.cfg.n_balls)
 
     def reset_scenes(self, idx: np.ndarray, rngs: list) -> None:
@@ -277,7 +289,7 @@ class TaskCore:
     def finish(self, flags: np.ndarray, imp: np.ndarray, obs: np.ndarray) -> np.ndarray:
         """Run the task kernel on the engine's state after a step; returns ``obs`` (written in place).
 
-        ``flags`` per scene as in ``_kernels``. Reward, energy, targets hit and the end flags are
+        ``flags``: one ``_layout.ROW_*`` code per scene. Reward, energy, targets hit and the end flags are
         then in ``S`` and ``C`` (see :meth:`outputs`).
         """
         live = self.batch.live_arrays()
@@ -288,10 +300,10 @@ class TaskCore:
 
     def outputs(self) -> tuple:
         """Fresh ``(reward, terminated, truncated, success, targets_hit, energy, nudge)`` arrays (B,)."""
-        S, C = self.S, self.C
-        return (S[:, K.S_REWARD].copy(), C[:, K.C_TERM].astype(bool), C[:, K.C_TRUNC].astype(bool),
-                C[:, K.C_SUCCESS].astype(bool), C[:, K.C_NHIT].copy(), S[:, K.S_ENERGY].copy(),
-                S[:, K.S_NUDGE].copy())
+        S, C, sf, si = self.S, self.C, SCENE_FLOATS, SCENE_INTS
+        return (S[:, sf.reward].copy(), C[:, si.terminated].astype(bool), C[:, si.truncated].astype(bool),
+                C[:, si.success].astype(bool), C[:, si.targets_hit].copy(), S[:, sf.energy].copy(),
+                S[:, sf.nudge].copy())
 
     def empty_impacts(self) -> np.ndarray:
         """A fresh zero-length impact record array (the engine's dtype)."""

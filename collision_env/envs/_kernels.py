@@ -3,12 +3,12 @@
 Both work on a batch of B scenes and are the only per-step task logic: the single env is a batch
 of one, so the single env and the native vector env run the same arithmetic and agree bit for bit.
 They are plain loops, compiled with numba when it is installed (like the engine's kernels) and run
-as ordinary Python otherwise.
+as ordinary Python otherwise. Each kernel is a short sequence of named phases; the phases are
+``inline="always"`` helpers, so numba compiles a kernel into one function, as fast as if it were
+written out in one piece.
 
-Wall codes follow ``collision_env.engine.WALL_NAMES``: 0 left, 1 right, 2 bottom, 3 top.
-Target status: 0 pending, 1 hit, 2 failed (its time window closed unhit).
-Row flags: 1 = a stepped scene (score it), 0 = a scene just reset (start its episode and observe it),
-2 = leave it alone, 3 = observe it without changing anything.
+The packed arrays are indexed by the named layouts of ``_layout`` (``S[b, SCENE_FLOATS.reward]``);
+wall codes are the engine's (``collision_env.engine.WALL_LEFT`` ... ``WALL_TOP``).
 """
 
 from __future__ import annotations
@@ -19,32 +19,75 @@ import numpy as np
 
 from collision_env.engine._jit import njit
 from collision_env.engine.motion import apply_impulses, ball_views
+from collision_env.engine.scene import WALL_BOTTOM, WALL_LEFT, WALL_RIGHT, WALL_TOP
+from collision_env.envs._layout import (
+    BALL_OBS,
+    EPISODE_FLOATS,
+    EPISODE_INTS,
+    GLOBAL_OBS,
+    PARAMS,
+    ROW_OBSERVE,
+    ROW_RESET,
+    ROW_SKIP,
+    ROW_STEPPED,
+    SCENE_FLOATS,
+    SCENE_INTS,
+    SWITCHES,
+    TARGET_FAILED,
+    TARGET_GEOMETRY,
+    TARGET_HIT,
+    TARGET_INTS,
+    TARGET_OBS,
+    TARGET_PENDING,
+)
 
-# indices into the float parameter vector P
-P_XMIN, P_YMIN, P_XMAX, P_YMAX = 0, 1, 2, 3
-P_HIT, P_MISS, P_BONUS, P_SHAPING = 4, 5, 6, 7
-P_VSCALE, P_MSCALE, P_TLIMIT = 8, 9, 10
-P_MAXDV, P_MAXSPEED, P_ACTCOST = 11, 12, 13
-P_LEN = 14
-# indices into the int parameter vector Q
-Q_SEQ, Q_CLUSTER, Q_DIM, Q_NSTEPS, Q_STICKY = 0, 1, 2, 3, 4
-Q_LEN = 5
-# The per-scene task state lives in a few packed arrays, because every array handed to a
-# compiled kernel costs about 0.1 us to pass (a step passes them all, every control step).
-# columns of the per-scene float array S (B, S_LEN)
-S_PHI, S_NUDGE, S_REWARD, S_ENERGY = 0, 1, 2, 3
-S_LEN = 4
-# columns of the per-scene int array C (B, C_LEN); the last two are the task kernel's scratch
-C_CUR, C_STEPS, C_NHIT, C_TERM, C_TRUNC, C_SUCCESS, C_HITS, C_MISSES = 0, 1, 2, 3, 4, 5, 6, 7
-C_LEN = 8
-# last axis of the per-target int array T (B, K, T_LEN)
-T_WALL, T_STATUS = 0, 1
-T_LEN = 2
+# short local names for the layouts the kernels index most
+SF, SI, TI, TG = SCENE_FLOATS, SCENE_INTS, TARGET_INTS, TARGET_GEOMETRY
+
+
+@njit(inline="always")
+def _on_side_wall(wall):  # pragma: no cover - numba
+    """Left and right walls run along y; bottom and top along x."""
+    return wall == WALL_LEFT or wall == WALL_RIGHT
+
+
+@njit(inline="always")
+def _clip1(v):  # pragma: no cover - numba
+    return min(max(v, -1.0), 1.0)
+
+
+# --------------------------------------------------------------------------------------------- #
+# nudge
+
+
+@njit(inline="always")
+def _first_nan_row(actions, active):  # pragma: no cover - numba
+    """The first active row holding a NaN, or -1 (an inactive row's action is ignored, NaN or not)."""
+    for b in range(actions.shape[0]):
+        if active[b]:
+            for c in range(actions.shape[1]):
+                if actions[b, c] != actions[b, c]:
+                    return b
+    return -1
+
+
+@njit(inline="always")
+def _capped_change(vx, vy, dx, dy, max_speed):  # pragma: no cover - numba
+    """The velocity change that applies (dx, dy) to (vx, vy) without exceeding max(max_speed, |v|)."""
+    nx = vx + dx
+    ny = vy + dy
+    s_new = math.sqrt(nx * nx + ny * ny)
+    cap = max(max_speed, math.sqrt(vx * vx + vy * vy))
+    if s_new > cap:
+        f = cap / s_new
+        nx *= f
+        ny *= f
+    return nx - vx, ny - vy
 
 
 @njit
 def nudge_kernel(actions, active, balls, body, ctrl, P, Q, dv, S):  # pragma: no cover - numba
-    """Scale actions to velocity changes ``dv`` (B, N, 2) and their size ``S[:, S_NUDGE]``, and apply
+    """Scale actions to velocity changes ``dv`` (B, N, 2) and their size ``S[:, nudge]``, and apply
     them to the engine's balls with the engine's own impulse kernel.
 
     Returns -1, or the first active row holding a NaN (then nothing is written). Only the controlled
@@ -55,73 +98,314 @@ def nudge_kernel(actions, active, balls, body, ctrl, P, Q, dv, S):  # pragma: no
     ``action_cost`` times it.
     Rows with ``active`` False get no nudge and no cost.
     """
-    B = actions.shape[0]
-    for b in range(B):
-        if active[b]:  # (an inactive row's action is ignored, NaN or not)
-            for c in range(actions.shape[1]):
-                if actions[b, c] != actions[b, c]:
-                    return b  # NaN: reject the whole call before changing anything
+    bad = _first_nan_row(actions, active)
+    if bad >= 0:
+        return bad  # reject the whole call before changing anything
     _, vel, _, _, _, _ = ball_views(balls)
-    dim = Q[Q_DIM]
-    max_dv = P[P_MAXDV]
-    max_speed = P[P_MAXSPEED]
-    for b in range(B):
-        c_total = 0.0
-        if not active[b]:
-            for c in range(ctrl.shape[0]):
-                dv[b, ctrl[c], 0] = 0.0
-                dv[b, ctrl[c], 1] = 0.0
-        else:
-            for c in range(ctrl.shape[0]):
-                i = ctrl[c]
-                ax = min(max(actions[b, c * dim], -1.0), 1.0)
-                ay = 0.0
-                if dim == 2:
-                    ay = min(max(actions[b, c * dim + 1], -1.0), 1.0)
-                dx = ax * max_dv
-                dy = ay * max_dv
-                c_total += math.sqrt(dx * dx + dy * dy)
-                vx = vel[b, i, 0]
-                vy = vel[b, i, 1]
-                nx = vx + dx
-                ny = vy + dy
-                s_new = math.sqrt(nx * nx + ny * ny)
-                cap = max(max_speed, math.sqrt(vx * vx + vy * vy))
-                if s_new > cap:
-                    f = cap / s_new
-                    nx *= f
-                    ny *= f
-                dv[b, i, 0] = nx - vx
-                dv[b, i, 1] = ny - vy
-        S[b, S_NUDGE] = c_total
-    apply_impulses(balls, body, dv, Q[Q_STICKY] != 0)
+    dim = Q[SWITCHES.dimension]
+    max_dv = P[PARAMS.max_dv]
+    max_speed = P[PARAMS.max_speed]
+    for b in range(actions.shape[0]):
+        requested = 0.0
+        for c in range(ctrl.shape[0]):
+            i = ctrl[c]
+            if not active[b]:
+                dv[b, i, 0] = 0.0
+                dv[b, i, 1] = 0.0
+                continue
+            ax = _clip1(actions[b, c * dim])
+            ay = _clip1(actions[b, c * dim + 1]) if dim == 2 else 0.0
+            dx = ax * max_dv
+            dy = ay * max_dv
+            requested += math.sqrt(dx * dx + dy * dy)
+            cdx, cdy = _capped_change(vel[b, i, 0], vel[b, i, 1], dx, dy, max_speed)
+            dv[b, i, 0] = cdx
+            dv[b, i, 1] = cdy
+        S[b, SF.nudge] = requested
+    apply_impulses(balls, body, dv, Q[SWITCHES.sticky] != 0)
     return -1
 
 
-@njit
-def _segment(P, wall, centre, hw):  # pragma: no cover - numba
-    """End points (x0, y0, x1, y1) of a target segment on a wall."""
-    if wall == 0:
-        return P[P_XMIN], centre - hw, P[P_XMIN], centre + hw
-    if wall == 1:
-        return P[P_XMAX], centre - hw, P[P_XMAX], centre + hw
-    if wall == 2:
-        return centre - hw, P[P_YMIN], centre + hw, P[P_YMIN]
-    return centre - hw, P[P_YMAX], centre + hw, P[P_YMAX]
+# --------------------------------------------------------------------------------------------- #
+# scoring: impacts -> target hits
 
 
-@njit
-def _clip1(v):  # pragma: no cover - numba
-    return min(max(v, -1.0), 1.0)
-
-
-@njit
+@njit(inline="always")
 def _in_cluster(body, b, i):  # pragma: no cover - numba
     root = body[b, i]
     for k in range(body.shape[1]):
         if k != i and body[b, k] == root:
             return True
     return False
+
+
+@njit(inline="always")
+def _merge_clusters(body, b, i, o):  # pragma: no cover - numba
+    """A ball-ball impact in a stick scene joins the two balls' clusters (under the smaller root)."""
+    ri = body[b, i]
+    ro = body[b, o]
+    root = min(ri, ro)
+    gone = max(ri, ro)
+    for q in range(body.shape[1]):
+        if body[b, q] == gone:
+            body[b, q] = root
+
+
+@njit(inline="always")
+def _split_cluster(body, b, i):  # pragma: no cover - numba
+    """A wall impact stops ball i's cluster and takes it apart, as the engine does."""
+    root = body[b, i]
+    for q in range(body.shape[1]):
+        if body[b, q] == root:
+            body[b, q] = q
+
+
+@njit(inline="always")
+def _visible_targets(C, b, n_targets, seq):  # pragma: no cover - numba
+    """The range of targets that can be hit now: the current one if sequential, else all."""
+    if seq:
+        return C[b, SI.current], min(C[b, SI.current] + 1, n_targets)
+    return 0, n_targets
+
+
+@njit(inline="always")
+def _take_target(C, T, t_geo, b, wall, along, t, seq):  # pragma: no cover - numba
+    """Mark the first visible pending target that a wall impact (wall, position along it, time) lands on
+    as hit; returns whether there was one."""
+    k0, k1 = _visible_targets(C, b, T.shape[1], seq)
+    for k in range(k0, k1):
+        if (T[b, k, TI.status] == TARGET_PENDING and T[b, k, TI.wall] == wall
+                and abs(along - t_geo[b, k, TG.centre]) <= t_geo[b, k, TG.half_width]
+                and t_geo[b, k, TG.opens] <= t and t <= t_geo[b, k, TG.closes]):
+            T[b, k, TI.status] = TARGET_HIT
+            if seq:
+                C[b, SI.current] += 1
+            return True
+    return False
+
+
+@njit(inline="always")
+def _score_impacts(flags, imp, C, T, t_geo, body, qual, seq, cluster):  # pragma: no cover - numba
+    """Count each stepped scene's target hits and off-target wall impacts of scoring balls.
+
+    In cluster mode ``body`` mirrors the engine's clusters through the step, replayed from the
+    impacts, so that a wall impact scores only if its ball was part of a cluster at that instant.
+    """
+    for b in range(flags.shape[0]):
+        C[b, SI.hits] = 0
+        C[b, SI.misses] = 0
+    for j in range(imp.shape[0]):
+        b = imp[j]["scene"]
+        if flags[b] != ROW_STEPPED:
+            continue
+        i = imp[j]["ball"]
+        w = imp[j]["wall"]
+        if w < 0:
+            if cluster:
+                o = imp[j]["other"]
+                if o >= 0:
+                    _merge_clusters(body, b, i, o)
+            continue
+        scores = qual[i]
+        if cluster:
+            scores = scores and _in_cluster(body, b, i)
+            _split_cluster(body, b, i)
+        if not scores:
+            continue
+        along = imp[j]["y"] if _on_side_wall(w) else imp[j]["x"]
+        if _take_target(C, T, t_geo, b, w, along, imp[j]["time"], seq):
+            C[b, SI.hits] += 1
+        else:
+            C[b, SI.misses] += 1
+
+
+@njit(inline="always")
+def _close_windows(T, t_geo, b, now):  # pragma: no cover - numba
+    """Targets whose time window closed unhit fail."""
+    for k in range(T.shape[1]):
+        if T[b, k, TI.status] == TARGET_PENDING and t_geo[b, k, TG.closes] < now:
+            T[b, k, TI.status] = TARGET_FAILED
+
+
+@njit(inline="always")
+def _target_tally(T, b):  # pragma: no cover - numba
+    """(targets hit, whether some target failed) of scene b."""
+    n_hit = 0
+    failed = False
+    for k in range(T.shape[1]):
+        if T[b, k, TI.status] == TARGET_HIT:
+            n_hit += 1
+        elif T[b, k, TI.status] == TARGET_FAILED:
+            failed = True
+    return n_hit, failed
+
+
+# --------------------------------------------------------------------------------------------- #
+# observation
+
+
+@njit(inline="always")
+def _play_area(P):  # pragma: no cover - numba
+    """Centre (xc, yc), half-size (xh, yh) and diagonal of the play area."""
+    xmin = P[PARAMS.xmin]
+    ymin = P[PARAMS.ymin]
+    xmax = P[PARAMS.xmax]
+    ymax = P[PARAMS.ymax]
+    diag = math.sqrt((xmax - xmin) ** 2 + (ymax - ymin) ** 2)
+    return 0.5 * (xmin + xmax), 0.5 * (ymin + ymax), 0.5 * (xmax - xmin), 0.5 * (ymax - ymin), diag
+
+
+@njit(inline="always")
+def _observe_balls(obs, b, pos, vel, masses, body, qual, cluster, area, P):  # pragma: no cover - numba
+    """Write every ball's observation block; returns the kinetic energy of the scene."""
+    xc, yc, xh, yh, _ = area
+    vscale = P[PARAMS.vscale]
+    mscale = P[PARAMS.mscale]
+    ke = 0.0
+    o = 0
+    for i in range(pos.shape[1]):
+        vx = vel[b, i, 0]
+        vy = vel[b, i, 1]
+        ke += 0.5 * masses[b, i] * (vx * vx + vy * vy)
+        obs[b, o + BALL_OBS.x] = _clip1((pos[b, i, 0] - xc) / xh)
+        obs[b, o + BALL_OBS.y] = _clip1((pos[b, i, 1] - yc) / yh)
+        obs[b, o + BALL_OBS.vx] = _clip1(vx / vscale)
+        obs[b, o + BALL_OBS.vy] = _clip1(vy / vscale)
+        obs[b, o + BALL_OBS.mass] = _clip1(masses[b, i] / mscale)
+        scoring = qual[i] and (not cluster or _in_cluster(body, b, i))
+        obs[b, o + BALL_OBS.scoring] = 1.0 if scoring else 0.0
+        o += len(BALL_OBS)
+    return ke
+
+
+@njit(inline="always")
+def _observed_point(wall, centre, area):  # pragma: no cover - numba
+    """A target's centre point in observation coordinates, and the half length of its wall."""
+    xc, yc, xh, yh, _ = area
+    if wall == WALL_LEFT:
+        return -1.0, (centre - yc) / yh, yh
+    if wall == WALL_RIGHT:
+        return 1.0, (centre - yc) / yh, yh
+    if wall == WALL_BOTTOM:
+        return (centre - xc) / xh, -1.0, xh
+    return (centre - xc) / xh, 1.0, xh
+
+
+@njit(inline="always")
+def _observe_targets(obs, o, b, C, T, t_geo, seq, now, area, P):  # pragma: no cover - numba
+    """Write the target slots' blocks from offset o (the current target when sequential)."""
+    n_targets = T.shape[1]
+    tlimit = P[PARAMS.time_limit]
+    for slot in range(1 if seq else n_targets):
+        k = min(C[b, SI.current], n_targets - 1) if seq else slot
+        w = T[b, k, TI.wall]
+        px, py, half = _observed_point(w, t_geo[b, k, TG.centre], area)
+        obs[b, o + TARGET_OBS.x] = _clip1(px)
+        obs[b, o + TARGET_OBS.y] = _clip1(py)
+        obs[b, o + TARGET_OBS.half_width] = _clip1(t_geo[b, k, TG.half_width] / half)
+        for q in range(WALL_TOP + 1):
+            obs[b, o + TARGET_OBS.wall_left + q] = 1.0 if q == w else 0.0
+        st = T[b, k, TI.status]
+        obs[b, o + TARGET_OBS.status] = 1.0 if st == TARGET_PENDING else (0.0 if st == TARGET_HIT else -1.0)
+        obs[b, o + TARGET_OBS.opens] = _clip1((t_geo[b, k, TG.opens] - now) / tlimit)
+        obs[b, o + TARGET_OBS.closes] = _clip1((t_geo[b, k, TG.closes] - now) / tlimit)
+        o += len(TARGET_OBS)
+    return o
+
+
+@njit(inline="always")
+def _segment(P, wall, centre, hw):  # pragma: no cover - numba
+    """End points (x0, y0, x1, y1) of a target segment on a wall."""
+    if wall == WALL_LEFT:
+        return P[PARAMS.xmin], centre - hw, P[PARAMS.xmin], centre + hw
+    if wall == WALL_RIGHT:
+        return P[PARAMS.xmax], centre - hw, P[PARAMS.xmax], centre + hw
+    if wall == WALL_BOTTOM:
+        return centre - hw, P[PARAMS.ymin], centre + hw, P[PARAMS.ymin]
+    return centre - hw, P[PARAMS.ymax], centre + hw, P[PARAMS.ymax]
+
+
+@njit(inline="always")
+def _border_contact(x, y, vx, vy, r, P):  # pragma: no cover - numba
+    """Where a ball at (x, y) of radius r would touch the border flying straight on at (vx, vy) != 0."""
+    xmin = P[PARAMS.xmin]
+    ymin = P[PARAMS.ymin]
+    xmax = P[PARAMS.xmax]
+    ymax = P[PARAMS.ymax]
+    tx = math.inf
+    ty = math.inf
+    if vx > 0.0:
+        tx = (xmax - r - x) / vx
+    elif vx < 0.0:
+        tx = (xmin + r - x) / vx
+    if vy > 0.0:
+        ty = (ymax - r - y) / vy
+    elif vy < 0.0:
+        ty = (ymin + r - y) / vy
+    if tx <= ty:
+        return xmax if vx > 0.0 else xmin, y + vy * max(tx, 0.0)
+    return x + vx * max(ty, 0.0), ymax if vy > 0.0 else ymin
+
+
+@njit(inline="always")
+def _aim_distance(b, pos, vel, radii, body, qual, cluster, C, T, t_geo, seq, diag, P):  # pragma: no cover
+    """Distance from each scoring ball's straight-line border contact point to the nearest visible
+    pending target, over the play-area diagonal, at its smallest (1 when nothing is aimed).
+
+    A shaping heuristic: it ignores other balls.
+    """
+    best = 1.0
+    for i in range(pos.shape[1]):
+        if not (qual[i] and (not cluster or _in_cluster(body, b, i))):
+            continue
+        vx = vel[b, i, 0]
+        vy = vel[b, i, 1]
+        if vx == 0.0 and vy == 0.0:
+            continue
+        cx, cy = _border_contact(pos[b, i, 0], pos[b, i, 1], vx, vy, radii[b, i], P)
+        k0, k1 = _visible_targets(C, b, T.shape[1], seq)
+        for k in range(k0, k1):
+            if T[b, k, TI.status] != TARGET_PENDING:
+                continue
+            x0, y0, x1, y1 = _segment(P, T[b, k, TI.wall], t_geo[b, k, TG.centre], t_geo[b, k, TG.half_width])
+            sx = x1 - x0
+            sy = y1 - y0
+            u = ((cx - x0) * sx + (cy - y0) * sy) / (sx * sx + sy * sy)
+            u = min(max(u, 0.0), 1.0)
+            dx = cx - (x0 + u * sx)
+            dy = cy - (y0 + u * sy)
+            d = math.sqrt(dx * dx + dy * dy) / diag
+            if d < best:
+                best = d
+    return best
+
+
+# --------------------------------------------------------------------------------------------- #
+# reward and episode end
+
+
+@njit(inline="always")
+def _write_outcome(S, C, b, flag, done_ok, failed, phi_new, n_steps, P):  # pragma: no cover - numba
+    """Reward and end flags of a stepped scene (zero and False for a reset or observed one); the
+    potential phi is kept for the next step unless the scene was only observed."""
+    if flag == ROW_STEPPED:
+        rew = C[b, SI.hits] * P[PARAMS.hit_reward] - C[b, SI.misses] * P[PARAMS.miss_penalty] \
+            - P[PARAMS.action_cost] * S[b, SF.nudge]
+        if done_ok:
+            rew += P[PARAMS.success_bonus]
+        if C[b, SI.hits] == 0:
+            rew += P[PARAMS.shaping] * (phi_new - S[b, SF.phi])
+        S[b, SF.reward] = rew
+        C[b, SI.terminated] = done_ok or failed
+        C[b, SI.truncated] = C[b, SI.steps] >= n_steps
+        C[b, SI.success] = done_ok
+    else:
+        S[b, SF.reward] = 0.0
+        C[b, SI.terminated] = False
+        C[b, SI.truncated] = False
+        C[b, SI.success] = False
+    if flag != ROW_OBSERVE:
+        S[b, SF.phi] = phi_new
 
 
 @njit
@@ -131,251 +415,53 @@ def task_kernel(flags, imp, balls, sim_time, clusters, S, C, T, t_geo, body, qua
 
     ``imp`` is the engine's impact record array for the batch (sorted by scene then time);
     ``balls`` (the per-ball state, ``engine.motion.BALL_FIELDS``), ``sim_time`` and ``clusters``
-    are the engine's state after the step.
+    are the engine's state after the step. ``flags`` holds one ``ROW_*`` code per scene.
     In cluster mode ``body`` mirrors the engine's cluster roots through the step, replayed from
     the impacts (a ball-ball impact merges two clusters, a wall impact stops the cluster and
     takes it apart, as the engine does), so a wall impact scores only if its ball was part of a
     cluster at that instant; at the end ``body`` is set to the engine's ``clusters``.
     Updated in place: target status, current target, step count, body, phi. Written for rows
-    whose flag is 0 or 1: the observation, reward, energy, targets hit and the end flags.
+    whose flag is not ``ROW_SKIP``: the observation, reward, energy, targets hit and the end flags.
     """
     pos, vel, masses, _, radii, _ = ball_views(balls)  # (always a C array: one compiled version for any B, N)
-    t_wall = T[:, :, T_WALL]
-    t_status = T[:, :, T_STATUS]
-    cur = C[:, C_CUR]
-    steps = C[:, C_STEPS]
-    n_hit = C[:, C_NHIT]
-    terminated = C[:, C_TERM]
-    truncated = C[:, C_TRUNC]
-    success = C[:, C_SUCCESS]
-    nudge = S[:, S_NUDGE]
-    hits = C[:, C_HITS]
-    misses = C[:, C_MISSES]
-    phi = S[:, S_PHI]
-    reward = S[:, S_REWARD]
-    energy = S[:, S_ENERGY]
-    B = flags.shape[0]
-    N = pos.shape[1]
-    K = t_wall.shape[1]
-    seq = Q[Q_SEQ] != 0
-    cluster = Q[Q_CLUSTER] != 0
-    n_steps = Q[Q_NSTEPS]
-    xmin = P[P_XMIN]
-    ymin = P[P_YMIN]
-    xmax = P[P_XMAX]
-    ymax = P[P_YMAX]
-    xc = 0.5 * (xmin + xmax)
-    yc = 0.5 * (ymin + ymax)
-    xh = 0.5 * (xmax - xmin)
-    yh = 0.5 * (ymax - ymin)
-    diag = math.sqrt((xmax - xmin) ** 2 + (ymax - ymin) ** 2)
-    vscale = P[P_VSCALE]
-    mscale = P[P_MSCALE]
-    tlimit = P[P_TLIMIT]
-    shaping = P[P_SHAPING] != 0.0  # the aiming potential is only computed when it is used
-
-    for b in range(B):
-        hits[b] = 0
-        misses[b] = 0
-    for j in range(imp.shape[0]):
-        b = imp[j]["scene"]
-        if flags[b] != 1:
-            continue
-        i = imp[j]["ball"]
-        w = imp[j]["wall"]
-        if w < 0:
-            if cluster:
-                o = imp[j]["other"]
-                if o >= 0:
-                    ri = body[b, i]
-                    ro = body[b, o]
-                    root = min(ri, ro)
-                    gone = max(ri, ro)
-                    for q in range(N):
-                        if body[b, q] == gone:
-                            body[b, q] = root
-            continue
-        scores = qual[i]
-        if cluster:
-            scores = scores and _in_cluster(body, b, i)
-            root = body[b, i]
-            for q in range(N):  # the cluster stops at the wall and comes apart
-                if body[b, q] == root:
-                    body[b, q] = q
-        if not scores:
-            continue
-        s = imp[j]["y"] if w < 2 else imp[j]["x"]
-        t = imp[j]["time"]
-        k0 = 0
-        k1 = K
-        if seq:
-            k0 = cur[b]
-            k1 = min(cur[b] + 1, K)
-        hit = False
-        for k in range(k0, k1):
-            if (t_status[b, k] == 0 and t_wall[b, k] == w and abs(s - t_geo[b, k, 0]) <= t_geo[b, k, 1]
-                    and t_geo[b, k, 2] <= t and t <= t_geo[b, k, 3]):
-                t_status[b, k] = 1
-                hit = True
-                hits[b] += 1
-                if seq:
-                    cur[b] += 1
-                break
-        if not hit:
-            misses[b] += 1
-
-    slots = 1 if seq else K
-    for b in range(B):
+    seq = Q[SWITCHES.sequential] != 0
+    cluster = Q[SWITCHES.cluster] != 0
+    n_steps = Q[SWITCHES.n_steps]
+    shaping = P[PARAMS.shaping] != 0.0  # the aiming potential is only computed when it is used
+    area = _play_area(P)
+    n_targets = T.shape[1]
+    _score_impacts(flags, imp, C, T, t_geo, body, qual, seq, cluster)
+    for b in range(flags.shape[0]):
         f = flags[b]
-        if f == 2:
+        if f == ROW_SKIP:
             continue
         now = sim_time[b]
-        if f == 1:
-            steps[b] += 1
-            for k in range(K):  # windows that closed unhit fail
-                if t_status[b, k] == 0 and t_geo[b, k, 3] < now:
-                    t_status[b, k] = 2
-        elif f == 0:
-            steps[b] = 0
+        if f == ROW_STEPPED:
+            C[b, SI.steps] += 1
+            _close_windows(T, t_geo, b, now)
+        elif f == ROW_RESET:
+            C[b, SI.steps] = 0
         if cluster:
-            for q in range(N):
+            for q in range(body.shape[1]):
                 body[b, q] = clusters[b, q]
-        nh = 0
-        failed = False
-        for k in range(K):
-            if t_status[b, k] == 1:
-                nh += 1
-            elif t_status[b, k] == 2:
-                failed = True
-        done_ok = nh == K
-        n_hit[b] = nh
+        n_hit, failed = _target_tally(T, b)
+        C[b, SI.targets_hit] = n_hit
 
-        # ---- observation
-        o = 0
-        ke = 0.0
-        for i in range(N):
-            vx = vel[b, i, 0]
-            vy = vel[b, i, 1]
-            ke += 0.5 * masses[b, i] * (vx * vx + vy * vy)
-            obs[b, o] = _clip1((pos[b, i, 0] - xc) / xh)
-            obs[b, o + 1] = _clip1((pos[b, i, 1] - yc) / yh)
-            obs[b, o + 2] = _clip1(vx / vscale)
-            obs[b, o + 3] = _clip1(vy / vscale)
-            obs[b, o + 4] = _clip1(masses[b, i] / mscale)
-            scoring = qual[i] and (not cluster or _in_cluster(body, b, i))
-            obs[b, o + 5] = 1.0 if scoring else 0.0
-            o += 6
-        energy[b] = ke
-        for sl in range(slots):
-            k = sl
-            if seq:
-                k = min(cur[b], K - 1)
-            w = t_wall[b, k]
-            c = t_geo[b, k, 0]
-            hw = t_geo[b, k, 1]
-            if w == 0:
-                px, py, half = -1.0, (c - yc) / yh, yh
-            elif w == 1:
-                px, py, half = 1.0, (c - yc) / yh, yh
-            elif w == 2:
-                px, py, half = (c - xc) / xh, -1.0, xh
-            else:
-                px, py, half = (c - xc) / xh, 1.0, xh
-            obs[b, o] = _clip1(px)
-            obs[b, o + 1] = _clip1(py)
-            obs[b, o + 2] = _clip1(hw / half)
-            for q in range(4):
-                obs[b, o + 3 + q] = 1.0 if q == w else 0.0
-            st = t_status[b, k]
-            obs[b, o + 7] = 1.0 if st == 0 else (0.0 if st == 1 else -1.0)
-            obs[b, o + 8] = _clip1((t_geo[b, k, 2] - now) / tlimit)
-            obs[b, o + 9] = _clip1((t_geo[b, k, 3] - now) / tlimit)
-            o += 10
-        obs[b, o] = min(max(1.0 - steps[b] / n_steps, 0.0), 1.0)
-        obs[b, o + 1] = (K - nh) / K
+        S[b, SF.energy] = _observe_balls(obs, b, pos, vel, masses, body, qual, cluster, area, P)
+        o = _observe_targets(obs, len(BALL_OBS) * pos.shape[1], b, C, T, t_geo, seq, now, area, P)
+        obs[b, o + GLOBAL_OBS.steps_left] = min(max(1.0 - C[b, SI.steps] / n_steps, 0.0), 1.0)
+        obs[b, o + GLOBAL_OBS.targets_left] = (n_targets - n_hit) / n_targets
 
-        # ---- aiming potential: distance from each scoring ball's straight-line wall contact point
-        # to the nearest visible pending target, over the play-area diagonal (a shaping heuristic
-        # that ignores other balls; 1 when nothing is aimed)
-        best = 1.0
-        for i in range(N if shaping else 0):
-            if not (qual[i] and (not cluster or _in_cluster(body, b, i))):
-                continue
-            vx = vel[b, i, 0]
-            vy = vel[b, i, 1]
-            if vx == 0.0 and vy == 0.0:
-                continue
-            r = radii[b, i]
-            x = pos[b, i, 0]
-            y = pos[b, i, 1]
-            tx = math.inf
-            ty = math.inf
-            if vx > 0.0:
-                tx = (xmax - r - x) / vx
-            elif vx < 0.0:
-                tx = (xmin + r - x) / vx
-            if vy > 0.0:
-                ty = (ymax - r - y) / vy
-            elif vy < 0.0:
-                ty = (ymin + r - y) / vy
-            if tx <= ty:
-                cx = xmax if vx > 0.0 else xmin
-                cy = y + vy * max(tx, 0.0)
-            else:
-                cx = x + vx * max(ty, 0.0)
-                cy = ymax if vy > 0.0 else ymin
-            k0 = 0
-            k1 = K
-            if seq:
-                k0 = cur[b]
-                k1 = min(cur[b] + 1, K)
-            for k in range(k0, k1):
-                if t_status[b, k] != 0:
-                    continue
-                x0, y0, x1, y1 = _segment(P, t_wall[b, k], t_geo[b, k, 0], t_geo[b, k, 1])
-                sx = x1 - x0
-                sy = y1 - y0
-                u = ((cx - x0) * sx + (cy - y0) * sy) / (sx * sx + sy * sy)
-                u = min(max(u, 0.0), 1.0)
-                dx = cx - (x0 + u * sx)
-                dy = cy - (y0 + u * sy)
-                d = math.sqrt(dx * dx + dy * dy) / diag
-                if d < best:
-                    best = d
-        phi_new = -best
-
-        if f == 1:
-            rew = hits[b] * P[P_HIT] - misses[b] * P[P_MISS] - P[P_ACTCOST] * nudge[b]
-            if done_ok:
-                rew += P[P_BONUS]
-            if hits[b] == 0:
-                rew += P[P_SHAPING] * (phi_new - phi[b])
-            reward[b] = rew
-            terminated[b] = done_ok or failed
-            truncated[b] = steps[b] >= n_steps
-            success[b] = done_ok
-        else:
-            reward[b] = 0.0
-            terminated[b] = False
-            truncated[b] = False
-            success[b] = False
-        if f != 3:
-            phi[b] = phi_new
+        phi_new = -(_aim_distance(b, pos, vel, radii, body, qual, cluster, C, T, t_geo, seq, area[4], P)
+                    if shaping else 1.0)
+        _write_outcome(S, C, b, f, n_hit == n_targets, failed, phi_new, n_steps, P)
 
 
 # --------------------------------------------------------------------------------------------- #
 # episode construction from blocks of uniform random numbers
 
-#: indices into the float parameter vector of ``build_episodes``
-E_XMIN, E_YMIN, E_XMAX, E_YMAX = 0, 1, 2, 3
-E_MLO, E_MHI, E_RADIUS = 4, 5, 6  # (masses and radii are computed by the caller from U[:, :N])
-E_SLO, E_SHI, E_OLO, E_OHI = 7, 8, 9, 10
-E_HW, E_WINDOW, E_TLIMIT = 11, 12, 13  # E_WINDOW < 0: no windows
-E_LEN = 14
-#: indices into the int parameter vector
-F_DIM, F_N, F_K, F_RACK, F_TRIES = 0, 1, 2, 3, 4
-F_LEN = 5
 _GAP = 1e-3
+_NO_WINDOW = 1e300  # a target without a time window is open from -_NO_WINDOW to _NO_WINDOW
 
 
 def block_size(n_balls: int, n_targets: int, tries: int) -> int:
@@ -383,109 +469,147 @@ def block_size(n_balls: int, n_targets: int, tries: int) -> int:
     return 3 * n_balls + 3 * n_targets + 2 * n_balls * tries
 
 
+@njit(inline="always")
+def _draw_velocities(U, r, ctrl_mask, E, dim, vel):  # pragma: no cover - numba
+    """Speeds uniform in the ball's range, directions uniform (a random sign in 1D)."""
+    N = vel.shape[1]
+    for i in range(N):
+        if ctrl_mask[i]:
+            lo, hi = E[EPISODE_FLOATS.speed_low], E[EPISODE_FLOATS.speed_high]
+        else:
+            lo, hi = E[EPISODE_FLOATS.others_low], E[EPISODE_FLOATS.others_high]
+        speed = lo + (hi - lo) * U[r, N + i]
+        u = U[r, 2 * N + i]
+        if dim == 1:
+            vel[r, i, 0] = speed if u < 0.5 else -speed
+            vel[r, i, 1] = 0.0
+        else:
+            vel[r, i, 0] = speed * math.cos(2.0 * math.pi * u)
+            vel[r, i, 1] = speed * math.sin(2.0 * math.pi * u)
+
+
+@njit(inline="always")
+def _place_on_line(U, r, off, radii, xmin, xmax, pos):  # pragma: no cover - numba
+    """Balls left to right by index, the free length split at sorted uniform points."""
+    N = pos.shape[1]
+    free = (xmax - xmin) - _GAP * (N + 1)
+    for i in range(N):
+        free -= 2.0 * radii[r, i]
+    us = np.sort(U[r, off:off + N] * free)
+    edge = xmin
+    for i in range(N):
+        edge += _GAP
+        pos[r, i, 0] = edge + us[i] + radii[r, i]
+        pos[r, i, 1] = 0.0
+        edge += 2.0 * radii[r, i]
+
+
+@njit(inline="always")
+def _place_in_box(U, r, off, tries, ctrl_mask, rack, radii, E, pos):  # pragma: no cover - numba
+    """Each ball at the first of its tries that overlaps no ball placed before it; False if none does."""
+    xmin = E[EPISODE_FLOATS.xmin]
+    ymin = E[EPISODE_FLOATS.ymin]
+    xmax = E[EPISODE_FLOATS.xmax]
+    ymax = E[EPISODE_FLOATS.ymax]
+    for i in range(pos.shape[1]):
+        rad = radii[r, i]
+        lo_x = xmin + rad + _GAP
+        hi_x = xmax - rad - _GAP
+        if rack:
+            if ctrl_mask[i]:
+                hi_x = min(hi_x, xmin + 0.4 * (xmax - xmin) - rad)
+            else:
+                lo_x = max(lo_x, xmin + 0.5 * (xmax - xmin) + rad)
+        lo_y = ymin + rad + _GAP
+        hi_y = ymax - rad - _GAP
+        placed = False
+        for t in range(tries):
+            px = lo_x + (hi_x - lo_x) * U[r, off + 2 * (i * tries + t)]
+            py = lo_y + (hi_y - lo_y) * U[r, off + 2 * (i * tries + t) + 1]
+            free_spot = True
+            for j in range(i):
+                dx = pos[r, j, 0] - px
+                dy = pos[r, j, 1] - py
+                if math.sqrt(dx * dx + dy * dy) <= radii[r, j] + rad + _GAP:
+                    free_spot = False
+                    break
+            if free_spot:
+                pos[r, i, 0] = px
+                pos[r, i, 1] = py
+                placed = True
+                break
+        if not placed:
+            return False
+    return True
+
+
+@njit(inline="always")
+def _draw_targets(U, r, off, walls, dim, E, t_wall, t_geo):  # pragma: no cover - numba
+    """Target walls uniform among ``walls``, centres uniform along the wall (the whole end wall in 1D)."""
+    K = t_wall.shape[1]
+    nw = walls.shape[0]
+    xmin = E[EPISODE_FLOATS.xmin]
+    ymin = E[EPISODE_FLOATS.ymin]
+    xmax = E[EPISODE_FLOATS.xmax]
+    ymax = E[EPISODE_FLOATS.ymax]
+    for k in range(K):
+        w = walls[min(int(U[r, off + k] * nw), nw - 1)]
+        t_wall[r, k] = w
+        if dim == 1:
+            t_geo[r, k, TG.centre] = 0.5 * (ymin + ymax)
+            t_geo[r, k, TG.half_width] = 0.5 * (ymax - ymin)
+        else:
+            hw = E[EPISODE_FLOATS.half_width]
+            lo_s = (ymin if _on_side_wall(w) else xmin) + hw
+            hi_s = (ymax if _on_side_wall(w) else xmax) - hw
+            t_geo[r, k, TG.centre] = lo_s + (hi_s - lo_s) * U[r, off + K + k]
+            t_geo[r, k, TG.half_width] = hw
+
+
+@njit(inline="always")
+def _draw_windows(U, r, off, E, t_geo):  # pragma: no cover - numba
+    """Time windows opening at sorted uniform times, so that the targets come due in index order."""
+    K = t_geo.shape[1]
+    if E[EPISODE_FLOATS.window] < 0.0:
+        for k in range(K):
+            t_geo[r, k, TG.opens] = -_NO_WINDOW
+            t_geo[r, k, TG.closes] = _NO_WINDOW
+        return
+    win = E[EPISODE_FLOATS.window]
+    latest = E[EPISODE_FLOATS.time_limit] - win
+    earliest = min(1.0, latest)
+    opens = np.sort(U[r, off:off + K])
+    for k in range(K):
+        t_geo[r, k, TG.opens] = earliest + (latest - earliest) * opens[k]
+        t_geo[r, k, TG.closes] = t_geo[r, k, TG.opens] + win
+
+
 @njit
 def build_episodes(U, ctrl_mask, walls, E, F, pos, vel, masses, radii, t_wall, t_geo, ok):  # pragma: no cover
     """Turn one block of uniforms per row of ``U`` into an episode's start state.
 
-    ``masses`` and ``radii`` are inputs (the caller maps ``U[:, :N]`` to masses and applies the
-    radius rule); everything else is written.
+    ``E`` and ``F`` are laid out as ``EPISODE_FLOATS`` and ``EPISODE_INTS``. ``masses`` and ``radii``
+    are inputs (the caller maps ``U[:, :N]`` to masses and applies the radius rule); everything else
+    is written.
     Layout of a block (N balls, K targets, T placement tries per ball): N masses, N speeds,
     N directions (angle, or the sign in 1D), K target walls, K target centres, K window openings,
     then 2 N T placement coordinates (ball i's try t uses entries 2 (i T + t) and +1; a 1D line
     uses the first N). ``ok[r]`` is False when some ball found no free place in its T tries; the
     caller then draws a fresh block for that row.
     """
-    R = U.shape[0]
-    dim = F[F_DIM]
-    N = F[F_N]
-    K = F[F_K]
-    rack = F[F_RACK] != 0
-    T = F[F_TRIES]
-    xmin = E[E_XMIN]
-    ymin = E[E_YMIN]
-    xmax = E[E_XMAX]
-    ymax = E[E_YMAX]
-    nw = walls.shape[0]
-    off_p = 3 * N + 3 * K
-    for r in range(R):
-        ok[r] = True
-        for i in range(N):
-            if ctrl_mask[i]:
-                speed = E[E_SLO] + (E[E_SHI] - E[E_SLO]) * U[r, N + i]
-            else:
-                speed = E[E_OLO] + (E[E_OHI] - E[E_OLO]) * U[r, N + i]
-            u = U[r, 2 * N + i]
-            if dim == 1:
-                vel[r, i, 0] = speed if u < 0.5 else -speed
-                vel[r, i, 1] = 0.0
-            else:
-                vel[r, i, 0] = speed * math.cos(2.0 * math.pi * u)
-                vel[r, i, 1] = speed * math.sin(2.0 * math.pi * u)
-        # placement
+    dim = F[EPISODE_INTS.dimension]
+    N = F[EPISODE_INTS.n_balls]
+    K = F[EPISODE_INTS.n_targets]
+    rack = F[EPISODE_INTS.rack] != 0
+    tries = F[EPISODE_INTS.tries]
+    off_targets = 3 * N
+    off_places = 3 * N + 3 * K
+    for r in range(U.shape[0]):
+        _draw_velocities(U, r, ctrl_mask, E, dim, vel)
         if dim == 1:
-            free = (xmax - xmin) - _GAP * (N + 1)
-            for i in range(N):
-                free -= 2.0 * radii[r, i]
-            us = np.sort(U[r, off_p:off_p + N] * free)
-            edge = xmin
-            for i in range(N):
-                edge += _GAP
-                pos[r, i, 0] = edge + us[i] + radii[r, i]
-                pos[r, i, 1] = 0.0
-                edge += 2.0 * radii[r, i]
+            _place_on_line(U, r, off_places, radii, E[EPISODE_FLOATS.xmin], E[EPISODE_FLOATS.xmax], pos)
+            ok[r] = True
         else:
-            for i in range(N):
-                rad = radii[r, i]
-                lo_x = xmin + rad + _GAP
-                hi_x = xmax - rad - _GAP
-                if rack:
-                    if ctrl_mask[i]:
-                        hi_x = min(hi_x, xmin + 0.4 * (xmax - xmin) - rad)
-                    else:
-                        lo_x = max(lo_x, xmin + 0.5 * (xmax - xmin) + rad)
-                lo_y = ymin + rad + _GAP
-                hi_y = ymax - rad - _GAP
-                placed = False
-                for t in range(T):
-                    px = lo_x + (hi_x - lo_x) * U[r, off_p + 2 * (i * T + t)]
-                    py = lo_y + (hi_y - lo_y) * U[r, off_p + 2 * (i * T + t) + 1]
-                    free_spot = True
-                    for j in range(i):
-                        dx = pos[r, j, 0] - px
-                        dy = pos[r, j, 1] - py
-                        if math.sqrt(dx * dx + dy * dy) <= radii[r, j] + rad + _GAP:
-                            free_spot = False
-                            break
-                    if free_spot:
-                        pos[r, i, 0] = px
-                        pos[r, i, 1] = py
-                        placed = True
-                        break
-                if not placed:
-                    ok[r] = False
-                    break
-        # targets
-        for k in range(K):
-            w = walls[min(int(U[r, 3 * N + k] * nw), nw - 1)]
-            t_wall[r, k] = w
-            if dim == 1:
-                t_geo[r, k, 0] = 0.5 * (ymin + ymax)
-                t_geo[r, k, 1] = 0.5 * (ymax - ymin)
-            else:
-                hw = E[E_HW]
-                lo_s = (ymin if w < 2 else xmin) + hw
-                hi_s = (ymax if w < 2 else xmax) - hw
-                t_geo[r, k, 0] = lo_s + (hi_s - lo_s) * U[r, 3 * N + K + k]
-                t_geo[r, k, 1] = hw
-        if E[E_WINDOW] < 0.0:
-            for k in range(K):
-                t_geo[r, k, 2] = -1e300
-                t_geo[r, k, 3] = 1e300
-        else:
-            win = E[E_WINDOW]
-            latest = E[E_TLIMIT] - win
-            earliest = min(1.0, latest)
-            opens = np.sort(U[r, 3 * N + 2 * K:3 * N + 3 * K])
-            for k in range(K):
-                t_geo[r, k, 2] = earliest + (latest - earliest) * opens[k]
-                t_geo[r, k, 3] = t_geo[r, k, 2] + win
+            ok[r] = _place_in_box(U, r, off_places, tries, ctrl_mask, rack, radii, E, pos)
+        _draw_targets(U, r, off_targets, walls, dim, E, t_wall, t_geo)
+        _draw_windows(U, r, off_targets + 2 * K, E, t_geo)

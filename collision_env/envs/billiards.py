@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from collision_env.envs.registry import Task, register_task
 from collision_env.envs.target_env import CollisionTargetEnv
-from collision_env.envs.vector import CollisionTargetVectorEnv
 
 
 class BilliardsEnv(CollisionTargetEnv):
@@ -58,10 +58,18 @@ class BilliardsEnv(CollisionTargetEnv):
     Any `TaskConfig` field as a keyword (e.g. `n_balls=6`, `elasticity=1.0`); `render_mode`; `trails`.
     """
 
-    preset = "billiards"
+    task = Task(
+        env_id="CollisionEnv/Billiards-v0",
+        preset="billiards",
+        config=dict(
+            dimension=2, elasticity=0.95, n_balls=4, mass_range=(1.0, 1.0), radius="constant",
+            layout="rack", speed_range=(0.0, 0.0), others_speed_range=(0.0, 0.0), controlled=(0,),
+            n_targets=2, sequential=False, target_width=0.6, scorers="others", hit_reward=1.0,
+            success_bonus=1.0, miss_penalty=0.0, action_cost=0.02, shaping=0.0, max_dv=0.2, max_speed=2.0,
+        ),
+        bench_scene="4 balls, e = 0.95 (rack)",
+        hyperparams_like="CollisionEnv/Line1D-v0",
+    )
 
 
-class BilliardsVectorEnv(CollisionTargetVectorEnv):
-    """Native vector version of :class:`BilliardsEnv` (see :class:`CollisionTargetVectorEnv`)."""
-
-    preset = "billiards"
+BilliardsVectorEnv = register_task(BilliardsEnv)

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from collision_env.envs.registry import Task, register_task
 from collision_env.envs.target_env import CollisionTargetEnv
-from collision_env.envs.vector import CollisionTargetVectorEnv
 
 
 class InelasticClusterEnv(CollisionTargetEnv):
@@ -63,10 +63,18 @@ class InelasticClusterEnv(CollisionTargetEnv):
     `render_mode`; `trails`.
     """
 
-    preset = "inelastic_cluster"
+    task = Task(
+        env_id="CollisionEnv/InelasticCluster-v0",
+        preset="inelastic_cluster",
+        config=dict(
+            dimension=2, elasticity=0.0, inelastic="stick", n_balls=2, mass_range=(0.5, 1.5),
+            radius="mass", speed_range=(0.0, 0.3), others_speed_range=(0.0, 0.0), controlled=(0,),
+            n_targets=1, sequential=True, target_width=0.8, scorers="cluster", hit_reward=1.0,
+            success_bonus=1.0, miss_penalty=0.0, action_cost=0.02, shaping=0.0, max_dv=0.15, max_speed=1.5,
+        ),
+        bench_scene="inelastic (stick)",
+        hyperparams_like="CollisionEnv/Line1D-v0",
+    )
 
 
-class InelasticClusterVectorEnv(CollisionTargetVectorEnv):
-    """Native vector version of :class:`InelasticClusterEnv` (see :class:`CollisionTargetVectorEnv`)."""
-
-    preset = "inelastic_cluster"
+InelasticClusterVectorEnv = register_task(InelasticClusterEnv)

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from collision_env.envs.registry import Task, register_task
 from collision_env.envs.target_env import CollisionTargetEnv
-from collision_env.envs.vector import CollisionTargetVectorEnv
 
 
 class Line1DEnv(CollisionTargetEnv):
@@ -64,10 +64,17 @@ class Line1DEnv(CollisionTargetEnv):
     Any `TaskConfig` field as a keyword (e.g. `n_balls=5`, `mode="naive"`); `render_mode`; `trails`.
     """
 
-    preset = "line_1d"
+    task = Task(
+        env_id="CollisionEnv/Line1D-v0",
+        preset="line_1d",
+        config=dict(
+            dimension=1, elasticity=1.0, n_balls=3, mass_range=(0.5, 2.0), radius="mass",
+            speed_range=(0.0, 0.5), others_speed_range=(0.0, 0.5), controlled=(0,), n_targets=2,
+            sequential=False, window=2.0, scorers="any", hit_reward=1.0, success_bonus=1.0,
+            miss_penalty=0.0, action_cost=0.02, shaping=0.0, max_dv=0.1, max_speed=1.5,
+        ),
+        bench_scene="explore_1d (3 balls)",
+    )
 
 
-class Line1DVectorEnv(CollisionTargetVectorEnv):
-    """Native vector version of :class:`Line1DEnv` (see :class:`CollisionTargetVectorEnv`)."""
-
-    preset = "line_1d"
+Line1DVectorEnv = register_task(Line1DEnv)

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from collision_env.envs.registry import Task, register_task
 from collision_env.envs.target_env import CollisionTargetEnv
-from collision_env.envs.vector import CollisionTargetVectorEnv
 
 
 class MultiBallEnv(CollisionTargetEnv):
@@ -63,10 +63,18 @@ class MultiBallEnv(CollisionTargetEnv):
     `render_mode`; `trails`.
     """
 
-    preset = "multi_ball"
+    task = Task(
+        env_id="CollisionEnv/MultiBall-v0",
+        preset="multi_ball",
+        config=dict(
+            dimension=2, elasticity=0.8, ball_collisions=False, n_balls=3, mass_range=(0.5, 1.5), radius=0.12,
+            speed_range=(0.2, 0.6), controlled=(0, 1, 2), n_targets=3, sequential=False, target_width=0.6,
+            scorers="any", hit_reward=1.0, success_bonus=1.0, miss_penalty=0.02, action_cost=0.01, shaping=0.5,
+            max_dv=0.15, max_speed=2.0,
+        ),
+        bench_scene="3 balls, no ball-ball collisions, e = 0.8",
+        hyperparams_like="CollisionEnv/Line1D-v0",
+    )
 
 
-class MultiBallVectorEnv(CollisionTargetVectorEnv):
-    """Native vector version of :class:`MultiBallEnv` (see :class:`CollisionTargetVectorEnv`)."""
-
-    preset = "multi_ball"
+MultiBallVectorEnv = register_task(MultiBallEnv)

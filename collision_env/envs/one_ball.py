@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from collision_env.envs.registry import Task, register_task
 from collision_env.envs.target_env import CollisionTargetEnv
-from collision_env.envs.vector import CollisionTargetVectorEnv
 
 
 class OneBallTargetEnv(CollisionTargetEnv):
@@ -63,10 +63,17 @@ class OneBallTargetEnv(CollisionTargetEnv):
     "rgb_array" or "human"; `trails=True`.
     """
 
-    preset = "one_ball"
+    task = Task(
+        env_id="CollisionEnv/OneBallTarget-v0",
+        preset="one_ball",
+        config=dict(
+            dimension=2, elasticity=1.0, n_balls=1, mass_range=(1.0, 1.0), radius="mass",
+            speed_range=(0.3, 0.8), controlled=(0,), n_targets=3, sequential=True, target_width=0.6,
+            scorers="any", hit_reward=1.0, success_bonus=1.0, miss_penalty=0.05, action_cost=0.02,
+            shaping=1.0, max_dv=0.15, max_speed=2.0,
+        ),
+        bench_scene="explore_2d n=1 / dilute_gas n=1",
+    )
 
 
-class OneBallTargetVectorEnv(CollisionTargetVectorEnv):
-    """Native vector version of :class:`OneBallTargetEnv` (see :class:`CollisionTargetVectorEnv`)."""
-
-    preset = "one_ball"
+OneBallTargetVectorEnv = register_task(OneBallTargetEnv)

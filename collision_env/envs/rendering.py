@@ -15,6 +15,9 @@ import os
 
 import numpy as np
 
+from collision_env.engine.scene import WALL_BOTTOM, WALL_LEFT, WALL_RIGHT
+from collision_env.envs._layout import TARGET_FAILED, TARGET_GEOMETRY, TARGET_HIT, TARGET_PENDING
+
 BG = (18, 22, 34)
 AREA = (30, 37, 56)
 WALL = (200, 204, 214)
@@ -86,21 +89,22 @@ class Renderer:
 
     def _segment_px(self, wall, c, hw, out=5):
         xmin, ymin, xmax, ymax = self.cfg.bounds
-        if wall == 0:
+        if wall == WALL_LEFT:
             a, b_, d = self._px(xmin, c - hw), self._px(xmin, c + hw), (-out, 0)
-        elif wall == 1:
+        elif wall == WALL_RIGHT:
             a, b_, d = self._px(xmax, c - hw), self._px(xmax, c + hw), (out, 0)
-        elif wall == 2:
+        elif wall == WALL_BOTTOM:
             a, b_, d = self._px(c - hw, ymin), self._px(c + hw, ymin), (0, out)
         else:
             a, b_, d = self._px(c - hw, ymax), self._px(c + hw, ymax), (0, -out)
         return (a[0] + d[0], a[1] + d[1]), (b_[0] + d[0], b_[1] + d[1])
 
     def _on_hit_target(self, core, b, wall, x, y):
-        s = y if wall < 2 else x
+        s = y if wall in (WALL_LEFT, WALL_RIGHT) else x
+        geo = TARGET_GEOMETRY
         for k in range(core.t_wall.shape[1]):
-            on_segment = abs(s - core.t_geo[b, k, 0]) <= core.t_geo[b, k, 1]
-            if core.t_status[b, k] == 1 and core.t_wall[b, k] == wall and on_segment:
+            on_segment = abs(s - core.t_geo[b, k, geo.centre]) <= core.t_geo[b, k, geo.half_width]
+            if core.t_status[b, k] == TARGET_HIT and core.t_wall[b, k] == wall and on_segment:
                 return True
         return False
 
@@ -122,12 +126,12 @@ class Renderer:
         cur = int(core.cur[b])
         for k in range(n_t):
             st = int(core.t_status[b, k])
-            if cfg.sequential and st == 0 and k != cur:
+            if cfg.sequential and st == TARGET_PENDING and k != cur:
                 continue  # later targets of a sequence are not shown yet
             c, hw, t_open, t_close = core.t_geo[b, k]
-            if st == 1:
+            if st == TARGET_HIT:
                 col = HIT
-            elif st == 2:
+            elif st == TARGET_FAILED:
                 col = FAILED
             else:
                 col = PENDING if t_open <= now <= t_close else WAITING
@@ -208,17 +212,17 @@ class Renderer:
         bx, by, bw, bh = self.margin, 8, self.width - 2 * self.margin - 16 * n_t - 8, 10
         pg.draw.rect(surf, AREA, pg.Rect(bx, by, bw, bh))
         for k in range(n_t):
-            t_open, t_close = core.t_geo[b, k, 2:4]
+            t_open, t_close = core.t_geo[b, k, TARGET_GEOMETRY.opens], core.t_geo[b, k, TARGET_GEOMETRY.closes]
             if t_open > -1e299:
                 u0 = bx + bw * max(0.0, t_open / cfg.time_limit)
                 u1 = bx + bw * min(1.0, t_close / cfg.time_limit)
                 st = int(core.t_status[b, k])
-                col = HIT if st == 1 else FAILED if st == 2 else WAITING
+                col = HIT if st == TARGET_HIT else FAILED if st == TARGET_FAILED else WAITING
                 pg.draw.rect(surf, col, pg.Rect(int(u0), by, max(1, int(u1 - u0)), bh))
         pg.draw.rect(surf, (120, 170, 255), pg.Rect(bx, by + bh // 2 - 1, int(bw * frac), 3))
         for k in range(n_t):
             st = int(core.t_status[b, k])
-            col = HIT if st == 1 else FAILED if st == 2 else PENDING
+            col = HIT if st == TARGET_HIT else FAILED if st == TARGET_FAILED else PENDING
             pg.draw.rect(surf, col, pg.Rect(bx + bw + 8 + 16 * k, by - 1, 12, 12))
 
         frame = pg.surfarray.array3d(surf)

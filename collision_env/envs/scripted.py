@@ -18,13 +18,16 @@ from collections.abc import Callable
 
 import numpy as np
 
+from collision_env.engine.scene import WALL_BOTTOM, WALL_LEFT, WALL_RIGHT, WALL_TOP
+from collision_env.envs._layout import TARGET_GEOMETRY, TARGET_HIT, TARGET_PENDING
+
 Plan = Callable[[int, object], np.ndarray]
 
 
 def on_target(core, b: int, k: int, wall: int, x: float, y: float, t: float) -> bool:
     """Whether an impact at wall code ``wall``, point (x, y), time t lands on target k of scene b."""
     c, hw, t_open, t_close = core.t_geo[b, k]
-    s = y if wall < 2 else x
+    s = y if wall in (WALL_LEFT, WALL_RIGHT) else x
     return core.t_wall[b, k] == wall and abs(s - c) <= hw and t_open <= t <= t_close
 
 
@@ -56,7 +59,7 @@ class AimingPolicy:
         if cfg.sequential:
             k = int(core.cur[0])
             return [k] if k < core.t_wall.shape[1] else []
-        return np.flatnonzero(core.t_status[0] == 0).tolist()
+        return np.flatnonzero(core.t_status[0] == TARGET_PENDING).tolist()
 
     def predicts_hit(self, ball: int, dv: np.ndarray, targets) -> bool:
         """Does ``ball`` hit one of ``targets`` next if its velocity changes by ``dv`` now?"""
@@ -115,7 +118,7 @@ def shoot(env, plans, horizon: int):
     try:
         for plan in plans:
             env.set_state(start)
-            hits = int((env.core.t_status[0] == 1).sum())
+            hits = int((env.core.t_status[0] == TARGET_HIT).sum())
             for t in range(horizon):
                 _, _, term, trunc, info = env.step(plan(t, env))
                 if info["targets_hit"] > hits:
@@ -129,7 +132,7 @@ def shoot(env, plans, horizon: int):
 
 def _target_point(cfg, wall: int, c: float):
     xmin, ymin, xmax, ymax = cfg.bounds
-    return {0: (xmin, c), 1: (xmax, c), 2: (c, ymin), 3: (c, ymax)}[wall]
+    return {WALL_LEFT: (xmin, c), WALL_RIGHT: (xmax, c), WALL_BOTTOM: (c, ymin), WALL_TOP: (c, ymax)}[wall]
 
 
 def billiards_plans(env) -> list:
@@ -137,8 +140,8 @@ def billiards_plans(env) -> list:
     core, cfg = env.core, env.config
     pos, r = core.pos[0], core.radii[0]
     plans = []
-    for k in np.flatnonzero(core.t_status[0] == 0):
-        target = _target_point(cfg, int(core.t_wall[0, k]), core.t_geo[0, k, 0])
+    for k in np.flatnonzero(core.t_status[0] == TARGET_PENDING):
+        target = _target_point(cfg, int(core.t_wall[0, k]), core.t_geo[0, k, TARGET_GEOMETRY.centre])
         for j in range(cfg.n_balls):
             if j in cfg.controlled:
                 continue

@@ -11,9 +11,9 @@ from gymnasium import spaces
 from numpy.typing import ArrayLike
 
 from collision_env.engine import BatchSimulator
-from collision_env.envs import _kernels as K
 from collision_env.envs._config import PRESETS, TaskConfig, make_config
 from collision_env.envs._core import Impacts, TaskCore
+from collision_env.envs._layout import ROW_RESET, ROW_STEPPED, SCENE_FLOATS, SCENE_INTS
 
 _CLASS_PRESET = "__class_preset__"
 
@@ -28,8 +28,8 @@ class CollisionTargetEnv(gym.Env):
     reports it (exact time and contact point), lands on a **target**: a wall segment (wall,
     centre, width), in some tasks only inside a time window. This class is the generic,
     configurable task: `gym.make("CollisionEnv/Target-v0", preset=..., **fields)`; each registered
-    preset (`OneBallTarget`, `Line1D`, `Billiards`, `InelasticCluster`) is one configuration of it
-    (`collision_env.envs.PRESETS`), and any field of `TaskConfig` can be overridden by keyword.
+    preset (`collision_env.envs.PRESET_IDS`) is one configuration of it (`collision_env.envs.PRESETS`),
+    and any field of `TaskConfig` can be overridden by keyword.
 
     ## Action Space
 
@@ -45,19 +45,19 @@ class CollisionTargetEnv(gym.Env):
     1 when targets are sequential, else `n_targets`). Centre and half-size of the play area are
     (xc, yc), (xh, yh); `vs = 2 * max_speed`. Every entry is clipped to [-1, 1].
 
-    | Index            | Observation                                                     |
-    |------------------|-----------------------------------------------------------------|
-    | 6i + 0, 6i + 1   | ball i position: (x - xc) / xh, (y - yc) / yh                   |
-    | 6i + 2, 6i + 3   | ball i velocity: vx / vs, vy / vs (0 for y in 1D)               |
-    | 6i + 4           | ball i mass / 3 kg                                              |
-    | 6i + 5           | 1 if ball i's wall impacts currently score, else 0              |
-    | 6N + 10s + 0, 1  | target s centre point, normalised like positions                |
-    | 6N + 10s + 2     | target s half width / half length of its wall                   |
-    | 6N + 10s + 3..6  | target s wall one-hot (left, right, bottom, top)                |
-    | 6N + 10s + 7     | target s status: 1 pending, 0 hit, -1 failed (window closed)    |
-    | 6N + 10s + 8, 9  | (window open - t) / time_limit, (window close - t) / time_limit |
-    | D - 2            | fraction of the episode's control steps left                    |
-    | D - 1            | fraction of targets not yet hit                                 |
+    | Index           | Observation                                                     |
+    |-----------------|-----------------------------------------------------------------|
+    | 6i + 0, 1       | ball i position: (x - xc) / xh, (y - yc) / yh                   |
+    | 6i + 2, 3       | ball i velocity: vx / vs, vy / vs (0 for y in 1D)               |
+    | 6i + 4          | ball i mass / 3 kg                                              |
+    | 6i + 5          | 1 if ball i's wall impacts currently score, else 0              |
+    | 6N + 10s + 0, 1 | target s centre point, normalised like positions                |
+    | 6N + 10s + 2    | target s half width / half length of its wall                   |
+    | 6N + 10s + 3..6 | target s wall one-hot (left, right, bottom, top)                |
+    | 6N + 10s + 7    | target s status: 1 pending, 0 hit, -1 failed (window closed)    |
+    | 6N + 10s + 8, 9 | (window open - t) / time_limit, (window close - t) / time_limit |
+    | D - 2           | fraction of the episode's control steps left                    |
+    | D - 1           | fraction of targets not yet hit                                 |
 
     With sequential targets the single slot shows the current target. Targets without a window
     read -1 and 1 in the window entries.
@@ -121,8 +121,8 @@ class CollisionTargetEnv(gym.Env):
         self.action_space = spaces.Box(-1.0, 1.0, (cfg.action_dim,), np.float32)
         self.observation_space = spaces.Box(-1.0, 1.0, (cfg.obs_dim,), np.float32)
         self._ones = np.ones(1, dtype=bool)
-        self._reset_flag = np.zeros(1, dtype=np.int8)
-        self._step_flag = np.ones(1, dtype=np.int8)
+        self._reset_flag = np.full(1, ROW_RESET, dtype=np.int8)
+        self._step_flag = np.full(1, ROW_STEPPED, dtype=np.int8)
         self._adim = cfg.action_dim
         self._action = np.zeros((1, cfg.action_dim))
         self._dt = cfg.dt
@@ -135,8 +135,9 @@ class CollisionTargetEnv(gym.Env):
     def _scalars(self) -> tuple:
         """This step's (reward, terminated, truncated, success, targets hit, energy, nudge) as Python values."""
         S, C = self._core.S[0].tolist(), self._core.C[0].tolist()
-        return (S[K.S_REWARD], bool(C[K.C_TERM]), bool(C[K.C_TRUNC]), bool(C[K.C_SUCCESS]), C[K.C_NHIT],
-                S[K.S_ENERGY], S[K.S_NUDGE])
+        sf, si = SCENE_FLOATS, SCENE_INTS
+        return (S[sf.reward], bool(C[si.terminated]), bool(C[si.truncated]), bool(C[si.success]), C[si.targets_hit],
+                S[sf.energy], S[sf.nudge])
 
     # ------------------------------------------------------------------------------------- #
     def reset(self, *, seed: int | None = None,

@@ -24,6 +24,7 @@ from numpy.typing import ArrayLike
 
 from collision_env.envs._config import TaskConfig, make_config
 from collision_env.envs._core import Impacts, TaskCore
+from collision_env.envs._layout import ROW_OBSERVE, ROW_RESET, ROW_SKIP, ROW_STEPPED
 
 _CLASS_PRESET = "__class_preset__"
 _SCALAR_KEYS = ("event_cap", "nudge", "energy", "time", "targets_hit", "is_success")
@@ -127,7 +128,7 @@ class CollisionTargetVectorEnv(VectorEnv):
         idx = np.flatnonzero(mask)
         core = self._core
         core.reset_scenes(idx, [self._rngs[i] for i in idx])
-        flags = np.where(mask, 0, 3).astype(np.int8)  # the others are observed unchanged
+        flags = np.where(mask, ROW_RESET, ROW_OBSERVE).astype(np.int8)  # the others are observed unchanged
         imp = core.empty_impacts()
         obs = core.finish(flags, imp, self._fresh_obs())
         _, _, _, success, n_hit, energy, _ = core.outputs()
@@ -165,11 +166,11 @@ class CollisionTargetVectorEnv(VectorEnv):
             if any_reset:
                 idx = np.flatnonzero(resetting)
                 core.reset_scenes(idx, [self._rngs[i] for i in idx])
-                flags = active.astype(np.int8)
+                flags = np.where(active, ROW_STEPPED, ROW_RESET).astype(np.int8)
                 imp = imp[active[imp["scene"]]]
                 event_cap &= active
             else:
-                flags = np.ones(B, dtype=np.int8)
+                flags = np.full(B, ROW_STEPPED, dtype=np.int8)
             obs = core.finish(flags, imp, self._fresh_obs())
             reward, term, trunc, success, n_hit, energy, nudge = core.outputs()
             if cap_limit is not None:
@@ -183,7 +184,7 @@ class CollisionTargetVectorEnv(VectorEnv):
         # SAME_STEP: step everything, then reset the sub-envs that ended and report their last step
         imp = core.advance(a, self._all, self.config.dt)
         event_cap = core.batch.cap_reached
-        obs = core.finish(np.ones(B, dtype=np.int8), imp, self._fresh_obs())
+        obs = core.finish(np.full(B, ROW_STEPPED, dtype=np.int8), imp, self._fresh_obs())
         reward, term, trunc, success, n_hit, energy, nudge = core.outputs()
         if cap_limit is not None:
             trunc |= core.steps >= cap_limit
@@ -206,7 +207,7 @@ class CollisionTargetVectorEnv(VectorEnv):
             final_info[key] = v
             final_info["_" + key] = done.copy()
         core.reset_scenes(idx, [self._rngs[i] for i in idx])
-        flags = np.where(done, 0, 2).astype(np.int8)
+        flags = np.where(done, ROW_RESET, ROW_SKIP).astype(np.int8)
         core.finish(flags, imp[:0], obs)  # the reset sub-envs' first observations, in place
         _, _, _, _, r_hit, r_energy, _ = core.outputs()
         event_cap = event_cap & ~done
