@@ -167,17 +167,27 @@ def _versions() -> dict:
 
 
 #: Ray resolves 127.0.0.1 to the machine's network address unless this is "0" (then it stays on
-#: loopback, as a single-machine instance should); it must be set before ray is imported.
+#: loopback, as a single-machine instance should). Ray reads it when it is imported.
 LOOPBACK_ENV = "RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER"
 
 
-def _start_ray(address: str | None, env_runners: int) -> None:
+def keep_ray_on_loopback() -> None:
+    """Make a local Ray instance of this process (and its children) bind to 127.0.0.1 only."""
+    os.environ[LOOPBACK_ENV] = "0"  # for the processes Ray starts
+    from ray._private import ray_constants
+
+    ray_constants.ENABLE_RAY_CLUSTER = False  # for this process, if ray was imported before
+
+
+def start_ray(address: str | None, num_cpus: int) -> None:
+    """Join the cluster at ``address``, or start a private local instance on 127.0.0.1."""
     import ray
 
     if address:
         ray.init(address=address, log_to_driver=False)
-    else:  # a private local instance on the loopback address, one CPU per runner
-        ray.init(num_cpus=env_runners, include_dashboard=False, _node_ip_address="127.0.0.1", log_to_driver=False)
+    else:
+        keep_ray_on_loopback()
+        ray.init(num_cpus=num_cpus, include_dashboard=False, _node_ip_address="127.0.0.1", log_to_driver=False)
 
 
 def train(env_id: str = DEFAULT_ENV, *, iterations: int | None = None, env_runners: int | None = None,
@@ -213,8 +223,6 @@ def train(env_id: str = DEFAULT_ENV, *, iterations: int | None = None, env_runne
     steps = episode_steps(env_id, kwargs)  # validates every env kwarg
     mode = kwargs.get("mode", "exact")
     kwargs_env = {**kwargs, "max_episode_steps": steps}
-    if not address:  # a private local instance: keep Ray on the loopback address (see _start_ray)
-        os.environ.setdefault(LOOPBACK_ENV, "0")
     try:
         import ray  # noqa: F401
         from ray.rllib.algorithms.ppo import PPOConfig  # noqa: F401
@@ -250,7 +258,7 @@ def train(env_id: str = DEFAULT_ENV, *, iterations: int | None = None, env_runne
     }
     write_yaml(run_dir / CONFIG_FILE, record)
     warm_up(env_id, kwargs)  # compile (or load) the kernels once here, not in every runner at once
-    _start_ray(address, env_runners)
+    start_ray(address, max(env_runners, 1))
     try:
         say(f"training RLlib PPO on {env_id} (mode={mode}) for up to {iterations} iterations, {env_runners} env "
             f"runners x {envs_per_runner} envs ({vectorize}), seed {seed} -> {run_dir}")
