@@ -60,14 +60,20 @@ test-compat: $(OLD_STAMP) $(RAY_STAMP)
 test-rllib: $(RAY_STAMP)
 	$(RAY_PY) -m pytest -q -p no:cacheprovider tests/agents/test_rllib.py
 
-# Two Ray nodes on this machine (a head and a worker node, both on 127.0.0.1, one CPU each), then
-# train_rllib joins the cluster with --address; its two env runners land one on each node.
+# Two Ray nodes on this machine, each with one CPU, on loopback addresses of their own (Ray maps
+# 127.0.0.1 itself to the machine's network address; 127.0.0.2 and .3 stay on loopback): a head
+# and a worker node; train_rllib joins with --address and its two env runners land one per node.
+# Token authentication (the token in ~/.ray) guards the cluster's ports, as on real machines.
+HEAD_IP ?= 127.0.0.2
+WORKER_IP ?= 127.0.0.3
+rllib-two-nodes: export RAY_AUTH_MODE = token
 rllib-two-nodes: $(RAY_STAMP)
-	RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER=0 $(RAY_VENV)/bin/ray start --head --node-ip-address=127.0.0.1 \
-		--port=$(RAY_PORT) --num-cpus=1 --include-dashboard=false --disable-usage-stats
-	$(RAY_VENV)/bin/ray start --address=127.0.0.1:$(RAY_PORT) --num-cpus=1 --disable-usage-stats
-	$(RAY_PY) -m agents.train_rllib --address 127.0.0.1:$(RAY_PORT) --env-runners 2 --run-name rllib-two-nodes \
-		--overwrite; status=$$?; $(RAY_VENV)/bin/ray stop; exit $$status
+	$(RAY_VENV)/bin/ray start --head --node-ip-address=$(HEAD_IP) --port=$(RAY_PORT) --num-cpus=1 \
+		--include-dashboard=false --disable-usage-stats
+	$(RAY_VENV)/bin/ray start --address=$(HEAD_IP):$(RAY_PORT) --node-ip-address=$(WORKER_IP) --num-cpus=1 \
+		--disable-usage-stats; \
+	$(RAY_PY) -m agents.train_rllib --address $(HEAD_IP):$(RAY_PORT) --node-ip-address $(HEAD_IP) \
+		--env-runners 2 --run-name rllib-two-nodes --overwrite; status=$$?; $(RAY_VENV)/bin/ray stop; exit $$status
 
 # Re-measure the README's RLlib block (throughput, a training run, the two-node run's placement).
 rllib-report: $(RAY_STAMP)

@@ -110,10 +110,12 @@ def block(env_id: str, rates: dict, run: dict, results: dict, cluster: dict | No
     ]
     if cluster is not None:
         nodes = len({s["node_id"] for s in cluster["runner_placement"]})
+        addresses = " and ".join(sorted({s["node_address"] for s in cluster["runner_placement"]}))
         lines += [
             "",
             f"**Two nodes on one machine** (`make rllib-two-nodes`: `ray start --head` and a second `ray start "
-            f"--address` worker node, both on 127.0.0.1; `train_rllib --address`): {len(cluster['runner_placement'])} "
+            f"--address` worker node on the loopback addresses {addresses}; `train_rllib --address "
+            f"{cluster['address']}`): {len(cluster['runner_placement'])} "
             f"env runners on {nodes} nodes; {100 * cluster['final_success']:.0f} % evaluation success after "
             f"{cluster['iterations_done']} iterations, {cluster['train_seconds']:.0f} s.",
             "",

@@ -179,12 +179,13 @@ def keep_ray_on_loopback() -> None:
     ray_constants.ENABLE_RAY_CLUSTER = False  # for this process, if ray was imported before
 
 
-def start_ray(address: str | None, num_cpus: int) -> None:
-    """Join the cluster at ``address``, or start a private local instance on 127.0.0.1."""
+def start_ray(address: str | None, num_cpus: int, node_ip_address: str | None = None) -> None:
+    """Join the cluster at ``address`` (this machine's address in it: ``node_ip_address``, else
+    Ray's guess), or start a private local instance on 127.0.0.1."""
     import ray
 
     if address:
-        ray.init(address=address, log_to_driver=False)
+        ray.init(address=address, _node_ip_address=node_ip_address, log_to_driver=False)
     else:
         keep_ray_on_loopback()
         ray.init(num_cpus=num_cpus, include_dashboard=False, _node_ip_address="127.0.0.1", log_to_driver=False)
@@ -192,6 +193,7 @@ def start_ray(address: str | None, num_cpus: int) -> None:
 
 def train(env_id: str = DEFAULT_ENV, *, iterations: int | None = None, env_runners: int | None = None,
           envs_per_runner: int | None = None, vectorize: str | None = None, address: str | None = None,
+          node_ip_address: str | None = None,
           seed: int = 0, mode: str | None = None, substeps: int | None = None, env_kwargs: dict | None = None,
           output: str | Path = "runs", run_name: str | None = None, hyperparams: str | Path = HYPERPARAMS,
           target_success: float | None = None, overwrite: bool = False, threads: int = 1, log=print) -> Path:
@@ -253,12 +255,12 @@ def train(env_id: str = DEFAULT_ENV, *, iterations: int | None = None, env_runne
         "algorithm": ALGORITHM, "env_id": env_id, "env_kwargs": kwargs, "episode_steps": steps, "seed": seed,
         "iterations": iterations, "env_runners": env_runners, "envs_per_runner": envs_per_runner,
         "vectorize": vectorize, "target_success": target, "eval_episodes": eval_episodes, "eval_seed": EVAL_SEED,
-        "address": address, "hyperparams": {**hp, "env_kwargs": dict(kwargs)}, "hyperparams_file": str(hyperparams),
+        "address": address, "node_ip_address": node_ip_address, "hyperparams": {**hp, "env_kwargs": dict(kwargs)}, "hyperparams_file": str(hyperparams),
         "versions": _versions(),
     }
     write_yaml(run_dir / CONFIG_FILE, record)
     warm_up(env_id, kwargs)  # compile (or load) the kernels once here, not in every runner at once
-    start_ray(address, max(env_runners, 1))
+    start_ray(address, max(env_runners, 1), node_ip_address)
     try:
         say(f"training RLlib PPO on {env_id} (mode={mode}) for up to {iterations} iterations, {env_runners} env "
             f"runners x {envs_per_runner} envs ({vectorize}), seed {seed} -> {run_dir}")
@@ -310,6 +312,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--vectorize", choices=("native", "sync"),
                    help="native batched vector env per runner (default), or RLlib's sync vectorisation")
     p.add_argument("--address", help="join this Ray cluster (host:port of `ray start --head`); default: local Ray")
+    p.add_argument("--node-ip-address", help="with --address: this machine's address in the cluster "
+                                             "(default: Ray's guess)")
     p.add_argument("--target-success", type=float, help="stop at this evaluation success share (default: 0.9)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--mode", choices=("exact", "posteriori", "naive"), help="engine fidelity mode (default: exact)")
@@ -327,6 +331,7 @@ def main(argv: list[str] | None = None) -> Path:
     args = build_parser().parse_args(argv)
     run_dir = train(args.env, iterations=args.iterations, env_runners=args.env_runners,
                     envs_per_runner=args.envs_per_runner, vectorize=args.vectorize, address=args.address,
+                    node_ip_address=args.node_ip_address,
                     seed=args.seed, mode=args.mode, substeps=args.substeps,
                     env_kwargs=parse_env_kwargs(args.env_kwargs), output=args.output, run_name=args.run_name,
                     hyperparams=args.hyperparams, target_success=args.target_success, overwrite=args.overwrite,
