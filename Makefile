@@ -33,14 +33,14 @@ $(RAY_STAMP): pyproject.toml
 	$(PYTHON) -m venv $(RAY_VENV)
 	$(RAY_PY) -m pip install --quiet --upgrade pip
 	$(RAY_PY) -m pip install --quiet $(TORCH)
-	$(RAY_PY) -m pip install --quiet -e ".[fast,test,distributed]"
+	$(RAY_PY) -m pip install --quiet -e ".[fast,render,test,distributed]"
 	$(RAY_PY) -m collision_env.precompile
 	touch $(RAY_STAMP)
 
 $(OLD_STAMP): pyproject.toml
 	$(PYTHON) -m venv $(OLD_VENV)
 	$(OLD_PY) -m pip install --quiet --upgrade pip
-	$(OLD_PY) -m pip install --quiet -e ".[fast,test]" "$(OLDEST_GYMNASIUM)"
+	$(OLD_PY) -m pip install --quiet -e ".[fast,render,test]" "$(OLDEST_GYMNASIUM)"
 	$(OLD_PY) -m collision_env.precompile
 	touch $(OLD_STAMP)
 

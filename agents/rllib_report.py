@@ -103,7 +103,8 @@ def block(env_id: str, rates: dict, run: dict, results: dict, cluster: dict | No
         f"**Training**: `python -m agents.train_rllib --env {env_id}` ({run['env_runners']} env runners x "
         f"{run['envs_per_runner']} envs, native): the deterministic policy reached "
         f"{100 * run['final_success']:.0f} % success on the evaluation episodes after {run['iterations_done']} "
-        f"iterations, {run['env_steps_done']:,} env steps, **{run['train_seconds']:.0f} s** of training.",
+        f"iterations, {run['env_steps_done']:,} env steps, **{run['train_seconds']:.0f} s** of training "
+        f"(its evaluations included; starting Ray and the runners took another {run['setup_seconds']:.0f} s).",
         "`python -m agents.evaluate <run>` on the same 100 episodes:",
         "",
         markdown(results),

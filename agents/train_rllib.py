@@ -196,7 +196,7 @@ def train(env_id: str = DEFAULT_ENV, *, iterations: int | None = None, env_runne
           node_ip_address: str | None = None,
           seed: int = 0, mode: str | None = None, substeps: int | None = None, env_kwargs: dict | None = None,
           output: str | Path = "runs", run_name: str | None = None, hyperparams: str | Path = HYPERPARAMS,
-          target_success: float | None = None, overwrite: bool = False, threads: int = 1, log=print) -> Path:
+          target_success: float | None = None, overwrite: bool = False, threads: int = 1, log=None) -> Path:
     """Train RLlib PPO on ``env_id`` and write the run folder; returns its path.
 
     Arguments left as None come from the hyperparameter entry. Everything is validated before Ray
@@ -204,6 +204,7 @@ def train(env_id: str = DEFAULT_ENV, *, iterations: int | None = None, env_runne
     """
     from agents.evaluate import EVAL_SEED
 
+    log = log or (lambda line: print(line, flush=True))
     check_env_id(env_id)
     hp = hyperparams_for(env_id, hyperparams)
     pick = lambda value, key, default: hp.get(key, default) if value is None else value  # noqa: E731
@@ -255,10 +256,11 @@ def train(env_id: str = DEFAULT_ENV, *, iterations: int | None = None, env_runne
         "algorithm": ALGORITHM, "env_id": env_id, "env_kwargs": kwargs, "episode_steps": steps, "seed": seed,
         "iterations": iterations, "env_runners": env_runners, "envs_per_runner": envs_per_runner,
         "vectorize": vectorize, "target_success": target, "eval_episodes": eval_episodes, "eval_seed": EVAL_SEED,
-        "address": address, "node_ip_address": node_ip_address, "hyperparams": {**hp, "env_kwargs": dict(kwargs)}, "hyperparams_file": str(hyperparams),
-        "versions": _versions(),
+        "address": address, "node_ip_address": node_ip_address, "hyperparams": {**hp, "env_kwargs": dict(kwargs)},
+        "hyperparams_file": str(hyperparams), "versions": _versions(),
     }
     write_yaml(run_dir / CONFIG_FILE, record)
+    setup_start = time.perf_counter()
     warm_up(env_id, kwargs)  # compile (or load) the kernels once here, not in every runner at once
     start_ray(address, max(env_runners, 1), node_ip_address)
     try:
@@ -271,6 +273,7 @@ def train(env_id: str = DEFAULT_ENV, *, iterations: int | None = None, env_runne
                 f"{', the driver node' if spot['driver_node'] else ''}), pid {spot['pid']}")
         history = []
         start = time.perf_counter()
+        setup_seconds = start - setup_start
         env_steps = 0
         for it in range(1, iterations + 1):
             result = algo.train()
@@ -292,9 +295,9 @@ def train(env_id: str = DEFAULT_ENV, *, iterations: int | None = None, env_runne
         algo.stop()
     finally:
         ray.shutdown()  # stops the local instance; with --address it only disconnects from the cluster
-    record.update({"train_seconds": round(seconds, 2), "iterations_done": it, "env_steps_done": env_steps,
-                   "evaluations": history, "final_success": history[-1]["success"] if history else None,
-                   "runner_placement": placement})
+    record.update({"setup_seconds": round(setup_seconds, 2), "train_seconds": round(seconds, 2),
+                   "iterations_done": it, "env_steps_done": env_steps, "evaluations": history,
+                   "final_success": history[-1]["success"] if history else None, "runner_placement": placement})
     write_yaml(run_dir / CONFIG_FILE, record)
     say(f"trained {env_steps:,} env steps in {seconds:.0f} s ({env_steps / seconds:,.0f} steps/s); "
         f"checkpoint {run_dir / CHECKPOINT_DIR}")

@@ -36,6 +36,7 @@ def _count(monkeypatch, cls, name, counts):
 
 @pytest.mark.parametrize("env_id", ["CollisionEnv/Billiards-v0", "CollisionEnv/Line1D-v0"])
 def test_planning_neither_steps_renders_nor_restarts_the_trails_of_the_played_env(env_id, monkeypatch):
+    pytest.importorskip("pygame")
     env = gym.make(env_id, render_mode="rgb_array", trails=True)
     obs, _ = env.reset(seed=1)
     env.render()  # the renderer exists from here on

@@ -27,7 +27,8 @@ def fresh_python(code: str, **env) -> subprocess.CompletedProcess:
     f"import gymnasium as gym; env = gym.make_vec({MODULE_ID!r}, num_envs=2)",
 ])
 def test_each_documented_id_form_makes_and_steps_in_a_fresh_interpreter(code):
-    run = fresh_python(code + "\nenv.reset(seed=0); env.step(env.action_space.sample()); print(type(env.unwrapped).__name__)")
+    run = fresh_python(code + "\nenv.reset(seed=0); env.step(env.action_space.sample())"
+                              "\nprint(type(env.unwrapped).__name__)")
     assert run.returncode == 0, run.stderr
     assert "OneBallTarget" in run.stdout
 
