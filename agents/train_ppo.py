@@ -88,14 +88,28 @@ def make_vec_env(env_id: str, n_envs: int, seed: int, env_kwargs: dict, vec_env:
     from stable_baselines3.common.env_util import make_vec_env as sb3_make_vec_env
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
 
+    start_method = subproc_start_method()
+    if vec_env == "subproc" and start_method == "fork":
+        _load_kernels(env_id, kwargs)  # forked workers inherit them instead of each loading the cache
+
     # "module:id" makes gym.make import collision_env first, in a subprocess too
     return sb3_make_vec_env(
         f"collision_env:{env_id}", n_envs=n_envs, seed=seed, env_kwargs=kwargs,
         vec_env_cls=DummyVecEnv if vec_env == "dummy" else SubprocVecEnv,
-        vec_env_kwargs={} if vec_env == "dummy" else {"start_method": subproc_start_method()},
+        vec_env_kwargs={} if vec_env == "dummy" else {"start_method": start_method},
         monitor_dir=None if monitor_dir is None else str(monitor_dir),
         monitor_kwargs={"info_keywords": ("is_success",)},
     )
+
+
+def _load_kernels(env_id: str, kwargs: dict) -> None:
+    """One step of the env in this process: its compiled kernels are then loaded (or compiled)."""
+    import gymnasium as gym
+
+    env = gym.make(env_id, **kwargs)
+    env.reset(seed=0)
+    env.step(env.action_space.sample())
+    env.close()
 
 
 def subproc_start_method() -> str:
