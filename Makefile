@@ -3,28 +3,86 @@ PYTHON ?= python3
 VENV ?= .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
+# torch's CPU build first: a plain `torch` requirement would pull a multi-GB CUDA build
+TORCH := torch==2.13.0
+# Ray with RLlib pins its own gymnasium (1.2.2 for Ray 2.60): it gets a venv of its own.
+RAY_VENV ?= .venv-ray
+RAY_PY := $(RAY_VENV)/bin/python
+RAY_STAMP := $(RAY_VENV)/.installed
+# The oldest gymnasium pyproject.toml allows, for the compatibility run.
+OLD_VENV ?= .venv-oldgym
+OLD_PY := $(OLD_VENV)/bin/python
+OLD_STAMP := $(OLD_VENV)/.installed
+OLDEST_GYMNASIUM := gymnasium==1.1.1
+# What the extra gymnasium versions run: the env API (checkers, vector envs, ids in fresh processes).
+COMPAT_TESTS := tests/envs
+RAY_PORT ?= 6390
 
-.PHONY: main test lint bench figures agents-study clean-cache
+.PHONY: main test lint test-compat test-rllib rllib-two-nodes rllib-report bench figures agents-study clean-cache
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	# torch's CPU build first: stable-baselines3 would otherwise pull a multi-GB CUDA build
-	$(PY) -m pip install --quiet torch==2.13.0
+	$(PY) -m pip install --quiet $(TORCH)
 	$(PY) -m pip install --quiet -e ".[all]"
+	# compile the kernels once now, not in the first run (nor in every test worker at once)
+	$(PY) -m collision_env.precompile
 	touch $(STAMP)
+
+$(RAY_STAMP): pyproject.toml
+	$(PYTHON) -m venv $(RAY_VENV)
+	$(RAY_PY) -m pip install --quiet --upgrade pip
+	$(RAY_PY) -m pip install --quiet $(TORCH)
+	$(RAY_PY) -m pip install --quiet -e ".[fast,render,test,distributed]"
+	$(RAY_PY) -m collision_env.precompile
+	touch $(RAY_STAMP)
+
+$(OLD_STAMP): pyproject.toml
+	$(PYTHON) -m venv $(OLD_VENV)
+	$(OLD_PY) -m pip install --quiet --upgrade pip
+	$(OLD_PY) -m pip install --quiet -e ".[fast,render,test]" "$(OLDEST_GYMNASIUM)"
+	$(OLD_PY) -m collision_env.precompile
+	touch $(OLD_STAMP)
 
 # Train PPO on the default env and evaluate it (prints where the model, logs and GIF went).
 main: $(STAMP)
 	$(PY) -m agents.main
 
 test: $(STAMP)
+	$(PY) -m collision_env.precompile
 	$(PY) -m pytest -n 2
 
 # ruff's lint rules and its formatter, as configured in pyproject.toml (the pre-commit hooks run the same).
 lint: $(STAMP)
 	$(PY) -m ruff check .
 	$(PY) -m ruff format --check .
+
+# The env API under the oldest allowed gymnasium and under Ray's (1.2.2), with the RLlib smoke test.
+test-compat: $(OLD_STAMP) $(RAY_STAMP)
+	$(OLD_PY) -m pytest -n 2 -q -p no:cacheprovider $(COMPAT_TESTS)
+	$(RAY_PY) -m pytest -n 2 -q -p no:cacheprovider $(COMPAT_TESTS) tests/agents/test_rllib.py
+
+test-rllib: $(RAY_STAMP)
+	$(RAY_PY) -m pytest -q -p no:cacheprovider tests/agents/test_rllib.py
+
+# Two Ray nodes on this machine, each with one CPU, on loopback addresses of their own (Ray maps
+# 127.0.0.1 itself to the machine's network address; 127.0.0.2 and .3 stay on loopback): a head
+# and a worker node; train_rllib joins with --address and its two env runners land one per node.
+# Token authentication (the token in ~/.ray) guards the cluster's ports, as on real machines.
+HEAD_IP ?= 127.0.0.2
+WORKER_IP ?= 127.0.0.3
+rllib-two-nodes: export RAY_AUTH_MODE = token
+rllib-two-nodes: $(RAY_STAMP)
+	$(RAY_VENV)/bin/ray start --head --node-ip-address=$(HEAD_IP) --port=$(RAY_PORT) --num-cpus=1 \
+		--include-dashboard=false --disable-usage-stats
+	$(RAY_VENV)/bin/ray start --address=$(HEAD_IP):$(RAY_PORT) --node-ip-address=$(WORKER_IP) --num-cpus=1 \
+		--disable-usage-stats; \
+	$(RAY_PY) -m agents.train_rllib --address $(HEAD_IP):$(RAY_PORT) --node-ip-address $(HEAD_IP) \
+		--env-runners 2 --run-name rllib-two-nodes --overwrite; status=$$?; $(RAY_VENV)/bin/ray stop; exit $$status
+
+# Re-measure the README's RLlib block (throughput, a training run, the two-node run's placement).
+rllib-report: $(RAY_STAMP)
+	$(RAY_PY) -m agents.rllib_report --readme README.md --cluster runs/rllib-two-nodes
 
 # A quick look at the engine's speed against its peers (~30 s; writes nothing).
 bench: $(STAMP)
@@ -42,7 +100,8 @@ figures: $(STAMP)
 agents-study: $(STAMP)
 	$(PY) -m agents.study --jobs 2 --readme README.md
 
-# numba caches compiled kernels next to the sources and does not notice edits to a kernel's
-# callees in other files: clear the cache after editing the engine.
+# The compiled kernels live in a folder named by a hash of their sources, so an edit never runs
+# stale code; this only frees the disk space (numba's own per-file caches included).
 clean-cache:
+	rm -rf collision_env/__pycache__/kernels-* "$${XDG_CACHE_HOME:-$$HOME/.cache}"/collision_env/kernels-*
 	find collision_env -name '*.nbi' -delete -o -name '*.nbc' -delete

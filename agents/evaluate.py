@@ -11,7 +11,12 @@ episode) and a **scripted** policy that aims with the engine's exact prediction
 (``collision_env.envs.scripted``; not every task has one). Reported per policy: success rate (with a
 95 % Wilson interval), mean return, mean nudge (the requested velocity change summed over the
 episode, m/s) and its cost in reward units, mean targets hit and mean episode length. The table is
-printed and written as JSON to ``<run>/eval-<mode>[<substeps>].json`` (or ``--json``).
+printed and written as JSON to ``<run>/eval-<mode>[<substeps>].json`` (or ``--json``); an earlier
+evaluation's file is never replaced: the default name gets a number (``eval-exact-2.json``), and
+an existing ``--json`` path needs ``--overwrite``.
+
+The run folder may come from ``agents.train_ppo`` (stable-baselines3) or ``agents.train_rllib``
+(RLlib; its policy is the checkpoint's RLModule, acting deterministically; needs ray).
 
 The scripted baseline predicts with the engine it plays in: under ``--mode naive`` it aims with
 naive mode's (wrong) impacts, which is part of what such an evaluation measures.
@@ -29,12 +34,15 @@ from pathlib import Path
 import numpy as np
 
 from agents.config import (
+    CONFIG_FILE,
     MODEL_FILE,
     VECNORMALIZE_FILE,
     UsageError,
     as_int,
     check_env_id,
     episode_steps,
+    is_run_config,
+    load_yaml,
     normalize_settings,
     read_run,
     run_cli,
@@ -96,6 +104,48 @@ def trained_policy(run_dir: str | Path, which: str = "final") -> PolicyFactory:
         return act
 
     return factory
+
+
+def rllib_policy(run_dir: str | Path) -> PolicyFactory:
+    """The RLlib run's policy (the RLModule in ``<run>/checkpoint``), deterministic."""
+    from agents.train_rllib import CHECKPOINT_DIR
+
+    checkpoint = Path(run_dir) / CHECKPOINT_DIR
+    try:
+        from agents.rllib_policy import load_module, module_policy
+    except ImportError:
+        raise UsageError('evaluating an RLlib run needs ray: pip install -e ".[distributed]"') from None
+    return module_policy(load_module(checkpoint))
+
+
+def is_rllib_run(run: dict) -> bool:
+    from agents.train_rllib import ALGORITHM
+
+    return run.get("algorithm") == ALGORITHM
+
+
+def read_any_run(run_dir: str | Path) -> dict:
+    """The resolved config of a train_ppo or train_rllib run folder (UsageError if it is neither)."""
+    from agents.train_rllib import CHECKPOINT_DIR
+
+    run_dir = Path(run_dir)
+    config = run_dir / CONFIG_FILE
+    if config.is_file():
+        data = load_yaml(config)
+        if is_run_config(data) and is_rllib_run(data):
+            if not (run_dir / CHECKPOINT_DIR).is_dir():
+                raise UsageError(f"{run_dir} is an RLlib run without its {CHECKPOINT_DIR}/ folder")
+            return data
+    return read_run(run_dir)
+
+
+def run_policy(run_dir: str | Path, run: dict, which: str = "final") -> PolicyFactory:
+    """The trained policy of a run folder of either trainer (RLlib runs keep only their final policy)."""
+    if is_rllib_run(run):
+        if which != "final":
+            raise UsageError("an RLlib run keeps only its final policy (--model final)")
+        return rllib_policy(run_dir)
+    return trained_policy(run_dir, which)
 
 
 def random_policy(seed: int = 0) -> PolicyFactory:
@@ -175,19 +225,20 @@ def eval_kwargs(run: dict, mode: str | None, substeps: int | None) -> dict:
 def evaluate(run_dir: str | Path, *, episodes: int = 100, mode: str | None = None, substeps: int | None = None,
              seed: int = EVAL_SEED, baselines: tuple = BASELINES, model: str = "final") -> dict:
     """Evaluate the run (and the baselines) on the same episodes; returns the results dict."""
-    run = read_run(run_dir)
+    run = read_any_run(run_dir)
     env_id = check_env_id(run["env_id"])
     episodes = as_int("episodes", episodes)
     seed = as_int("seed", seed, low=0)
     kwargs = eval_kwargs(run, mode, substeps)
     env = make_env(env_id, kwargs)
-    policies = {"ppo": trained_policy(run_dir, model)}
+    policies = {"ppo": run_policy(run_dir, run, model)}
     if "random" in baselines:
         policies["random"] = random_policy(seed)
     if "scripted" in baselines:
         policies["scripted"] = scripted_baseline(env)
     trained = run.get("env_kwargs") or {}
-    results = {"env_id": env_id, "run": str(run_dir), "model": model, "train_mode": trained.get("mode", "exact"),
+    results = {"env_id": env_id, "run": str(run_dir), "trainer": "rllib" if is_rllib_run(run) else "sb3",
+               "model": model, "train_mode": trained.get("mode", "exact"),
                "train_substeps": int(trained.get("substeps", 1)), "mode": kwargs.get("mode", "exact"),
                "substeps": int(kwargs.get("substeps", 1)), "episodes": episodes, "seed": seed, "policies": {}}
     for name, factory in policies.items():
@@ -213,12 +264,12 @@ def record(run_dir: str | Path, path: str | Path, *, episodes: int = 1, mode: st
     """Record the trained policy's first ``episodes`` evaluation episodes as a GIF or MP4 (by suffix)."""
     import imageio.v2 as imageio
 
-    run = read_run(run_dir)
+    run = read_any_run(run_dir)
     path = check_video_path(path)
     episodes = as_int("record episodes", episodes)
     env = make_env(check_env_id(run["env_id"]), eval_kwargs(run, mode, substeps), render_mode="rgb_array")
     frames: list = []
-    play(env, trained_policy(run_dir, model), episodes, seed, frames=frames)
+    play(env, run_policy(run_dir, run, model), episodes, seed, frames=frames)
     fps = env.unwrapped.metadata["render_fps"]
     env.close()
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -243,7 +294,8 @@ def markdown(results: dict) -> str:
              "",
              "| policy | success (95 % CI) | mean return | mean nudge (m/s) | nudge cost | targets hit | steps |",
              "|---|---:|---:|---:|---:|---:|---:|"]
-    names = {"ppo": "PPO (this run, deterministic)", "random": "random", "scripted": SCRIPTED_LABEL}
+    trained = "RLlib PPO" if results.get("trainer") == "rllib" else "PPO"
+    names = {"ppo": f"{trained} (this run, deterministic)", "random": "random", "scripted": SCRIPTED_LABEL}
     for key, r in results["policies"].items():
         if r is None:
             lines.append(f"| {names.get(key, key)} | n/a | | | | | |")
@@ -255,17 +307,40 @@ def markdown(results: dict) -> str:
     return "\n".join(lines)
 
 
+def results_path(run_dir: str | Path, run: dict, json_path: str | None, mode: str | None, substeps: int | None,
+                 overwrite: bool = False) -> Path:
+    """Where to write the results, decided before evaluating: never an earlier evaluation's file.
+
+    ``--json PATH`` is used as given (an existing file needs ``overwrite``); the default
+    ``<run>/eval-<mode>[<substeps>].json`` becomes ``eval-<mode>-2.json``, ``-3``... when taken.
+    """
+    if json_path:
+        path = Path(json_path)
+        if path.exists() and not overwrite:
+            raise UsageError(f"{path} exists (pass --overwrite to replace it, or another --json path)")
+        return path
+    kwargs = eval_kwargs(run, mode, substeps)
+    substeps = int(kwargs.get("substeps", 1))
+    stem = f"eval-{kwargs.get('mode', 'exact')}{substeps if substeps != 1 else ''}"
+    path, n = Path(run_dir) / f"{stem}.json", 1
+    while path.exists():
+        n += 1
+        path = Path(run_dir) / f"{stem}-{n}.json"
+    return path
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python -m agents.evaluate", description=__doc__.split("\n\n")[0],
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("run", help="a run folder written by agents.train_ppo")
+    p.add_argument("run", help="a run folder written by agents.train_ppo or agents.train_rllib")
     p.add_argument("--episodes", type=int, default=100)
     p.add_argument("--mode", choices=("exact", "posteriori", "naive"), help="engine mode (default: the run's)")
     p.add_argument("--substeps", type=int, help="sub-steps for naive/posteriori (default 1 with --mode)")
     p.add_argument("--seed", type=int, default=EVAL_SEED, help="episode i starts from seed + i")
     p.add_argument("--model", choices=("final", "best"), default="final")
     p.add_argument("--no-baselines", action="store_true", help="evaluate the trained policy only")
-    p.add_argument("--json", help="write the results here (default: <run>/eval-<mode>.json)")
+    p.add_argument("--json", help="write the results here (default: <run>/eval-<mode>.json, numbered if taken)")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing --json file")
     p.add_argument("--gif", nargs="?", const="", metavar="PATH", help="record a GIF (default: <run>/episodes.gif)")
     p.add_argument("--video", metavar="PATH.mp4|PATH.gif", help="record a video (MP4 needs imageio-ffmpeg)")
     p.add_argument("--record-episodes", type=int, default=1, help="episodes to record (default 1)")
@@ -279,11 +354,11 @@ def main(argv: list[str] | None = None) -> dict:
     for video in videos:  # fail on a bad path before the evaluation, not after it
         check_video_path(video)
     as_int("record episodes", args.record_episodes)
+    run = read_any_run(args.run)
+    out = results_path(args.run, run, args.json, args.mode, args.substeps, args.overwrite)
     results = evaluate(args.run, episodes=args.episodes, mode=args.mode, substeps=args.substeps, seed=args.seed,
                        baselines=() if args.no_baselines else BASELINES, model=args.model)
     print(markdown(results))
-    suffix = results["mode"] + (str(results["substeps"]) if results["substeps"] != 1 else "")
-    out = Path(args.json) if args.json else Path(args.run) / f"eval-{suffix}.json"
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(results, indent=1))
     print(f"results: {out}")

@@ -21,6 +21,7 @@ The run folder (``--output``/``--run-name``) holds:
 | ``checkpoints/`` | CheckpointCallback's periodic saves (with the VecNormalize statistics) |
 | ``tb/`` | TensorBoard logs (``tensorboard --logdir <run>/tb``) |
 | ``monitor.csv`` | per-episode return, length and success (``<i>.monitor.csv`` per sub-env with dummy/subproc) |
+| ``train.log`` | progress lines (every 10 % of the run) when no progress bar is shown |
 
 Evaluation and checkpoint frequencies count env steps (all sub-envs together), not callback calls.
 Every evaluation replays the same episodes (the evaluation env is reseeded first), so the best
@@ -63,6 +64,7 @@ DEFAULT_ENV = "CollisionEnv/OneBallTarget-v0"
 VEC_ENVS = ("native", "dummy", "subproc")
 EVAL_SEED_OFFSET = 100_000  # evaluation episodes never share seeds with training episodes
 BEST_VECNORMALIZE_FILE = "best_vecnormalize.pkl"
+LOG_FILE = "train.log"
 #: train()'s callback settings, recorded in config.yml and reused by --hyperparams <run>/config.yml
 CALLBACK_DEFAULTS = {"eval_freq": 50_000, "eval_episodes": 20, "save_freq": 250_000}
 
@@ -86,13 +88,44 @@ def make_vec_env(env_id: str, n_envs: int, seed: int, env_kwargs: dict, vec_env:
     from stable_baselines3.common.env_util import make_vec_env as sb3_make_vec_env
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
 
+    start_method = subproc_start_method()
+    if vec_env == "subproc" and start_method == "fork":
+        _load_kernels(env_id, kwargs)  # forked workers inherit them instead of each loading the cache
+
     # "module:id" makes gym.make import collision_env first, in a subprocess too
     return sb3_make_vec_env(
         f"collision_env:{env_id}", n_envs=n_envs, seed=seed, env_kwargs=kwargs,
         vec_env_cls=DummyVecEnv if vec_env == "dummy" else SubprocVecEnv,
+        vec_env_kwargs={} if vec_env == "dummy" else {"start_method": start_method},
         monitor_dir=None if monitor_dir is None else str(monitor_dir),
         monitor_kwargs={"info_keywords": ("is_success",)},
     )
+
+
+def _load_kernels(env_id: str, kwargs: dict) -> None:
+    """One step of the env in this process: its compiled kernels are then loaded (or compiled)."""
+    import gymnasium as gym
+
+    env = gym.make(env_id, **kwargs)
+    env.reset(seed=0)
+    env.step(env.action_space.sample())
+    env.close()
+
+
+def subproc_start_method() -> str:
+    """``fork`` on Linux (workers start in well under a second: nothing is re-imported), else SB3's
+    default ``forkserver`` / ``spawn``, which re-import torch and the package in every worker.
+
+    Forking is safe here: the vector env is made before the policy, so no torch thread is running
+    yet, and the workers only step the env.
+    """
+    import multiprocessing as mp
+    import sys
+
+    methods = mp.get_all_start_methods()
+    if sys.platform.startswith("linux") and "fork" in methods:
+        return "fork"
+    return "forkserver" if "forkserver" in methods else "spawn"
 
 
 def _wrap_normalize(venv, settings: dict | None, gamma: float, training: bool):
@@ -136,6 +169,38 @@ def _callbacks(run_dir: Path, eval_env, eval_seed: int, n_envs: int, eval_freq: 
     return out
 
 
+def _print(line: str) -> None:
+    print(line, flush=True)  # flushed: a log file or pipe shows each line as it comes
+
+
+def _progress_log(total: int, log, every: float = 0.1):
+    """SB3 callback: one log line each ``every`` of the run (steps, success and return of recent
+    episodes, steps/s), for when no progress bar is shown (stdout is not a terminal)."""
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    class ProgressLog(BaseCallback):
+        def _on_training_start(self) -> None:
+            self.start = time.perf_counter()
+            self.next = every * total
+
+        def _on_step(self) -> bool:
+            done = self.model.num_timesteps
+            if done >= self.next:
+                self.next += every * total
+                episodes = list(self.model.ep_info_buffer)
+                success = list(getattr(self.model, "ep_success_buffer", []))
+                line = f"{done:,} / {total:,} steps ({100 * done / total:.0f} %)"
+                if success:
+                    line += f", success {100 * sum(success) / len(success):.0f} %"
+                if episodes:
+                    line += f", episode return {sum(e['r'] for e in episodes) / len(episodes):.2f}"
+                seconds = time.perf_counter() - self.start
+                log(f"{line}, {seconds:.0f} s ({done / max(seconds, 1e-9):,.0f} steps/s)")
+            return True
+
+    return ProgressLog()
+
+
 def run_label(env_id: str, mode: str, substeps: int, seed: int) -> str:
     """``oneballtarget-posteriori4-s0``: what a run folder's name starts with."""
     name = env_id.split("/")[-1].rsplit("-v", 1)[0].lower()
@@ -153,7 +218,7 @@ def train(env_id: str = DEFAULT_ENV, *, timesteps: float | None = None, n_envs: 
           vec_env: str = "native", eval_freq: int = CALLBACK_DEFAULTS["eval_freq"],
           eval_episodes: int = CALLBACK_DEFAULTS["eval_episodes"], save_freq: int = CALLBACK_DEFAULTS["save_freq"],
           progress: bool = False, threads: int = 1, overwrite: bool = False, verbose: int = 0,
-          log=print) -> Path:
+          log=None) -> Path:
     """Train PPO on ``env_id`` and write the run folder; returns its path.
 
     ``mode``/``substeps`` set the engine's fidelity (they override ``env_kwargs``, which override
@@ -161,6 +226,7 @@ def train(env_id: str = DEFAULT_ENV, *, timesteps: float | None = None, n_envs: 
     0 turns the EvalCallback / CheckpointCallback off. Everything is validated before the run
     folder is made, so a mistake costs no half-written folder.
     """
+    log = log or _print
     check_env_id(env_id)
     if vec_env not in VEC_ENVS:
         raise UsageError(f"--vec-env: expected one of {VEC_ENVS}, got {vec_env!r}")
@@ -224,8 +290,20 @@ def train(env_id: str = DEFAULT_ENV, *, timesteps: float | None = None, n_envs: 
     log(f"training PPO on {env_id} (mode={mode}, substeps={substeps}) for {timesteps:,} steps, "
         f"{n_envs} envs ({vec_env}), seed {seed} -> {run_dir}")
     start = time.perf_counter()
+    log_file = None
+    if not progress:  # no bar: progress lines in the log instead (and in train.log)
+        log_file = (run_dir / LOG_FILE).open("a")
+
+        def log_line(line: str) -> None:
+            log(line)
+            log_file.write(line + "\n")
+            log_file.flush()
+
+        callbacks.append(_progress_log(timesteps, log_line))
     model.learn(total_timesteps=timesteps, callback=callbacks, progress_bar=progress, tb_log_name="ppo")
     seconds = time.perf_counter() - start
+    if log_file is not None:
+        log_file.close()
     model.save(run_dir / MODEL_FILE)
     if norm is not None:
         venv.save(str(run_dir / VECNORMALIZE_FILE))

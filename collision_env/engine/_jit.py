@@ -4,9 +4,33 @@ The kernels are plain Python loops over numpy arrays. With numba installed (the 
 they are compiled once and cached on disk; without it they run as ordinary Python, with the same
 results and a much higher cost per event. ``NUMBA_DISABLE_JIT=1`` forces the Python path, which is
 how the tests check that both paths agree.
+
+Every kernel of the package goes through :func:`njit`, which differs from ``numba.njit`` in three
+ways:
+
+* **The cache can never run stale code.** numba keys its on-disk cache on the kernel's own file,
+  so a cached caller keeps the old machine code of a callee inlined from another file after that
+  file is edited. Here every kernel is cached in one folder named by a hash of all the kernel
+  sources (:data:`SOURCE_HASH`: every module of ``collision_env.engine`` and every other module that
+  defines a kernel): an edit to any of them recompiles everything once.
+  The folder is ``collision_env/__pycache__/kernels-<hash>`` when the package folder is writable,
+  else ``~/.cache/collision_env/kernels-<hash>`` (``$XDG_CACHE_HOME``), or under numba's own
+  ``NUMBA_CACHE_DIR`` when that is set. Folders of earlier sources are removed when a new one is
+  made.
+* **One compiled version per kernel.** numba compiles a separate version of a called kernel for
+  every distinct literal argument (``f(i, -1)`` and ``f(i, j)`` are two compilations); here a
+  kernel called from another kernel is compiled for the arguments' plain types only.
+* **It says so when it compiles.** The first compilation in a process (a fresh install, or edited
+  sources) prints one line on stderr, since it takes a while and is otherwise silent.
 """
 
 from __future__ import annotations
+
+import hashlib
+import os
+import shutil
+import sys
+from pathlib import Path
 
 try:  # numba is an optional accelerator, not a requirement of the core install
     import numba as _numba
@@ -14,18 +38,161 @@ except ImportError:  # pragma: no cover - numba is installed wherever the suite 
     _numba = None
 
 HAVE_NUMBA = _numba is not None and not _numba.config.DISABLE_JIT
+BACKEND = "numba" if HAVE_NUMBA else "python"
+
+PACKAGE_DIR = Path(__file__).resolve().parent.parent
+CACHE_PREFIX = "kernels-"
+COMPILE_NOTICE = "collision_env: compiling the engine's kernels with numba (once per install or source edit) ..."
+
+
+def kernel_sources(package_dir: Path = PACKAGE_DIR) -> list[Path]:
+    """The files the compiled kernels are made of: every module of the engine subpackage (kernels
+    and the constants they freeze) and every other module of the package that defines a kernel."""
+    engine = package_dir / "engine"
+    return sorted(path for path in package_dir.rglob("*.py")
+                  if path.is_relative_to(engine) or "njit" in path.read_text(encoding="utf-8"))
+
+
+def source_hash(package_dir: Path = PACKAGE_DIR) -> str:
+    """A hash of the kernel sources (:func:`kernel_sources`: paths and contents), in a fixed order."""
+    digest = hashlib.sha256()
+    for path in kernel_sources(package_dir):
+        digest.update(path.relative_to(package_dir).as_posix().encode())
+        digest.update(b"\0")
+        digest.update(path.read_bytes())
+        digest.update(b"\0")
+    return digest.hexdigest()[:16]
+
+
+SOURCE_HASH = source_hash()
+
+
+def _writable(folder: Path) -> bool:
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        probe = folder / f".probe-{os.getpid()}"
+        probe.touch()
+        probe.unlink()
+        return True
+    except OSError:
+        return False
+
+
+def cache_root() -> Path:
+    """The folder holding the ``kernels-<hash>`` cache folders (see the module docstring)."""
+    if HAVE_NUMBA and _numba.config.CACHE_DIR:
+        return Path(_numba.config.CACHE_DIR) / "collision_env"
+    in_tree = PACKAGE_DIR / "__pycache__"
+    if _writable(in_tree):
+        return in_tree
+    user = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
+    return user / "collision_env"
+
+
+def cache_dir() -> Path:
+    """Where this version of the sources keeps its compiled kernels."""
+    return cache_root() / f"{CACHE_PREFIX}{SOURCE_HASH}"
+
+
+def remove_stale_caches(root: Path, keep: Path) -> None:
+    """Delete the cache folders of other source versions under ``root`` (never ``keep``)."""
+    for old in root.glob(f"{CACHE_PREFIX}*"):
+        if old.is_dir() and old != keep:
+            shutil.rmtree(old, ignore_errors=True)
+
+
+class _CompileNotice:
+    """Prints :data:`COMPILE_NOTICE` on stderr the first time a kernel misses the cache."""
+
+    shown = False
+
+    @classmethod
+    def show(cls) -> None:
+        if not cls.shown:
+            cls.shown = True
+            print(COMPILE_NOTICE, file=sys.stderr, flush=True)
+
+
+if HAVE_NUMBA:
+    from numba.core import types as _types
+    from numba.core.caching import CompileResultCacheImpl, FunctionCache, _CacheLocator
+    from numba.core.registry import CPUDispatcher
+
+    class _SourceHashLocator(_CacheLocator):
+        """Numba cache locator: one folder for the whole package, named by its source hash."""
+
+        _prepared: set = set()
+
+        def __init__(self, py_func, py_file):
+            self._py_file = py_file  # numba names it in its warning about an uncachable kernel
+            self._path = cache_dir()
+            self._name = f"{py_func.__module__}-{py_func.__code__.co_firstlineno}"
+
+        def ensure_cache_path(self):
+            path = self._path
+            if path not in self._prepared:
+                if not path.is_dir():
+                    remove_stale_caches(path.parent, keep=path)
+                path.mkdir(parents=True, exist_ok=True)
+                self._prepared.add(path)
+
+        def get_cache_path(self):
+            return str(self._path)
+
+        def get_source_stamp(self):
+            return SOURCE_HASH  # the folder is already keyed on every source file
+
+        def get_disambiguator(self):
+            return self._name
+
+        @classmethod
+        def from_function(cls, py_func, py_file):
+            return cls(py_func, py_file)
+
+    class _SourceHashCacheImpl(CompileResultCacheImpl):
+        _locator_classes = [_SourceHashLocator]
+
+    class _KernelCache(FunctionCache):
+        _impl_class = _SourceHashCacheImpl
+
+        def load_overload(self, sig, target_context):
+            loaded = super().load_overload(sig, target_context)
+            if loaded is None:
+                _CompileNotice.show()  # a miss: numba compiles this signature now
+            return loaded
+
+    class _KernelDispatcher(CPUDispatcher):
+        """A CPU dispatcher compiled for plain (non-literal) argument types, cached by source hash."""
+
+        def get_call_template(self, args, kws):
+            args = tuple(_types.unliteral(a) for a in args)
+            kws = {k: _types.unliteral(v) for k, v in kws.items()}
+            return super().get_call_template(args, kws)
+
+        def enable_caching(self):
+            self._cache = _KernelCache(self.py_func)
+
+
+def _in_package(func) -> bool:
+    try:
+        return Path(func.__code__.co_filename).resolve().is_relative_to(PACKAGE_DIR)
+    except (OSError, ValueError):
+        return False
 
 
 def njit(func=None, **options):
     """Compile ``func`` with numba in nopython mode (cached), or return it unchanged.
 
-    Use bare (``@njit``) or with extra numba options (``@njit(inline="always")``).
+    Use bare (``@njit``) or with extra numba options (``@njit(inline="always")``). Kernels outside
+    the package (a test's, say) get numba's own per-file cache.
     """
     if func is None:
         return lambda f: njit(f, **options)
-    if _numba is None:
+    if not HAVE_NUMBA:
         return func
-    return _numba.njit(cache=True, nogil=True, **options)(func)
-
-
-BACKEND = "numba" if HAVE_NUMBA else "python"
+    if not _in_package(func):
+        return _numba.njit(cache=True, nogil=True, **options)(func)
+    dispatcher = _KernelDispatcher(py_func=func, locals=options.pop("locals", {}),
+                                   targetoptions={"nopython": True, "nogil": True, "boundscheck": None, **options})
+    dispatcher.enable_caching()
+    return dispatcher

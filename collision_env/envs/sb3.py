@@ -19,7 +19,14 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 from gymnasium.vector import AutoresetMode
-from stable_baselines3.common.vec_env import VecEnv, VecMonitor
+
+try:
+    from stable_baselines3.common.vec_env import VecEnv, VecMonitor
+except ModuleNotFoundError as err:  # an optional extra: say how to get it
+    raise ModuleNotFoundError(
+        f"collision_env.envs.sb3 needs stable-baselines3 ({err.name} is missing): "
+        'pip install "collision_env[train]" (on a CPU-only machine install torch\'s CPU build first)',
+        name=err.name) from err
 
 from collision_env.envs.vector import CollisionTargetVectorEnv
 

@@ -3,16 +3,27 @@
 * :class:`AimingPolicy` (controlled balls with nothing but walls in the way): each step it asks a copy
   of the engine (``BatchSimulator.copy()`` then ``step``) where each ball's next wall impact will land;
   if not on a target, it searches directions the same way and steers towards one that is.
-* :class:`ShootingPolicy` (any preset): candidate plans (action sequences) are run ahead on the env
-  itself from a saved state (``get_state``/``set_state``); the first whose predicted rollout hits a
-  target is executed. Because the engine is deterministic and exact, the real episode hits the
-  target at exactly the predicted step with exactly the predicted impact.
+* :class:`ShootingPolicy` (any preset): candidate plans (action sequences) are run ahead on a
+  planning copy of the env (``copy.deepcopy``, no renderer) from the env's current state
+  (``get_state``/``set_state``); the first whose predicted rollout hits a target is executed.
+  Because the engine is deterministic and exact, the real episode hits the target at exactly the
+  predicted step with exactly the predicted impact. The env itself is never stepped by the
+  planning, so it neither renders the look-ahead nor loses its trails.
 
-``scripted_policy(env)`` picks the right one for a preset.
+``scripted_policy(env)`` picks the right one for the env's preset; ``env`` may be a ``gym.make``
+env (wrappers included) or the bare env. The policy is called each step and returns the action:
+
+>>> import gymnasium as gym
+>>> import collision_env
+>>> env = gym.make("CollisionEnv/Billiards-v0")
+>>> obs, info = env.reset(seed=0)
+>>> policy = scripted_policy(env)
+>>> obs, reward, terminated, truncated, info = env.step(policy(obs))
 """
 
 from __future__ import annotations
 
+import copy
 import math
 from collections.abc import Callable
 
@@ -108,26 +119,32 @@ def push(direction, steps: int, delay: int = 0) -> Plan:
     return lambda t, env: d if delay <= t < delay + steps else zero
 
 
-def shoot(env, plans, horizon: int):
+def planning_copy(env):
+    """A copy of the (unwrapped) env to plan on: same task and state, no renderer, no render mode."""
+    planner = copy.deepcopy(env)  # the env's __getstate__ leaves its renderer behind
+    planner.render_mode = None
+    return planner
+
+
+def shoot(env, plans, horizon: int, planner=None):
     """The first plan whose predicted rollout hits a target within ``horizon`` steps.
 
-    Each plan runs on ``env`` itself from its current state, which is restored afterwards.
-    Returns ``(plan, hit_step, impacts of that step)`` or ``(None, None, None)``.
+    Each plan runs on ``planner`` (default: a fresh :func:`planning_copy` of ``env``) from the
+    current state of ``env``, which is left untouched. Returns ``(plan, hit_step, impacts of that
+    step)`` or ``(None, None, None)``.
     """
+    planner = planning_copy(env) if planner is None else planner
     start = env.get_state()
-    try:
-        for plan in plans:
-            env.set_state(start)
-            hits = int((env.core.t_status[0] == TARGET_HIT).sum())
-            for t in range(horizon):
-                _, _, term, trunc, info = env.step(plan(t, env))
-                if info["targets_hit"] > hits:
-                    return plan, t, info["impacts"].records.copy()
-                if term or trunc:
-                    break
-        return None, None, None
-    finally:
-        env.set_state(start)
+    for plan in plans:
+        planner.set_state(start)
+        hits = int((planner.core.t_status[0] == TARGET_HIT).sum())
+        for t in range(horizon):
+            _, _, term, trunc, info = planner.step(plan(t, planner))
+            if info["targets_hit"] > hits:
+                return plan, t, info["impacts"].records.copy()
+            if term or trunc:
+                break
+    return None, None, None
 
 
 def _target_point(cfg, wall: int, c: float):
@@ -198,13 +215,14 @@ class ShootingPolicy:
         self.t = 0
         self.hit_step = None
         self.wait = 0
+        self.planner = planning_copy(env)
 
     def __call__(self, obs=None) -> np.ndarray:
         env = self.env
         if self.plan is None and self.wait <= 0:
             horizon = env.config.n_steps - int(env.core.steps[0])
             plans = self.candidates(env)
-            plan, hit_step, _ = shoot(env, plans, horizon) if plans else (None, None, None)
+            plan, hit_step, _ = shoot(env, plans, horizon, self.planner) if plans else (None, None, None)
             if plan is not None:
                 self.plan, self.t, self.hit_step = plan, 0, hit_step
             else:
@@ -222,7 +240,11 @@ class ShootingPolicy:
 
 
 def scripted_policy(env):
-    """A scripted policy for the unwrapped env's preset (``None`` when there is none)."""
+    """A scripted policy for the env's preset (``None`` when there is none): ``policy(obs) -> action``.
+
+    ``env`` is a ``gym.make`` env or the bare env; the policy reads the state of the bare env.
+    """
+    env = env.unwrapped
     cfg = env.config
     if cfg.dimension == 2 and cfg.scorers in ("any", "controlled") and (cfg.n_balls == 1 or not cfg.ball_collisions) \
             and len(cfg.controlled) == cfg.n_balls:

@@ -45,6 +45,8 @@ class CollisionTargetVectorEnv(VectorEnv):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 20, "autoreset_mode": AutoresetMode.NEXT_STEP}
     preset: str | None = "one_ball"
+    # set before __init__ can fail: gymnasium < 1.3's VectorEnv.__del__ closes a half-made env
+    _renderers: list | None = None
 
     def __init__(self, num_envs: int = 1, max_episode_steps: int | None = None, render_mode: str | None = None,
                  autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP, preset: str | None = _CLASS_PRESET,

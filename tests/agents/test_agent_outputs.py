@@ -1,0 +1,74 @@
+"""What the agent scripts leave and say: progress without a terminal, no silent overwrite, the
+subprocess start method, and a clear message when an optional extra is missing."""
+
+import importlib.util
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("stable_baselines3")
+pytest.importorskip("yaml")
+
+from agents import evaluate, train_ppo, train_rllib  # noqa: E402
+from agents.config import UsageError  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+TINY = ["--timesteps", "2048", "--n-envs", "4", "--eval-freq", "0", "--save-freq", "0"]
+
+
+def test_training_through_a_pipe_prints_progress_lines_and_keeps_them_in_the_run(tmp_path):
+    run = subprocess.run([sys.executable, "-m", "agents.train_ppo", *TINY, "--output", str(tmp_path),
+                          "--run-name", "piped"], capture_output=True, text=True, cwd=ROOT, timeout=600)
+    assert run.returncode == 0, run.stderr
+    progress = [line for line in run.stdout.splitlines() if " steps (" in line]
+    assert len(progress) >= 2 and progress[-1].startswith("2,048 / 2,048 steps (100 %)")
+    assert (tmp_path / "piped" / train_ppo.LOG_FILE).read_text().splitlines() == progress
+
+
+def test_evaluate_never_replaces_an_earlier_evaluation(tmp_path):
+    run_dir = train_ppo.main(TINY + ["--no-progress", "--output", str(tmp_path), "--run-name", "r"])
+    first = evaluate.main([str(run_dir), "--episodes", "2", "--no-baselines"])
+    second = evaluate.main([str(run_dir), "--episodes", "3", "--no-baselines"])
+    assert json.loads((run_dir / "eval-exact.json").read_text())["episodes"] == first["episodes"] == 2
+    assert json.loads((run_dir / "eval-exact-2.json").read_text())["episodes"] == second["episodes"] == 3
+    mine = tmp_path / "mine.json"
+    mine.write_text("{}")
+    with pytest.raises(UsageError, match="--overwrite"):
+        evaluate.main([str(run_dir), "--episodes", "2", "--no-baselines", "--json", str(mine)])
+    assert mine.read_text() == "{}"  # refused before evaluating: untouched
+    evaluate.main([str(run_dir), "--episodes", "2", "--no-baselines", "--json", str(mine), "--overwrite"])
+    assert json.loads(mine.read_text())["episodes"] == 2
+
+
+def test_subproc_workers_fork_on_linux():
+    expected = "fork" if sys.platform.startswith("linux") else ("forkserver", "spawn")
+    assert train_ppo.subproc_start_method() in expected
+
+
+@pytest.mark.skipif(importlib.util.find_spec("ray") is not None, reason="ray is installed here")
+def test_train_rllib_without_ray_says_how_to_install_it(tmp_path):
+    with pytest.raises(UsageError, match=r'pip install -e "\.\[distributed\]"'):
+        train_rllib.train(output=tmp_path)
+    assert not any(tmp_path.iterdir())  # nothing written
+
+
+def test_train_rllib_rejects_bad_settings_before_starting_anything(tmp_path):
+    with pytest.raises(UsageError, match="unknown env id"):
+        train_rllib.train("CollisionEnv/Nope-v0", output=tmp_path)
+    with pytest.raises(UsageError, match="iterations"):
+        train_rllib.train(iterations=0, output=tmp_path)
+    with pytest.raises(UsageError, match="target_success"):
+        train_rllib.train(target_success=1.5, output=tmp_path)
+    assert not any(tmp_path.iterdir())
+
+
+def test_the_rllib_hyperparameter_file_has_an_entry_for_the_default_env():
+    from agents.config import load_yaml
+
+    raw = load_yaml(train_rllib.HYPERPARAMS)
+    entry = raw[train_rllib.DEFAULT_ENV]
+    assert entry["vectorize"] == "native" and 0 < entry["target_success"] <= 1
+    assert entry["train_batch_size_per_learner"] >= entry["minibatch_size"]
