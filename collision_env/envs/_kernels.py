@@ -3,9 +3,10 @@
 Both work on a batch of B scenes and are the only per-step task logic: the single env is a batch
 of one, so the single env and the native vector env run the same arithmetic and agree bit for bit.
 They are plain loops, compiled with numba when it is installed (like the engine's kernels) and run
-as ordinary Python otherwise. Each kernel is a short sequence of named phases; the phases are
-``inline="always"`` helpers, so numba compiles a kernel into one function, as fast as if it were
-written out in one piece.
+as ordinary Python otherwise. Each kernel is a short sequence of named phases, each a loop over the
+scenes; the phases are ``inline="always"`` helpers, so numba compiles a kernel into one function.
+(Phases loop over the scenes themselves because a helper that takes arrays, called once per scene,
+pays numba's reference counting on every call: several times the work of a one-ball scene.)
 
 The packed arrays are indexed by the named layouts of ``_layout`` (``S[b, SCENE_FLOATS.reward]``);
 wall codes are the engine's (``collision_env.engine.WALL_LEFT`` ... ``WALL_TOP``).
@@ -130,7 +131,7 @@ def nudge_kernel(actions, active, balls, body, ctrl, P, Q, dv, S):  # pragma: no
 # scoring: impacts -> target hits
 
 
-@njit(inline="always")
+@njit
 def _in_cluster(body, b, i):  # pragma: no cover - numba
     root = body[b, i]
     for k in range(body.shape[1]):
@@ -140,48 +141,15 @@ def _in_cluster(body, b, i):  # pragma: no cover - numba
 
 
 @njit(inline="always")
-def _merge_clusters(body, b, i, o):  # pragma: no cover - numba
-    """A ball-ball impact in a stick scene joins the two balls' clusters (under the smaller root)."""
-    ri = body[b, i]
-    ro = body[b, o]
-    root = min(ri, ro)
-    gone = max(ri, ro)
-    for q in range(body.shape[1]):
-        if body[b, q] == gone:
-            body[b, q] = root
-
-
-@njit(inline="always")
-def _split_cluster(body, b, i):  # pragma: no cover - numba
-    """A wall impact stops ball i's cluster and takes it apart, as the engine does."""
-    root = body[b, i]
-    for q in range(body.shape[1]):
-        if body[b, q] == root:
-            body[b, q] = q
-
-
-@njit(inline="always")
-def _visible_targets(C, b, n_targets, seq):  # pragma: no cover - numba
+def _visible_targets(current, n_targets, seq):  # pragma: no cover - numba
     """The range of targets that can be hit now: the current one if sequential, else all."""
     if seq:
-        return C[b, SI.current], min(C[b, SI.current] + 1, n_targets)
+        return current, min(current + 1, n_targets)
     return 0, n_targets
 
 
-@njit(inline="always")
-def _take_target(C, T, t_geo, b, wall, along, t, seq):  # pragma: no cover - numba
-    """Mark the first visible pending target that a wall impact (wall, position along it, time) lands on
-    as hit; returns whether there was one."""
-    k0, k1 = _visible_targets(C, b, T.shape[1], seq)
-    for k in range(k0, k1):
-        if (T[b, k, TI.status] == TARGET_PENDING and T[b, k, TI.wall] == wall
-                and abs(along - t_geo[b, k, TG.centre]) <= t_geo[b, k, TG.half_width]
-                and t_geo[b, k, TG.opens] <= t and t <= t_geo[b, k, TG.closes]):
-            T[b, k, TI.status] = TARGET_HIT
-            if seq:
-                C[b, SI.current] += 1
-            return True
-    return False
+# The phases below loop over the scenes themselves; the helpers they call per scene take scalars
+# (see the module docstring).
 
 
 @njit(inline="always")
@@ -189,8 +157,11 @@ def _score_impacts(flags, imp, C, T, t_geo, body, qual, seq, cluster):  # pragma
     """Count each stepped scene's target hits and off-target wall impacts of scoring balls.
 
     In cluster mode ``body`` mirrors the engine's clusters through the step, replayed from the
-    impacts, so that a wall impact scores only if its ball was part of a cluster at that instant.
+    impacts (a ball-ball impact merges two clusters under the smaller root; a wall impact stops the
+    cluster and takes it apart, as the engine does), so that a wall impact scores only if its ball
+    was part of a cluster at that instant.
     """
+    N = body.shape[1]
     for b in range(flags.shape[0]):
         C[b, SI.hits] = 0
         C[b, SI.misses] = 0
@@ -201,87 +172,70 @@ def _score_impacts(flags, imp, C, T, t_geo, body, qual, seq, cluster):  # pragma
         i = imp[j]["ball"]
         w = imp[j]["wall"]
         if w < 0:
-            if cluster:
-                o = imp[j]["other"]
-                if o >= 0:
-                    _merge_clusters(body, b, i, o)
+            o = imp[j]["other"]
+            if cluster and o >= 0:
+                root = min(body[b, i], body[b, o])
+                gone = max(body[b, i], body[b, o])
+                for q in range(N):
+                    if body[b, q] == gone:
+                        body[b, q] = root
             continue
         scores = qual[i]
         if cluster:
             scores = scores and _in_cluster(body, b, i)
-            _split_cluster(body, b, i)
+            root = body[b, i]
+            for q in range(N):
+                if body[b, q] == root:
+                    body[b, q] = q
         if not scores:
             continue
         along = imp[j]["y"] if _on_side_wall(w) else imp[j]["x"]
-        if _take_target(C, T, t_geo, b, w, along, imp[j]["time"], seq):
+        t = imp[j]["time"]
+        hit = False
+        k0, k1 = _visible_targets(C[b, SI.current], T.shape[1], seq)
+        for k in range(k0, k1):
+            if (T[b, k, TI.status] == TARGET_PENDING and T[b, k, TI.wall] == w
+                    and abs(along - t_geo[b, k, TG.centre]) <= t_geo[b, k, TG.half_width]
+                    and t_geo[b, k, TG.opens] <= t and t <= t_geo[b, k, TG.closes]):
+                T[b, k, TI.status] = TARGET_HIT
+                hit = True
+                if seq:
+                    C[b, SI.current] += 1
+                break
+        if hit:
             C[b, SI.hits] += 1
         else:
             C[b, SI.misses] += 1
 
 
 @njit(inline="always")
-def _close_windows(T, t_geo, b, now):  # pragma: no cover - numba
-    """Targets whose time window closed unhit fail."""
-    for k in range(T.shape[1]):
-        if T[b, k, TI.status] == TARGET_PENDING and t_geo[b, k, TG.closes] < now:
-            T[b, k, TI.status] = TARGET_FAILED
+def _advance_episodes(flags, sim_time, clusters, C, T, t_geo, body, cluster):  # pragma: no cover - numba
+    """Count the step (restart the count on a reset), fail targets whose window closed unhit, take
+    the engine's clusters, and count the targets hit."""
+    for b in range(flags.shape[0]):
+        f = flags[b]
+        if f == ROW_SKIP:
+            continue
+        if f == ROW_STEPPED:
+            C[b, SI.steps] += 1
+            for k in range(T.shape[1]):
+                if T[b, k, TI.status] == TARGET_PENDING and t_geo[b, k, TG.closes] < sim_time[b]:
+                    T[b, k, TI.status] = TARGET_FAILED
+        elif f == ROW_RESET:
+            C[b, SI.steps] = 0
+        if cluster:
+            for q in range(body.shape[1]):
+                body[b, q] = clusters[b, q]
+        n_hit = 0
+        for k in range(T.shape[1]):
+            if T[b, k, TI.status] == TARGET_HIT:
+                n_hit += 1
+        C[b, SI.targets_hit] = n_hit
 
 
 @njit(inline="always")
-def _target_tally(T, b):  # pragma: no cover - numba
-    """(targets hit, whether some target failed) of scene b."""
-    n_hit = 0
-    failed = False
-    for k in range(T.shape[1]):
-        if T[b, k, TI.status] == TARGET_HIT:
-            n_hit += 1
-        elif T[b, k, TI.status] == TARGET_FAILED:
-            failed = True
-    return n_hit, failed
-
-
-# --------------------------------------------------------------------------------------------- #
-# observation
-
-
-@njit(inline="always")
-def _play_area(P):  # pragma: no cover - numba
-    """Centre (xc, yc), half-size (xh, yh) and diagonal of the play area."""
-    xmin = P[PARAMS.xmin]
-    ymin = P[PARAMS.ymin]
-    xmax = P[PARAMS.xmax]
-    ymax = P[PARAMS.ymax]
-    diag = math.sqrt((xmax - xmin) ** 2 + (ymax - ymin) ** 2)
-    return 0.5 * (xmin + xmax), 0.5 * (ymin + ymax), 0.5 * (xmax - xmin), 0.5 * (ymax - ymin), diag
-
-
-@njit(inline="always")
-def _observe_balls(obs, b, pos, vel, masses, body, qual, cluster, area, P):  # pragma: no cover - numba
-    """Write every ball's observation block; returns the kinetic energy of the scene."""
-    xc, yc, xh, yh, _ = area
-    vscale = P[PARAMS.vscale]
-    mscale = P[PARAMS.mscale]
-    ke = 0.0
-    o = 0
-    for i in range(pos.shape[1]):
-        vx = vel[b, i, 0]
-        vy = vel[b, i, 1]
-        ke += 0.5 * masses[b, i] * (vx * vx + vy * vy)
-        obs[b, o + BALL_OBS.x] = _clip1((pos[b, i, 0] - xc) / xh)
-        obs[b, o + BALL_OBS.y] = _clip1((pos[b, i, 1] - yc) / yh)
-        obs[b, o + BALL_OBS.vx] = _clip1(vx / vscale)
-        obs[b, o + BALL_OBS.vy] = _clip1(vy / vscale)
-        obs[b, o + BALL_OBS.mass] = _clip1(masses[b, i] / mscale)
-        scoring = qual[i] and (not cluster or _in_cluster(body, b, i))
-        obs[b, o + BALL_OBS.scoring] = 1.0 if scoring else 0.0
-        o += len(BALL_OBS)
-    return ke
-
-
-@njit(inline="always")
-def _observed_point(wall, centre, area):  # pragma: no cover - numba
+def _observed_point(wall, centre, xc, yc, xh, yh):  # pragma: no cover - numba
     """A target's centre point in observation coordinates, and the half length of its wall."""
-    xc, yc, xh, yh, _ = area
     if wall == WALL_LEFT:
         return -1.0, (centre - yc) / yh, yh
     if wall == WALL_RIGHT:
@@ -292,46 +246,64 @@ def _observed_point(wall, centre, area):  # pragma: no cover - numba
 
 
 @njit(inline="always")
-def _observe_targets(obs, o, b, C, T, t_geo, seq, now, area, P):  # pragma: no cover - numba
-    """Write the target slots' blocks from offset o (the current target when sequential)."""
-    n_targets = T.shape[1]
+def _observe(flags, obs, S, pos, vel, masses, body, qual, C, T, t_geo, sim_time, seq, cluster, n_steps,
+             P):  # pragma: no cover - numba
+    """Write the observation (ball blocks, target slots, globals) and the kinetic energy."""
+    xc, yc, xh, yh = _centre_and_half_size(P)
+    vscale = P[PARAMS.vscale]
+    mscale = P[PARAMS.mscale]
     tlimit = P[PARAMS.time_limit]
-    for slot in range(1 if seq else n_targets):
-        k = min(C[b, SI.current], n_targets - 1) if seq else slot
-        w = T[b, k, TI.wall]
-        px, py, half = _observed_point(w, t_geo[b, k, TG.centre], area)
-        obs[b, o + TARGET_OBS.x] = _clip1(px)
-        obs[b, o + TARGET_OBS.y] = _clip1(py)
-        obs[b, o + TARGET_OBS.half_width] = _clip1(t_geo[b, k, TG.half_width] / half)
-        for q in range(WALL_TOP + 1):
-            obs[b, o + TARGET_OBS.wall_left + q] = 1.0 if q == w else 0.0
-        st = T[b, k, TI.status]
-        obs[b, o + TARGET_OBS.status] = 1.0 if st == TARGET_PENDING else (0.0 if st == TARGET_HIT else -1.0)
-        obs[b, o + TARGET_OBS.opens] = _clip1((t_geo[b, k, TG.opens] - now) / tlimit)
-        obs[b, o + TARGET_OBS.closes] = _clip1((t_geo[b, k, TG.closes] - now) / tlimit)
-        o += len(TARGET_OBS)
-    return o
+    N = pos.shape[1]
+    K = T.shape[1]
+    for b in range(flags.shape[0]):
+        if flags[b] == ROW_SKIP:
+            continue
+        ke = 0.0
+        o = 0
+        for i in range(N):  # ball blocks
+            vx = vel[b, i, 0]
+            vy = vel[b, i, 1]
+            ke += 0.5 * masses[b, i] * (vx * vx + vy * vy)
+            obs[b, o + BALL_OBS.x] = _clip1((pos[b, i, 0] - xc) / xh)
+            obs[b, o + BALL_OBS.y] = _clip1((pos[b, i, 1] - yc) / yh)
+            obs[b, o + BALL_OBS.vx] = _clip1(vx / vscale)
+            obs[b, o + BALL_OBS.vy] = _clip1(vy / vscale)
+            obs[b, o + BALL_OBS.mass] = _clip1(masses[b, i] / mscale)
+            scoring = qual[i] and (not cluster or _in_cluster(body, b, i))
+            obs[b, o + BALL_OBS.scoring] = 1.0 if scoring else 0.0
+            o += len(BALL_OBS)
+        S[b, SF.energy] = ke
+        now = sim_time[b]
+        for slot in range(1 if seq else K):  # target slots: the current target when sequential
+            k = min(C[b, SI.current], K - 1) if seq else slot
+            w = T[b, k, TI.wall]
+            px, py, half = _observed_point(w, t_geo[b, k, TG.centre], xc, yc, xh, yh)
+            obs[b, o + TARGET_OBS.x] = _clip1(px)
+            obs[b, o + TARGET_OBS.y] = _clip1(py)
+            obs[b, o + TARGET_OBS.half_width] = _clip1(t_geo[b, k, TG.half_width] / half)
+            for q in range(WALL_TOP + 1):
+                obs[b, o + TARGET_OBS.wall_left + q] = 1.0 if q == w else 0.0
+            st = T[b, k, TI.status]
+            obs[b, o + TARGET_OBS.status] = 1.0 if st == TARGET_PENDING else (0.0 if st == TARGET_HIT else -1.0)
+            obs[b, o + TARGET_OBS.opens] = _clip1((t_geo[b, k, TG.opens] - now) / tlimit)
+            obs[b, o + TARGET_OBS.closes] = _clip1((t_geo[b, k, TG.closes] - now) / tlimit)
+            o += len(TARGET_OBS)
+        obs[b, o + GLOBAL_OBS.steps_left] = min(max(1.0 - C[b, SI.steps] / n_steps, 0.0), 1.0)
+        obs[b, o + GLOBAL_OBS.targets_left] = (K - C[b, SI.targets_hit]) / K
 
 
 @njit(inline="always")
-def _segment(P, wall, centre, hw):  # pragma: no cover - numba
-    """End points (x0, y0, x1, y1) of a target segment on a wall."""
-    if wall == WALL_LEFT:
-        return P[PARAMS.xmin], centre - hw, P[PARAMS.xmin], centre + hw
-    if wall == WALL_RIGHT:
-        return P[PARAMS.xmax], centre - hw, P[PARAMS.xmax], centre + hw
-    if wall == WALL_BOTTOM:
-        return centre - hw, P[PARAMS.ymin], centre + hw, P[PARAMS.ymin]
-    return centre - hw, P[PARAMS.ymax], centre + hw, P[PARAMS.ymax]
-
-
-@njit(inline="always")
-def _border_contact(x, y, vx, vy, r, P):  # pragma: no cover - numba
-    """Where a ball at (x, y) of radius r would touch the border flying straight on at (vx, vy) != 0."""
+def _centre_and_half_size(P):  # pragma: no cover - numba
     xmin = P[PARAMS.xmin]
     ymin = P[PARAMS.ymin]
     xmax = P[PARAMS.xmax]
     ymax = P[PARAMS.ymax]
+    return 0.5 * (xmin + xmax), 0.5 * (ymin + ymax), 0.5 * (xmax - xmin), 0.5 * (ymax - ymin)
+
+
+@njit(inline="always")
+def _border_contact(x, y, vx, vy, r, xmin, ymin, xmax, ymax):  # pragma: no cover - numba
+    """Where a ball at (x, y) of radius r would touch the border flying straight on at (vx, vy) != 0."""
     tx = math.inf
     ty = math.inf
     if vx > 0.0:
@@ -348,64 +320,88 @@ def _border_contact(x, y, vx, vy, r, P):  # pragma: no cover - numba
 
 
 @njit(inline="always")
-def _aim_distance(b, pos, vel, radii, body, qual, cluster, C, T, t_geo, seq, diag, P):  # pragma: no cover
-    """Distance from each scoring ball's straight-line border contact point to the nearest visible
-    pending target, over the play-area diagonal, at its smallest (1 when nothing is aimed).
-
-    A shaping heuristic: it ignores other balls.
-    """
-    best = 1.0
-    for i in range(pos.shape[1]):
-        if not (qual[i] and (not cluster or _in_cluster(body, b, i))):
-            continue
-        vx = vel[b, i, 0]
-        vy = vel[b, i, 1]
-        if vx == 0.0 and vy == 0.0:
-            continue
-        cx, cy = _border_contact(pos[b, i, 0], pos[b, i, 1], vx, vy, radii[b, i], P)
-        k0, k1 = _visible_targets(C, b, T.shape[1], seq)
-        for k in range(k0, k1):
-            if T[b, k, TI.status] != TARGET_PENDING:
-                continue
-            x0, y0, x1, y1 = _segment(P, T[b, k, TI.wall], t_geo[b, k, TG.centre], t_geo[b, k, TG.half_width])
-            sx = x1 - x0
-            sy = y1 - y0
-            u = ((cx - x0) * sx + (cy - y0) * sy) / (sx * sx + sy * sy)
-            u = min(max(u, 0.0), 1.0)
-            dx = cx - (x0 + u * sx)
-            dy = cy - (y0 + u * sy)
-            d = math.sqrt(dx * dx + dy * dy) / diag
-            if d < best:
-                best = d
-    return best
-
-
-# --------------------------------------------------------------------------------------------- #
-# reward and episode end
+def _distance_to_target(cx, cy, wall, centre, hw, xmin, ymin, xmax, ymax):  # pragma: no cover - numba
+    """Distance from (cx, cy) to the target segment of half width hw centred at ``centre`` on ``wall``."""
+    if wall == WALL_LEFT:
+        x0, y0, x1, y1 = xmin, centre - hw, xmin, centre + hw
+    elif wall == WALL_RIGHT:
+        x0, y0, x1, y1 = xmax, centre - hw, xmax, centre + hw
+    elif wall == WALL_BOTTOM:
+        x0, y0, x1, y1 = centre - hw, ymin, centre + hw, ymin
+    else:
+        x0, y0, x1, y1 = centre - hw, ymax, centre + hw, ymax
+    sx = x1 - x0
+    sy = y1 - y0
+    u = ((cx - x0) * sx + (cy - y0) * sy) / (sx * sx + sy * sy)
+    u = min(max(u, 0.0), 1.0)
+    dx = cx - (x0 + u * sx)
+    dy = cy - (y0 + u * sy)
+    return math.sqrt(dx * dx + dy * dy)
 
 
 @njit(inline="always")
-def _write_outcome(S, C, b, flag, done_ok, failed, phi_new, n_steps, P):  # pragma: no cover - numba
-    """Reward and end flags of a stepped scene (zero and False for a reset or observed one); the
-    potential phi is kept for the next step unless the scene was only observed."""
-    if flag == ROW_STEPPED:
-        rew = C[b, SI.hits] * P[PARAMS.hit_reward] - C[b, SI.misses] * P[PARAMS.miss_penalty] \
-            - P[PARAMS.action_cost] * S[b, SF.nudge]
-        if done_ok:
-            rew += P[PARAMS.success_bonus]
-        if C[b, SI.hits] == 0:
-            rew += P[PARAMS.shaping] * (phi_new - S[b, SF.phi])
-        S[b, SF.reward] = rew
-        C[b, SI.terminated] = done_ok or failed
-        C[b, SI.truncated] = C[b, SI.steps] >= n_steps
-        C[b, SI.success] = done_ok
-    else:
-        S[b, SF.reward] = 0.0
-        C[b, SI.terminated] = False
-        C[b, SI.truncated] = False
-        C[b, SI.success] = False
-    if flag != ROW_OBSERVE:
-        S[b, SF.phi] = phi_new
+def _settle(flags, S, C, T, t_geo, pos, vel, radii, body, qual, seq, cluster, n_steps, P):  # pragma: no cover
+    """Reward and end flags of each stepped scene (zero and False for a reset or observed one), and
+    the aiming potential phi kept for the next step (unless the scene was only observed).
+
+    phi is minus the distance, over the play-area diagonal, from each scoring ball's straight-line
+    border contact point to the nearest visible pending target, at its smallest (-1 when nothing is
+    aimed, or when the task does not shape): a heuristic that ignores other balls.
+    """
+    xmin = P[PARAMS.xmin]
+    ymin = P[PARAMS.ymin]
+    xmax = P[PARAMS.xmax]
+    ymax = P[PARAMS.ymax]
+    diag = math.sqrt((xmax - xmin) ** 2 + (ymax - ymin) ** 2)
+    shaping = P[PARAMS.shaping] != 0.0  # the aiming potential is only computed when it is used
+    K = T.shape[1]
+    for b in range(flags.shape[0]):
+        f = flags[b]
+        if f == ROW_SKIP:
+            continue
+        best = 1.0
+        for i in range(pos.shape[1] if shaping else 0):
+            if not (qual[i] and (not cluster or _in_cluster(body, b, i))):
+                continue
+            vx = vel[b, i, 0]
+            vy = vel[b, i, 1]
+            if vx == 0.0 and vy == 0.0:
+                continue
+            cx, cy = _border_contact(pos[b, i, 0], pos[b, i, 1], vx, vy, radii[b, i], xmin, ymin, xmax, ymax)
+            k0, k1 = _visible_targets(C[b, SI.current], K, seq)
+            for k in range(k0, k1):
+                if T[b, k, TI.status] != TARGET_PENDING:
+                    continue
+                d = _distance_to_target(cx, cy, T[b, k, TI.wall], t_geo[b, k, TG.centre], t_geo[b, k, TG.half_width],
+                                        xmin, ymin, xmax, ymax) / diag
+                if d < best:
+                    best = d
+        phi_new = -best
+
+        if f == ROW_STEPPED:
+            failed = False
+            for k in range(K):
+                if T[b, k, TI.status] == TARGET_FAILED:
+                    failed = True
+            done_ok = C[b, SI.targets_hit] == K
+            hits = C[b, SI.hits]
+            rew = hits * P[PARAMS.hit_reward] - C[b, SI.misses] * P[PARAMS.miss_penalty] \
+                - P[PARAMS.action_cost] * S[b, SF.nudge]
+            if done_ok:
+                rew += P[PARAMS.success_bonus]
+            if hits == 0:
+                rew += P[PARAMS.shaping] * (phi_new - S[b, SF.phi])
+            S[b, SF.reward] = rew
+            C[b, SI.terminated] = done_ok or failed
+            C[b, SI.truncated] = C[b, SI.steps] >= n_steps
+            C[b, SI.success] = done_ok
+        else:
+            S[b, SF.reward] = 0.0
+            C[b, SI.terminated] = False
+            C[b, SI.truncated] = False
+            C[b, SI.success] = False
+        if f != ROW_OBSERVE:
+            S[b, SF.phi] = phi_new
 
 
 @njit
@@ -416,10 +412,8 @@ def task_kernel(flags, imp, balls, sim_time, clusters, S, C, T, t_geo, body, qua
     ``imp`` is the engine's impact record array for the batch (sorted by scene then time);
     ``balls`` (the per-ball state, ``engine.motion.BALL_FIELDS``), ``sim_time`` and ``clusters``
     are the engine's state after the step. ``flags`` holds one ``ROW_*`` code per scene.
-    In cluster mode ``body`` mirrors the engine's cluster roots through the step, replayed from
-    the impacts (a ball-ball impact merges two clusters, a wall impact stops the cluster and
-    takes it apart, as the engine does), so a wall impact scores only if its ball was part of a
-    cluster at that instant; at the end ``body`` is set to the engine's ``clusters``.
+    In cluster mode ``body`` mirrors the engine's cluster roots through the step (see
+    ``_score_impacts``); at the end it is set to the engine's ``clusters``.
     Updated in place: target status, current target, step count, body, phi. Written for rows
     whose flag is not ``ROW_SKIP``: the observation, reward, energy, targets hit and the end flags.
     """
@@ -427,34 +421,10 @@ def task_kernel(flags, imp, balls, sim_time, clusters, S, C, T, t_geo, body, qua
     seq = Q[SWITCHES.sequential] != 0
     cluster = Q[SWITCHES.cluster] != 0
     n_steps = Q[SWITCHES.n_steps]
-    shaping = P[PARAMS.shaping] != 0.0  # the aiming potential is only computed when it is used
-    area = _play_area(P)
-    n_targets = T.shape[1]
     _score_impacts(flags, imp, C, T, t_geo, body, qual, seq, cluster)
-    for b in range(flags.shape[0]):
-        f = flags[b]
-        if f == ROW_SKIP:
-            continue
-        now = sim_time[b]
-        if f == ROW_STEPPED:
-            C[b, SI.steps] += 1
-            _close_windows(T, t_geo, b, now)
-        elif f == ROW_RESET:
-            C[b, SI.steps] = 0
-        if cluster:
-            for q in range(body.shape[1]):
-                body[b, q] = clusters[b, q]
-        n_hit, failed = _target_tally(T, b)
-        C[b, SI.targets_hit] = n_hit
-
-        S[b, SF.energy] = _observe_balls(obs, b, pos, vel, masses, body, qual, cluster, area, P)
-        o = _observe_targets(obs, len(BALL_OBS) * pos.shape[1], b, C, T, t_geo, seq, now, area, P)
-        obs[b, o + GLOBAL_OBS.steps_left] = min(max(1.0 - C[b, SI.steps] / n_steps, 0.0), 1.0)
-        obs[b, o + GLOBAL_OBS.targets_left] = (n_targets - n_hit) / n_targets
-
-        phi_new = -(_aim_distance(b, pos, vel, radii, body, qual, cluster, C, T, t_geo, seq, area[4], P)
-                    if shaping else 1.0)
-        _write_outcome(S, C, b, f, n_hit == n_targets, failed, phi_new, n_steps, P)
+    _advance_episodes(flags, sim_time, clusters, C, T, t_geo, body, cluster)
+    _observe(flags, obs, S, pos, vel, masses, body, qual, C, T, t_geo, sim_time, seq, cluster, n_steps, P)
+    _settle(flags, S, C, T, t_geo, pos, vel, radii, body, qual, seq, cluster, n_steps, P)
 
 
 # --------------------------------------------------------------------------------------------- #
@@ -470,81 +440,89 @@ def block_size(n_balls: int, n_targets: int, tries: int) -> int:
 
 
 @njit(inline="always")
-def _draw_velocities(U, r, ctrl_mask, E, dim, vel):  # pragma: no cover - numba
+def _draw_velocities(U, ctrl_mask, E, dim, vel):  # pragma: no cover - numba
     """Speeds uniform in the ball's range, directions uniform (a random sign in 1D)."""
     N = vel.shape[1]
-    for i in range(N):
-        if ctrl_mask[i]:
-            lo, hi = E[EPISODE_FLOATS.speed_low], E[EPISODE_FLOATS.speed_high]
-        else:
-            lo, hi = E[EPISODE_FLOATS.others_low], E[EPISODE_FLOATS.others_high]
-        speed = lo + (hi - lo) * U[r, N + i]
-        u = U[r, 2 * N + i]
-        if dim == 1:
-            vel[r, i, 0] = speed if u < 0.5 else -speed
-            vel[r, i, 1] = 0.0
-        else:
-            vel[r, i, 0] = speed * math.cos(2.0 * math.pi * u)
-            vel[r, i, 1] = speed * math.sin(2.0 * math.pi * u)
+    for r in range(U.shape[0]):
+        for i in range(N):
+            if ctrl_mask[i]:
+                lo, hi = E[EPISODE_FLOATS.speed_low], E[EPISODE_FLOATS.speed_high]
+            else:
+                lo, hi = E[EPISODE_FLOATS.others_low], E[EPISODE_FLOATS.others_high]
+            speed = lo + (hi - lo) * U[r, N + i]
+            u = U[r, 2 * N + i]
+            if dim == 1:
+                vel[r, i, 0] = speed if u < 0.5 else -speed
+                vel[r, i, 1] = 0.0
+            else:
+                vel[r, i, 0] = speed * math.cos(2.0 * math.pi * u)
+                vel[r, i, 1] = speed * math.sin(2.0 * math.pi * u)
 
 
 @njit(inline="always")
-def _place_on_line(U, r, off, radii, xmin, xmax, pos):  # pragma: no cover - numba
-    """Balls left to right by index, the free length split at sorted uniform points."""
+def _place_on_line(U, off, radii, E, pos, ok):  # pragma: no cover - numba
+    """Balls left to right by index, the free length split at sorted uniform points (always fits)."""
     N = pos.shape[1]
-    free = (xmax - xmin) - _GAP * (N + 1)
-    for i in range(N):
-        free -= 2.0 * radii[r, i]
-    us = np.sort(U[r, off:off + N] * free)
-    edge = xmin
-    for i in range(N):
-        edge += _GAP
-        pos[r, i, 0] = edge + us[i] + radii[r, i]
-        pos[r, i, 1] = 0.0
-        edge += 2.0 * radii[r, i]
+    xmin = E[EPISODE_FLOATS.xmin]
+    xmax = E[EPISODE_FLOATS.xmax]
+    for r in range(U.shape[0]):
+        free = (xmax - xmin) - _GAP * (N + 1)
+        for i in range(N):
+            free -= 2.0 * radii[r, i]
+        us = np.sort(U[r, off:off + N] * free)
+        edge = xmin
+        for i in range(N):
+            edge += _GAP
+            pos[r, i, 0] = edge + us[i] + radii[r, i]
+            pos[r, i, 1] = 0.0
+            edge += 2.0 * radii[r, i]
+        ok[r] = True
 
 
 @njit(inline="always")
-def _place_in_box(U, r, off, tries, ctrl_mask, rack, radii, E, pos):  # pragma: no cover - numba
-    """Each ball at the first of its tries that overlaps no ball placed before it; False if none does."""
+def _place_in_box(U, off, tries, ctrl_mask, rack, radii, E, pos, ok):  # pragma: no cover - numba
+    """Each ball at the first of its tries that overlaps no ball placed before it; ``ok[r]`` False
+    when some ball of row r found no such place."""
     xmin = E[EPISODE_FLOATS.xmin]
     ymin = E[EPISODE_FLOATS.ymin]
     xmax = E[EPISODE_FLOATS.xmax]
     ymax = E[EPISODE_FLOATS.ymax]
-    for i in range(pos.shape[1]):
-        rad = radii[r, i]
-        lo_x = xmin + rad + _GAP
-        hi_x = xmax - rad - _GAP
-        if rack:
-            if ctrl_mask[i]:
-                hi_x = min(hi_x, xmin + 0.4 * (xmax - xmin) - rad)
-            else:
-                lo_x = max(lo_x, xmin + 0.5 * (xmax - xmin) + rad)
-        lo_y = ymin + rad + _GAP
-        hi_y = ymax - rad - _GAP
-        placed = False
-        for t in range(tries):
-            px = lo_x + (hi_x - lo_x) * U[r, off + 2 * (i * tries + t)]
-            py = lo_y + (hi_y - lo_y) * U[r, off + 2 * (i * tries + t) + 1]
-            free_spot = True
-            for j in range(i):
-                dx = pos[r, j, 0] - px
-                dy = pos[r, j, 1] - py
-                if math.sqrt(dx * dx + dy * dy) <= radii[r, j] + rad + _GAP:
-                    free_spot = False
+    for r in range(U.shape[0]):
+        ok[r] = True
+        for i in range(pos.shape[1]):
+            rad = radii[r, i]
+            lo_x = xmin + rad + _GAP
+            hi_x = xmax - rad - _GAP
+            if rack:
+                if ctrl_mask[i]:
+                    hi_x = min(hi_x, xmin + 0.4 * (xmax - xmin) - rad)
+                else:
+                    lo_x = max(lo_x, xmin + 0.5 * (xmax - xmin) + rad)
+            lo_y = ymin + rad + _GAP
+            hi_y = ymax - rad - _GAP
+            placed = False
+            for t in range(tries):
+                px = lo_x + (hi_x - lo_x) * U[r, off + 2 * (i * tries + t)]
+                py = lo_y + (hi_y - lo_y) * U[r, off + 2 * (i * tries + t) + 1]
+                free_spot = True
+                for j in range(i):
+                    dx = pos[r, j, 0] - px
+                    dy = pos[r, j, 1] - py
+                    if math.sqrt(dx * dx + dy * dy) <= radii[r, j] + rad + _GAP:
+                        free_spot = False
+                        break
+                if free_spot:
+                    pos[r, i, 0] = px
+                    pos[r, i, 1] = py
+                    placed = True
                     break
-            if free_spot:
-                pos[r, i, 0] = px
-                pos[r, i, 1] = py
-                placed = True
+            if not placed:
+                ok[r] = False
                 break
-        if not placed:
-            return False
-    return True
 
 
 @njit(inline="always")
-def _draw_targets(U, r, off, walls, dim, E, t_wall, t_geo):  # pragma: no cover - numba
+def _draw_targets(U, off, walls, dim, E, t_wall, t_geo):  # pragma: no cover - numba
     """Target walls uniform among ``walls``, centres uniform along the wall (the whole end wall in 1D)."""
     K = t_wall.shape[1]
     nw = walls.shape[0]
@@ -552,36 +530,38 @@ def _draw_targets(U, r, off, walls, dim, E, t_wall, t_geo):  # pragma: no cover 
     ymin = E[EPISODE_FLOATS.ymin]
     xmax = E[EPISODE_FLOATS.xmax]
     ymax = E[EPISODE_FLOATS.ymax]
-    for k in range(K):
-        w = walls[min(int(U[r, off + k] * nw), nw - 1)]
-        t_wall[r, k] = w
-        if dim == 1:
-            t_geo[r, k, TG.centre] = 0.5 * (ymin + ymax)
-            t_geo[r, k, TG.half_width] = 0.5 * (ymax - ymin)
-        else:
-            hw = E[EPISODE_FLOATS.half_width]
-            lo_s = (ymin if _on_side_wall(w) else xmin) + hw
-            hi_s = (ymax if _on_side_wall(w) else xmax) - hw
-            t_geo[r, k, TG.centre] = lo_s + (hi_s - lo_s) * U[r, off + K + k]
-            t_geo[r, k, TG.half_width] = hw
+    hw = E[EPISODE_FLOATS.half_width]
+    for r in range(U.shape[0]):
+        for k in range(K):
+            w = walls[min(int(U[r, off + k] * nw), nw - 1)]
+            t_wall[r, k] = w
+            if dim == 1:
+                t_geo[r, k, TG.centre] = 0.5 * (ymin + ymax)
+                t_geo[r, k, TG.half_width] = 0.5 * (ymax - ymin)
+            else:
+                lo_s = (ymin if _on_side_wall(w) else xmin) + hw
+                hi_s = (ymax if _on_side_wall(w) else xmax) - hw
+                t_geo[r, k, TG.centre] = lo_s + (hi_s - lo_s) * U[r, off + K + k]
+                t_geo[r, k, TG.half_width] = hw
 
 
 @njit(inline="always")
-def _draw_windows(U, r, off, E, t_geo):  # pragma: no cover - numba
+def _draw_windows(U, off, E, t_geo):  # pragma: no cover - numba
     """Time windows opening at sorted uniform times, so that the targets come due in index order."""
     K = t_geo.shape[1]
-    if E[EPISODE_FLOATS.window] < 0.0:
-        for k in range(K):
-            t_geo[r, k, TG.opens] = -_NO_WINDOW
-            t_geo[r, k, TG.closes] = _NO_WINDOW
-        return
     win = E[EPISODE_FLOATS.window]
     latest = E[EPISODE_FLOATS.time_limit] - win
     earliest = min(1.0, latest)
-    opens = np.sort(U[r, off:off + K])
-    for k in range(K):
-        t_geo[r, k, TG.opens] = earliest + (latest - earliest) * opens[k]
-        t_geo[r, k, TG.closes] = t_geo[r, k, TG.opens] + win
+    for r in range(U.shape[0]):
+        if win < 0.0:
+            for k in range(K):
+                t_geo[r, k, TG.opens] = -_NO_WINDOW
+                t_geo[r, k, TG.closes] = _NO_WINDOW
+            continue
+        opens = np.sort(U[r, off:off + K])
+        for k in range(K):
+            t_geo[r, k, TG.opens] = earliest + (latest - earliest) * opens[k]
+            t_geo[r, k, TG.closes] = t_geo[r, k, TG.opens] + win
 
 
 @njit
@@ -600,16 +580,12 @@ def build_episodes(U, ctrl_mask, walls, E, F, pos, vel, masses, radii, t_wall, t
     dim = F[EPISODE_INTS.dimension]
     N = F[EPISODE_INTS.n_balls]
     K = F[EPISODE_INTS.n_targets]
-    rack = F[EPISODE_INTS.rack] != 0
-    tries = F[EPISODE_INTS.tries]
     off_targets = 3 * N
     off_places = 3 * N + 3 * K
-    for r in range(U.shape[0]):
-        _draw_velocities(U, r, ctrl_mask, E, dim, vel)
-        if dim == 1:
-            _place_on_line(U, r, off_places, radii, E[EPISODE_FLOATS.xmin], E[EPISODE_FLOATS.xmax], pos)
-            ok[r] = True
-        else:
-            ok[r] = _place_in_box(U, r, off_places, tries, ctrl_mask, rack, radii, E, pos)
-        _draw_targets(U, r, off_targets, walls, dim, E, t_wall, t_geo)
-        _draw_windows(U, r, off_targets + 2 * K, E, t_geo)
+    _draw_velocities(U, ctrl_mask, E, dim, vel)
+    if dim == 1:
+        _place_on_line(U, off_places, radii, E, pos, ok)
+    else:
+        _place_in_box(U, off_places, F[EPISODE_INTS.tries], ctrl_mask, F[EPISODE_INTS.rack] != 0, radii, E, pos, ok)
+    _draw_targets(U, off_targets, walls, dim, E, t_wall, t_geo)
+    _draw_windows(U, off_targets + 2 * K, E, t_geo)
