@@ -31,17 +31,16 @@ import numpy as np
 from ._jit import njit
 from .ldp import least_distance
 from .motion import advance_all, ball_views, body_kinematics, has_rotation
-from .response import ball_ball, ball_wall, elastic_threshold, merge_bodies, stop_body
+from .response import ball_ball, ball_wall, group_threshold, impact_threshold, merge_bodies, stop_body
 from .toi import INF, ca_pair, ca_wall, toi_pair, toi_wall
+from .tolerance import CONTACT_RTOL, contact_tolerance
 
 # counters: 0 pair predictions, 1 wall predictions, 2 events, 3 rotating-cluster predictions
 PAIR_TESTS, WALL_TESTS, EVENTS, CLUSTER_TESTS = 0, 1, 2, 3
 
-#: Contact tolerance (relative to the length scale): re-verifying a cluster event, and which
-#: balls touch in a contact group.
-_CONTACT_TOL = 1e-9
 #: Sweeps over a contact group in one instant before the cascade is replaced by its limit (see
-#: ``_settle_contact_group``). Cascades among comparable masses end within a few dozen sweeps.
+#: ``_settle_contact_group``). Cascades among comparable masses end within a few dozen sweeps; the
+#: criterion is a count, so it does not depend on the masses, and the limit always ends the cascade.
 _MAX_SWEEPS = 1000
 #: Columns of the per-scene work arrays: float (time left in the step, start time of the step);
 #: int (events so far, active, stalled, sub-steps done).
@@ -164,20 +163,43 @@ def _rescan(i, pt, rmin, rarg):
 
 
 @njit(inline="always")
+def _coord(i, pos):
+    """Magnitude of ball ``i``'s coordinates (what the round-off of its gaps is relative to)."""
+    return max(abs(pos[i, 0]), abs(pos[i, 1]))
+
+
+@njit(inline="always")
 def _touching(a, k, pos, radius):
-    """Balls ``a`` and ``k`` touch within the contact tolerance."""
+    """Balls ``a`` and ``k`` touch within the contact tolerance (``tolerance.contact_tolerance``:
+    1e-9 of the radii, or the round-off of their coordinates)."""
     dx = pos[k, 0] - pos[a, 0]
     dy = pos[k, 1] - pos[a, 1]
-    scale = radius[a] + radius[k] + abs(pos[a, 0]) + abs(pos[a, 1]) + abs(pos[k, 0]) + abs(pos[k, 1])
-    return math.sqrt(dx * dx + dy * dy) - radius[a] - radius[k] <= _CONTACT_TOL * scale
+    sigma = radius[a] + radius[k]
+    tol = contact_tolerance(sigma, max(_coord(a, pos), _coord(k, pos)), CONTACT_RTOL)
+    return math.sqrt(dx * dx + dy * dy) - sigma <= tol
+
+
+@njit(inline="always")
+def wall_contact(i, wall, pos, radius, bounds):
+    """Ball ``i`` touches ``wall`` within the contact tolerance (1e-9 of its diameter, or the
+    round-off of its coordinates and the wall's)."""
+    line = bounds[0] if wall == 0 else bounds[2] if wall == 1 else bounds[1] if wall == 2 else bounds[3]
+    coord = max(_coord(i, pos), abs(line))
+    return wall_gap(i, wall, pos, radius, bounds) <= contact_tolerance(2.0 * radius[i], coord, CONTACT_RTOL)
 
 
 @njit
 def _resolve_contact_group(
-    sc, t_abs, i0, j0, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, u_min, imp, n_imp, counters,
-    group, in_group, c_a, c_b, c_hit,
+    sc, t_abs, i0, j0, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, u_min, ratio, imp, n_imp,
+    counters, group, in_group, c_a, c_b, c_hit,
 ):
     """Resolve, at one instant, every contact of the group of touching balls an impact started.
+
+    The impact was between ball ``i0`` and ball ``j0``, or the wall ``-1 - j0`` when ``j0 < 0``;
+    the caller has applied and reported it, so that contact is not reported again here (one
+    collision, one report, even when round-off leaves it closing at ~1e-16 m/s after a plastic
+    impulse). ``u_min`` is the impact's regulariser speed; the group's is the larger of it and
+    ``ratio`` times the group's fastest ball (``response.group_threshold``).
 
     At e < 1 an impact inside a touching group (a train pressed against a wall, a crowd) starts a
     cascade of ever smaller impulses at the same instant: sequential impulses converge to the
@@ -185,14 +207,15 @@ def _resolve_contact_group(
     order apply the same pairwise impulses as the event loop would, one after another, without
     re-predicting every ball after each; the collapse regulariser ends it. A cascade still running
     after ``_MAX_SWEEPS`` sweeps (its convergence rate is set by a mass ratio) is finished by
-    ``_settle_contact_group``. Contacts are gaps within ``_CONTACT_TOL`` of zero. Every contact
-    that takes an impulse is reported once. Returns the group size (its balls are in ``group``).
+    ``_settle_contact_group``. Contacts are gaps within the contact tolerance of zero
+    (:func:`_touching`, :func:`wall_contact`). Every contact that takes an impulse is reported
+    once. Returns the group size (its balls are in ``group``).
     """
     n = pos.shape[0]
     for k in range(n):
         in_group[k] = False
     size = 0
-    for start in (i0, j0):
+    for start in (i0, j0):  # j0 < 0: a wall
         if start >= 0 and not in_group[start]:
             group[size] = start
             in_group[start] = True
@@ -217,16 +240,16 @@ def _resolve_contact_group(
                 if _touching(a, k, pos, radius):
                     c_a[n_contacts] = min(a, k)
                     c_b[n_contacts] = max(a, k)
-                    c_hit[n_contacts] = False
+                    c_hit[n_contacts] = j0 >= 0 and c_a[n_contacts] == min(i0, j0) and c_b[n_contacts] == max(i0, j0)
                     n_contacts += 1
         if has_walls:
-            scale = _CONTACT_TOL * (2.0 * radius[a] + abs(pos[a, 0]) + abs(pos[a, 1]))
             for wall in range(4 if dim == 2 else 2):
-                if wall_gap(a, wall, pos, radius, bounds) <= scale:
+                if wall_contact(a, wall, pos, radius, bounds):
                     c_a[n_contacts] = a
                     c_b[n_contacts] = -1 - wall
-                    c_hit[n_contacts] = False
+                    c_hit[n_contacts] = a == i0 and j0 == -1 - wall
                     n_contacts += 1
+    u_min = group_threshold(group, size, vel, ratio, u_min)
     changed = True
     for _ in range(_MAX_SWEEPS):
         changed = False
@@ -300,11 +323,13 @@ def _settle_contact_group(
     between a wall and a ball ``M/m`` times heavier gets there only after about ``M/m`` sweeps.
     This jumps to that limit, regularised as everywhere else: the velocities closest to the
     current ones in the kinetic-energy metric at which every contact of the group separates at
-    ``u_min`` or faster (a least-distance problem in mass-weighted velocities, solved exactly by
-    Lawson & Hanson's NNLS). Momentum is conserved by ball-ball impulses and energy does not grow
-    by more than the regulariser's ``u_min`` allowance. Where no velocities separate every contact
-    (a chain wedged between opposite walls), the contacts are brought to rest instead, which is
-    always possible.
+    ``u_min`` or faster (a least-distance problem in mass-weighted velocities, solved by
+    ``ldp.least_distance`` whatever the mass ratio). Momentum is conserved by ball-ball impulses
+    and energy does not grow by more than the regulariser's ``u_min`` allowance. Where no
+    velocities separate every contact (a chain wedged between opposite walls), the contacts are
+    brought to rest instead, which is always possible. The result is checked: should round-off
+    still leave a contact closing, the group takes its centre-of-mass velocity (no wall among its
+    contacts) or stops (a wall among them), which ends the cascade in every case.
     """
     dof = 2 * size
     g_mat = np.zeros((n_contacts, dof))
@@ -315,6 +340,7 @@ def _settle_contact_group(
         slot[group[q]] = q
         root_w[q] = math.sqrt(inv_mass[group[q]])
     closing = np.empty(n_contacts)
+    fastest = 0.0
     for c in range(n_contacts):
         a = c_a[c]
         b = c_b[c]
@@ -330,6 +356,7 @@ def _settle_contact_group(
             g_mat[c, 2 * qb + 1] = ny * root_w[qb]
             sep += vel[b, 0] * nx + vel[b, 1] * ny
         closing[c] = -sep
+        fastest = max(fastest, abs(sep))
         h[c] = u_min - sep
     x, feasible = least_distance(g_mat, h)
     if not feasible:
@@ -340,10 +367,50 @@ def _settle_contact_group(
         i = group[q]
         vel[i, 0] += x[2 * q] * root_w[q]
         vel[i, 1] += x[2 * q + 1] * root_w[q]
+    if not _contacts_open(vel, pos, c_a, c_b, n_contacts, 16.0 * 2.0**-52 * fastest):
+        _stop_group(vel, inv_mass, group, size, c_b, n_contacts)
     for c in range(n_contacts):
         if closing[c] > 0.0:
             counters[EVENTS] += 1
             _record_contact(sc, t_abs, c, c_a, c_b, c_hit, pos, radius, bounds, closing[c], imp, n_imp)
+
+
+@njit
+def _contacts_open(vel, pos, c_a, c_b, n_contacts, slack):
+    """No contact of the group closes faster than ``slack`` (m/s)."""
+    for c in range(n_contacts):
+        a = c_a[c]
+        b = c_b[c]
+        nx, ny = _contact_normal(c, c_a, c_b, pos)
+        sep = -(vel[a, 0] * nx + vel[a, 1] * ny)
+        if b >= 0:
+            sep += vel[b, 0] * nx + vel[b, 1] * ny
+        if sep < -slack:
+            return False
+    return True
+
+
+@njit
+def _stop_group(vel, inv_mass, group, size, c_b, n_contacts):
+    """The last resort of :func:`_settle_contact_group`: every contact at rest, at once."""
+    on_wall = False
+    for c in range(n_contacts):
+        on_wall = on_wall or c_b[c] < 0
+    mass = 0.0
+    px = 0.0
+    py = 0.0
+    for q in range(size):
+        i = group[q]
+        m = 1.0 / inv_mass[i]
+        mass += m
+        px += m * vel[i, 0]
+        py += m * vel[i, 1]
+    vx = 0.0 if on_wall else px / mass
+    vy = 0.0 if on_wall else py / mass
+    for q in range(size):
+        i = group[q]
+        vel[i, 0] = vx
+        vel[i, 1] = vy
 
 
 def scratch_sizes(n):
@@ -421,7 +488,6 @@ def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, coun
         t0 = time[sc]
         now = 0.0
         rot = sticky and has_rotation(body, omega)
-        u_min = elastic_threshold(vel, ratio, floor)
 
         for i in range(n):
             wt[i] = INF
@@ -481,10 +547,9 @@ def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, coun
             if bj < 0:  # ball bi meets wall wid[bi]
                 wall = wid[bi]
                 if sticky:
-                    scale = radius[bi] + abs(pos[bi, 0]) + abs(pos[bi, 1])
                     axis = 0 if wall < 2 else 1
                     into = vel[bi, axis] < 0.0 if wall % 2 == 0 else vel[bi, axis] > 0.0
-                    if wall_gap(bi, wall, pos, radius, bounds) <= _CONTACT_TOL * scale and into:
+                    if wall_contact(bi, wall, pos, radius, bounds) and into:
                         if omega[body[bi]] == 0.0:
                             snap_to_wall(bi, wall, pos, radius, bounds)
                         x, y = wall_point(bi, wall, pos, radius, bounds)
@@ -500,6 +565,7 @@ def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, coun
                         n_inv = 1
                 else:
                     snap_to_wall(bi, wall, pos, radius, bounds)
+                    u_min = impact_threshold(bi, -1, vel, ratio, floor)
                     speed = ball_wall(bi, wall, vel, e, u_min)
                     if speed > 0.0:
                         x, y = wall_point(bi, wall, pos, radius, bounds)
@@ -508,18 +574,16 @@ def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, coun
                     n_inv = 1
                     if cascades and speed > 0.0:
                         n_inv = _resolve_contact_group(
-                            sc, t_abs, bi, -1, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, u_min,
-                            imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit,
+                            sc, t_abs, bi, -1 - wall, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e,
+                            u_min, ratio, imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit,
                         )
             else:  # balls bi and bj meet
                 dx = pos[bj, 0] - pos[bi, 0]
                 dy = pos[bj, 1] - pos[bi, 1]
                 dist = math.sqrt(dx * dx + dy * dy)
-                sigma = radius[bi] + radius[bj]
                 closing = (vel[bj, 0] - vel[bi, 0]) * dx + (vel[bj, 1] - vel[bi, 1]) * dy
                 if sticky:
-                    scale = sigma + abs(pos[bi, 0]) + abs(pos[bi, 1])
-                    if dist - sigma <= _CONTACT_TOL * scale and closing < 0.0:
+                    if _touching(bi, bj, pos, radius) and closing < 0.0:
                         x = pos[bi, 0] + radius[bi] * dx / dist
                         y = pos[bi, 1] + radius[bi] * dy / dist
                         record(imp, n_imp, sc, t_abs, bi, bj, -1, x, y, -closing / dist)
@@ -534,6 +598,7 @@ def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, coun
                         involved[1] = bj
                         n_inv = 2
                 else:
+                    u_min = impact_threshold(bi, bj, vel, ratio, floor)
                     speed = ball_ball(bi, bj, pos, vel, inv_mass, e, u_min)
                     if speed > 0.0:
                         x = pos[bi, 0] + radius[bi] * dx / dist
@@ -545,7 +610,7 @@ def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, coun
                     if cascades and speed > 0.0:
                         n_inv = _resolve_contact_group(
                             sc, t_abs, bi, bj, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, u_min,
-                            imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit,
+                            ratio, imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit,
                         )
             if sticky:
                 rot = has_rotation(body, omega)

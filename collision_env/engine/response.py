@@ -10,13 +10,17 @@ Ball-wall: ``v_n' = -e v_n``.
 
 **Collapse regulariser.** With e < 1, hard disks can collide infinitely often in finite time
 (inelastic collapse; McNamara & Young 1992), and a touching train pressed against a wall at e = 0
-is resolved by an infinite cascade of ever smaller impulses at one instant. Per scene and step
-the engine sets a tiny speed
+is resolved by an infinite cascade of ever smaller impulses at one instant. Every impact gets a
+tiny speed from the balls it involves, and from nothing else:
 
-    u_min = max(collapse_ratio * (largest ball speed at the start of the step), collapse_floor)
+    u_min = max(collapse_ratio * s, collapse_floor)
 
-(defaults 1e-9 and 1e-15 m/s, far below anything measurable and far above the round-off of the
-velocities) and
+where ``s`` is the fastest of the two balls just before the impact (the ball alone for a wall
+impact) or, inside a contact group resolved at one instant, the fastest ball of that group when
+the group is formed (see ``exact._resolve_contact_group``). Defaults: ``collapse_ratio`` = 1e-9,
+``collapse_floor`` = 0 m/s. ``u_min`` is far below anything measurable and, at 1e-9 of the speeds
+involved, far above their round-off (2.2e-16 of them), so a pair set apart at ``u_min`` really
+separates. The rule
 
 - makes a collision whose normal closing speed is at most ``u_min`` leave the pair (or the ball
   and the wall) separating at ``u_min``: elastic, or a hair more (as DynamO's ``ElasticV`` and
@@ -27,11 +31,17 @@ velocities) and
 
 A cascade that the rule does not end quickly because it converges at a rate set by a mass ratio
 (a light ball pressed between a wall and a far heavier ball) is replaced by its limit after a
-fixed number of sweeps: see ``exact._settle_contact_group``.
+fixed number of sweeps, whatever the ratio: see ``exact._settle_contact_group``.
 
-The rule can add at most ``1/2 mu u_min^2`` of energy to a collision whose closing speed
-was below ``u_min`` (1e-18 of the kinetic energy with the default ratio), which is below the
-round-off of the energy itself. Elastic scenes are otherwise unaffected.
+Energy: the rule can add at most ``1/2 mu u_min^2`` to a collision whose closing speed was below
+``u_min``. With ``u_min = collapse_ratio * s`` that is at most ``collapse_ratio^2`` (1e-18) of the
+kinetic energy of the balls involved, below the round-off of the energy itself, so at e < 1 the
+energy never grows beyond round-off, and balls that take no part in the impact have no say in it.
+A positive ``collapse_floor`` (an absolute minimum separation speed, m/s) trades that bound for
+``1/2 mu collapse_floor^2`` per collision. Elastic scenes are otherwise unaffected.
+
+The cheap modes (naive, posteriori) keep one threshold per scene and sub-step,
+:func:`elastic_threshold`, relative to the scene's fastest ball.
 
 Stick scenes (e = 0, ``inelastic="stick"``): colliding bodies merge into one rigid cluster that
 keeps the total momentum and the total angular momentum about the new centre of mass
@@ -48,11 +58,31 @@ from ._jit import njit
 
 @njit(inline="always")
 def elastic_threshold(vel, collapse_ratio, collapse_floor):
-    """``u_min`` for one scene: the closing speed at or below which a collision is elastic."""
+    """``u_min`` for one scene of the cheap modes: relative to the scene's fastest ball."""
     fastest = 0.0
     for i in range(vel.shape[0]):
         fastest = max(fastest, vel[i, 0] * vel[i, 0] + vel[i, 1] * vel[i, 1])
     return max(collapse_ratio * math.sqrt(fastest), collapse_floor)
+
+
+@njit(inline="always")
+def impact_threshold(i, j, vel, collapse_ratio, collapse_floor):
+    """``u_min`` of an impact of ball ``i`` with ball ``j`` (``j < 0``: a wall), from their speeds."""
+    fastest = vel[i, 0] * vel[i, 0] + vel[i, 1] * vel[i, 1]
+    if j >= 0:
+        fastest = max(fastest, vel[j, 0] * vel[j, 0] + vel[j, 1] * vel[j, 1])
+    return max(collapse_ratio * math.sqrt(fastest), collapse_floor)
+
+
+@njit(inline="always")
+def group_threshold(group, size, vel, collapse_ratio, u_min):
+    """``u_min`` of a contact group: at least the impact's own ``u_min``, and ``collapse_ratio``
+    times the group's fastest ball (the group's balls are ``group[:size]``)."""
+    fastest = 0.0
+    for q in range(size):
+        i = group[q]
+        fastest = max(fastest, vel[i, 0] * vel[i, 0] + vel[i, 1] * vel[i, 1])
+    return max(collapse_ratio * math.sqrt(fastest), u_min)
 
 
 @njit(inline="always")
