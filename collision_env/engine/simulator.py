@@ -115,6 +115,8 @@ def _is_real(x):
 
 def _real_number(value, field):
     """``value`` as a float: a real number (numpy scalar types included), not a boolean or a string."""
+    if isinstance(value, float):  # the common case (np.float64 too), at the cost of one test
+        return value
     if isinstance(value, np.ndarray) and value.ndim == 0:
         value = value[()]
     if not _is_real(value):
@@ -146,21 +148,23 @@ def _real_array(value, shapes, field, where):
 
 
 @njit
-def _advance_clocks(time, time_lo, start, remaining, dt_abs, sign):
-    """Compensated clocks: each scene's time is the pair ``time + time_lo`` (``time`` the correctly
-    rounded value), advanced by ``sign * dt_abs`` with Knuth's TwoSum and a renormalisation, so it
-    stays within an ulp of the exact sum of the steps. A scene that stopped short of the step's end
-    (``remaining[sc] > 0``: the event cap) keeps the time of its last event, as the kernel set it."""
+def _advance_clocks(time, clock, work_f, dt_abs, sign):
+    """Compensated clocks. ``clock[sc]`` = (the time at the start of the step, its compensation):
+    the exact time is their sum, and ``time`` (which the kernels read, and overwrite during the step)
+    its correctly rounded value. A scene that completed its step (``work_f[sc, 0]``, the time left
+    in it, is 0) advances by ``sign * dt_abs`` through Knuth's TwoSum and a renormalisation, so the
+    clock stays within an ulp of the exact sum of the steps. A scene that stopped short (the event
+    cap) keeps the time of its last event, as the kernel set it."""
     a = sign * dt_abs
     for sc in range(time.shape[0]):
-        if remaining[sc] != 0.0:
-            continue
-        hi = start[sc] + a
-        b = hi - start[sc]
-        lo = time_lo[sc] + ((start[sc] - (hi - b)) + (a - b))
-        t = hi + lo
-        time_lo[sc] = lo - (t - hi)
-        time[sc] = t
+        start = clock[sc, 0]
+        if work_f[sc, 0] == 0.0:
+            hi = start + a
+            b = hi - start
+            lo = clock[sc, 1] + ((start - (hi - b)) + (a - b))
+            time[sc] = hi + lo
+            clock[sc, 1] = lo - (time[sc] - hi)
+        clock[sc, 0] = time[sc]
 
 
 class BatchSimulator:
@@ -248,7 +252,7 @@ class BatchSimulator:
         self._radius[...] = radius
         self._body = np.tile(np.arange(n, dtype=np.int64), (n_scenes, 1))
         self._time = np.zeros(n_scenes)
-        self._time_lo = np.zeros(n_scenes)  # the clocks' compensation: the time is _time + _time_lo
+        self._clock = np.zeros((n_scenes, 2))  # per scene: _time as the clock set it, its compensation
         self._capped = np.zeros(n_scenes, dtype=np.bool_)
         self._counters = np.zeros(4, dtype=np.int64)
 
@@ -364,7 +368,6 @@ class BatchSimulator:
         self._n_imp = np.zeros(2, dtype=np.int64)  # rows filled, scenes that reached the cap
         self._work_f = np.zeros((b, WORK_F))  # per scene: time left in the step, sub-step start time
         self._work_i = np.zeros((b, WORK_I), dtype=np.int64)  # per scene: events, active, stalled, sub-steps done
-        self._t_start = np.zeros(b)  # the clocks at the start of the step (see _advance_clocks)
         # the mode's kernel and its arguments, bound once (the arrays are only ever updated in place)
         state = (self._balls, self._body, self._time, self._capped, self._fparams, self._iparams, self._imp,
                  self._n_imp, self._counters, self._work_f, self._work_i)
@@ -411,14 +414,13 @@ class BatchSimulator:
         if sign < 0:
             np.negative(self._vel, out=self._vel)
             np.negative(self._omega, out=self._omega)
-        np.copyto(self._t_start, self._time)
         try:
             chunks = self._run(abs(dt))
         finally:
             if sign < 0:
                 np.negative(self._vel, out=self._vel)
                 np.negative(self._omega, out=self._omega)
-            _advance_clocks(self._time, self._time_lo, self._t_start, self._work_f[:, 0], abs(dt), sign)
+            _advance_clocks(self._time, self._clock, self._work_f, abs(dt), sign)
         if self._n_imp[1]:
             warnings.warn(
                 f"event cap of {self.max_events} per step reached in scene(s) {np.flatnonzero(self._capped).tolist()}; "
@@ -610,7 +612,7 @@ class BatchSimulator:
         self._body[idx] = np.arange(self._n)
         self._omega[idx] = 0.0
         self._time[idx] = time
-        self._time_lo[idx] = 0.0
+        self._clock[idx] = (time, 0.0)
 
     def get_state(self):
         """A dict of array copies that :meth:`set_state` restores exactly."""
@@ -622,7 +624,7 @@ class BatchSimulator:
             "clusters": self._body.copy(),
             "omega": self._omega.copy(),
             "time": self._time.copy(),
-            "time_compensation": self._time_lo.copy(),
+            "time_compensation": self._clock[:, 1].copy(),
         }
 
     def set_state(self, state):
@@ -630,7 +632,7 @@ class BatchSimulator:
         the physics of the values is trusted)."""
         shapes = {"positions": self._pos.shape, "velocities": self._vel.shape, "masses": self._mass.shape,
                   "radii": self._radius.shape, "clusters": self._body.shape, "omega": self._omega.shape,
-                  "time": self._time.shape, "time_compensation": self._time_lo.shape}
+                  "time": self._time.shape, "time_compensation": self._time.shape}
         arrays = {}
         for key, shape in shapes.items():
             if key not in state:
@@ -653,7 +655,8 @@ class BatchSimulator:
         np.copyto(self._body, arrays["clusters"])
         np.copyto(self._omega, arrays["omega"])
         np.copyto(self._time, arrays["time"])
-        np.copyto(self._time_lo, arrays["time_compensation"])
+        self._clock[:, 0] = arrays["time"]
+        self._clock[:, 1] = arrays["time_compensation"]
 
     def copy(self):
         """An independent copy (for planning: step it ahead without touching this one)."""
@@ -661,7 +664,7 @@ class BatchSimulator:
 
     def __getstate__(self):
         state = self.__dict__.copy()
-        for key in ("_imp", "_n_imp", "_work_f", "_work_i", "_t_start", "_kernel", "_kernel_args", "_sign", "_live",
+        for key in ("_imp", "_n_imp", "_work_f", "_work_i", "_kernel", "_kernel_args", "_sign", "_live",
                     "_pos", "_vel", "_mass", "_inv_mass", "_radius", "_omega"):
             state.pop(key)
         return state
@@ -750,10 +753,10 @@ class Simulator:
     def set_balls(self, positions=None, velocities=None):
         """Replace positions and/or velocities (validated; on error nothing changes). Time is kept."""
         b = self._batch
-        lo = b._time_lo[0]
+        clock = b._clock[0].copy()
         b.set_scenes([0], b._pos if positions is None else [positions], b._vel if velocities is None else [velocities],
                      time=b._time[0])
-        b._time_lo[0] = lo
+        b._clock[0] = clock
 
     def get_state(self):
         """A dict of array copies (no batch axis) that :meth:`set_state` restores exactly."""
