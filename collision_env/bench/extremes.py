@@ -3,9 +3,11 @@
 Run it as ``python -m collision_env.bench.extremes [--quick] [--out docs/bench]``.
 
 The grid (:func:`cells`) spans speeds 1e-6 to 1e4 m/s, radii 1e-4 to 0.5 m, mass ratios up to
-1e12, restitution 0 (slip and stick), 0.05, 0.5 and 1, control steps 1e-6 to 1 s, episodes up to
-1e5 s of simulated time, balls touching at the start (each other and the walls), exact corner hits
-and grazing contacts. Each cell is one scene, one control step and one duration; every mode runs
+1e12 (1e18 for a light ball squeezed against a wall), restitution 0 (slip and stick), 0.05, 0.5 and
+1, control steps 1e-6 to 1 s, episodes up to 1e5 s of simulated time and 1e6 steps, balls touching
+at the start (each other and the walls), exact corner hits and grazing contacts, scenes 1e6 m from
+the origin, slow pairs beside a fast ball, inputs at the edge of float64 (and just beyond it, which
+must be refused) and balls as tall as the box (refused). Each cell is one scene, one control step and one duration; every mode runs
 it, stepping the public :class:`~collision_env.engine.Simulator` and checking after every step:
 
 - **NaN**: a position or velocity is not finite;
