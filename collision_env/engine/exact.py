@@ -190,7 +190,7 @@ def wall_contact(i, wall, pos, radius, bounds):
 
 @njit
 def _resolve_contact_group(
-    sc, t_abs, i0, j0, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, u_min, ratio, imp, n_imp,
+    sc, t_abs, i0, j0, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, ratio, floor, imp, n_imp,
     counters, group, in_group, c_a, c_b, c_hit,
 ):
     """Resolve, at one instant, every contact of the group of touching balls an impact started.
@@ -198,8 +198,8 @@ def _resolve_contact_group(
     The impact was between ball ``i0`` and ball ``j0``, or the wall ``-1 - j0`` when ``j0 < 0``;
     the caller has applied and reported it, so that contact is not reported again here (one
     collision, one report, even when round-off leaves it closing at ~1e-16 m/s after a plastic
-    impulse). ``u_min`` is the impact's regulariser speed; the group's is the larger of it and
-    ``ratio`` times the group's fastest ball (``response.group_threshold``).
+    impulse). The group's regulariser speed comes from its own balls when it is formed
+    (``response.group_threshold`` of the collapse ``ratio`` and ``floor``).
 
     At e < 1 an impact inside a touching group (a train pressed against a wall, a crowd) starts a
     cascade of ever smaller impulses at the same instant: sequential impulses converge to the
@@ -249,7 +249,7 @@ def _resolve_contact_group(
                     c_b[n_contacts] = -1 - wall
                     c_hit[n_contacts] = a == i0 and j0 == -1 - wall
                     n_contacts += 1
-    u_min = group_threshold(group, size, vel, ratio, u_min)
+    u_min = group_threshold(group, size, vel, inv_mass, ratio, floor)
     changed = True
     for _ in range(_MAX_SWEEPS):
         changed = False
@@ -575,7 +575,7 @@ def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, coun
                     if cascades and speed > 0.0:
                         n_inv = _resolve_contact_group(
                             sc, t_abs, bi, -1 - wall, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e,
-                            u_min, ratio, imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit,
+                            ratio, floor, imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit,
                         )
             else:  # balls bi and bj meet
                 dx = pos[bj, 0] - pos[bi, 0]
@@ -609,8 +609,8 @@ def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, coun
                     n_inv = 2
                     if cascades and speed > 0.0:
                         n_inv = _resolve_contact_group(
-                            sc, t_abs, bi, bj, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, u_min,
-                            ratio, imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit,
+                            sc, t_abs, bi, bj, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, ratio,
+                            floor, imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit,
                         )
             if sticky:
                 rot = has_rotation(body, omega)

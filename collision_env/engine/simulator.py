@@ -195,8 +195,8 @@ class BatchSimulator:
         The inelastic-collapse regulariser: a collision whose normal closing speed is at most
         ``u_min = max(collapse_ratio * s, collapse_floor)`` leaves the pair separating at ``u_min``,
         ``s`` being the fastest speed among the balls of the impact (exact mode; the cheap modes use
-        the scene's fastest ball), see :mod:`collision_env.engine.response`. The default floor, 0,
-        keeps energy from growing beyond round-off at e < 1.
+        the scene's slowest moving ball), see :mod:`collision_env.engine.response`. The default
+        floor, 0, keeps energy from growing beyond round-off at e < 1.
 
     Inputs are real numbers (numpy scalar types included; booleans, strings and complex numbers
     are refused) with finite, representable values: positions and speeds up to 1e150, masses
