@@ -3,10 +3,13 @@
 Run it as ``python -m collision_env.bench.extremes [--quick] [--out docs/bench]``.
 
 The grid (:func:`cells`) spans speeds 1e-6 to 1e4 m/s, radii 1e-4 to 0.5 m, mass ratios up to
-1e12, restitution 0 (slip and stick), 0.05, 0.5 and 1, control steps 1e-6 to 1 s, episodes up to
-1e5 s of simulated time, balls touching at the start (each other and the walls), exact corner hits
-and grazing contacts. Each cell is one scene, one control step and one duration; every mode runs
-it, stepping the public :class:`~collision_env.engine.Simulator` and checking after every step:
+1e12 (1e18 for a light ball squeezed against a wall), restitution 0 (slip and stick), 0.05, 0.5 and
+1, control steps 1e-6 to 1 s, episodes up to 1e5 s of simulated time and 1e6 steps, balls touching
+at the start (each other and the walls), exact corner hits and grazing contacts, scenes 1e6 m from
+the origin, slow pairs beside a fast ball, inputs at the edge of float64 (and just beyond it, which
+must be refused) and balls as tall as the box (refused). Each cell is one scene, one control step
+and one duration; every mode runs it, stepping the public :class:`~collision_env.engine.Simulator`
+and checking after every step:
 
 - **NaN**: a position or velocity is not finite;
 - **escape**: a ball sticks out of the reflecting border by more than ``1e-9 (r + |x|)``;
@@ -120,9 +123,8 @@ def _wall_touch(e):
 
 
 def _wedged(e, gap):
-    """A ball ``gap`` m shorter than the box is tall (r = 1 - gap/2), moving diagonally (gap 0: along x)."""
-    vy = 0.5 if gap > 0 else 0.0
-    return _case(Scene(bounds=PLAY_AREA_2D, elasticity=e), [[0.0, 0.0]], [[1.0, vy]], [1.0], [1.0 - gap / 2])
+    """A ball ``gap`` m shorter than the box is tall (r = 1 - gap/2), moving diagonally."""
+    return _case(Scene(bounds=PLAY_AREA_2D, elasticity=e), [[0.0, 0.0]], [[1.0, 0.5]], [1.0], [1.0 - gap / 2])
 
 
 def _slide(e):
@@ -350,7 +352,6 @@ def cells(quick: bool = False) -> list[Cell]:
         add(f"train on wall 5 e={e:g}", "touching", lambda e=e: _train_on_wall(5, e), 0.01, 2.0, 1e3,
             q=e in (0.0, 0.05), e=e)
         add(f"wall touch pair e={e:g}", "touching", lambda e=e: _wall_touch(e), 0.01, 3.0, 100.0, q=e == 1.0, e=e)
-        add(f"wedged 2r=H e={e:g}", "touching", lambda e=e: _wedged(e, 0.0), 0.01, 5.0, 100.0, q=e == 0.5, e=e)
         add(f"wedged 2r=H-2e-6 e={e:g}", "touching", lambda e=e: _wedged(e, 2e-6), 0.01, 2.0, 3e5, q=e == 1.0, e=e)
     for e in (1.0, 0.05, 0.0):
         add(f"hex pack 19 touching e={e:g}", "touching", lambda e=e: _hex_pack(e), 0.01, 3.0, 1e4, q=e == 0.05, e=e)
@@ -368,7 +369,163 @@ def cells(quick: bool = False) -> list[Cell]:
     for delta, hit in ((1e-3, True), (1e-8, True), (1e-12, True), (0.0, False), (-1e-12, False)):
         add(f"graze 1-{delta:g}", "grazing", lambda d=delta: _two_ball_graze(d), 0.013, 2.0, 10.0, _check_graze(hit),
             q=delta in (1e-12, 0.0), delta=delta)
+    _add_robustness_cells(add)
     return [c for c in out if c.quick] if quick else out
+
+
+# --------------------------------------------------------------------------- robustness cells
+# Squeezed mass ratios, a scene far from the origin, a million-step clock, slow pairs beside a fast
+# ball, inputs at the edge of float64 and boxes with no room: each cell is a scene the engine must
+# run, and where an input must be refused instead, its check makes sure that it is, with a message
+# naming the ball and the field.
+def _squeeze(ratio, e):
+    """A ball ``ratio`` times heavier presses a light ball at rest against the left wall; 1D."""
+    return _case(Scene(bounds=PLAY_AREA_1D, elasticity=e, dimension=1), [[-1.9, 0.0], [-1.5, 0.0]],
+                 [[0.0, 0.0], [-1.0, 0.0]], [1.0, ratio], [0.1, 0.1])
+
+
+def _check_squeeze(t_end):
+    """The clock reached the end, and the heavy ball stopped against the light one (the cascade's limit)."""
+    def check(sim, count, impacts):
+        if abs(sim.time - t_end) > 1e-12 * t_end:
+            return f"clock at {sim.time!r} s, expected {t_end:g} s"
+        v = float(np.abs(sim.velocities[1]).max())
+        return None if v <= 1e-6 else f"heavy ball still at {v:.3g} m/s against the wall"
+    return check
+
+
+def _shifted(case, offset):
+    """``case`` translated by ``offset`` m along x (and y in 2D), border included."""
+    b = case.scene.bounds
+    dy = offset if case.scene.dimension == 2 else 0.0
+    scene = Scene(bounds=(b[0] + offset, b[1] + dy, b[2] + offset, b[3] + dy), elasticity=case.scene.elasticity,
+                  dimension=case.scene.dimension)
+    return Case(scene, case.positions + np.array([offset, dy]), *case[2:])
+
+
+def _near_wall(e):
+    """Ball 0 rests 0.5 mm from the left wall; ball 1 hits it, and only then does it reach the wall; 1D."""
+    return _case(Scene(bounds=PLAY_AREA_1D, elasticity=e, dimension=1), [[-1.8995, 0.0], [-1.0, 0.0]],
+                 [[0.0, 0.0], [-1.0, 0.0]], [1.0, 1.0], [0.1, 0.1])
+
+
+def _three_balls(e):
+    return _case(Scene(bounds=PLAY_AREA_2D, elasticity=e), [[-1.2, -0.4], [0.0, 0.3], [1.1, -0.2]],
+                 [[0.9, 0.4], [-0.3, -0.8], [-0.7, 0.5]], [1.0, 2.0, 0.5], [0.2, 0.25, 0.15])
+
+
+def _run_exact(case, dt, duration):
+    """The impacts of ``case`` in exact mode over ``duration`` (steps of ``dt``) and the final simulator."""
+    sim = Simulator(*case, mode="exact")
+    rows = [sim.batch.step(dt) for _ in range(max(1, int(round(duration / dt))))]
+    return np.concatenate(rows), sim
+
+
+def _check_translation(case, dt, duration):
+    """The same impacts (who and when, within the coordinates' round-off) as the scene at the origin."""
+    def check(sim, count, impacts):
+        want, _ = _run_exact(case, dt, duration)
+        if impacts is None or len(impacts) != len(want):
+            return f"{count} impacts, {len(want)} at the origin"
+        if not all(np.array_equal(impacts[k], want[k]) for k in ("ball", "other", "wall")):
+            return "another impact sequence than at the origin"
+        worst = float(np.max(np.abs(impacts["time"] - want["time"]), initial=0.0))
+        return None if worst <= 1e-8 else f"impact times off those at the origin by up to {worst:.3g} s"
+    return check
+
+
+def _check_clock(case, dt, steps):
+    """The clock is the correctly rounded sum of the steps (within 2 ulps) and the impacts are on time."""
+    lone = _check_lone(case, dt * steps)
+
+    def check(sim, count, impacts):
+        exact = math.fsum([dt] * steps)
+        if abs(sim.time - exact) > 2 * math.ulp(exact):
+            return f"clock {sim.time!r} s off the exact sum {exact!r} s by {sim.time - exact:.3g} s"
+        return lone(sim, count, impacts)
+    return check
+
+
+def _slow_pair(e, fast):
+    """A pair closing at 2e-9 m/s in the middle of the box, and ball 2 far off at ``fast`` m/s."""
+    r = 0.1
+    return _case(Scene(bounds=None, elasticity=e), [[-r - 1e-9, 0.0], [r + 1e-9, 0.0], [5.0, 5.0]],
+                 [[1e-9, 0.0], [-1e-9, 0.0], [fast, fast]], [1.0, 1.0, 1.0], [r, r, r])
+
+
+def _check_slow_pair(e, dt, duration):
+    """The pair ends as it would alone: separating at ``e`` times its closing speed, no energy gained."""
+    def check(sim, count, impacts):
+        _, alone = _run_exact(_slow_pair(e, 0.0), dt, duration)
+        if not np.array_equal(sim.velocities[:2], alone.velocities[:2]):
+            return f"the pair's velocities {sim.velocities[:2, 0].tolist()} depend on the far ball"
+        v = sim.velocities[:2, 0]
+        want = np.array([-e * 1e-9, e * 1e-9])
+        ok = np.allclose(v, want, rtol=1e-6, atol=1e-9 * 1e-9)
+        return None if ok else f"the pair separates at {v.tolist()} m/s, expected {want.tolist()}"
+    return check
+
+
+def _refuses(build, match):
+    """A check that the input ``build()`` makes is refused with a ValueError saying ``match``."""
+    def check(sim, count, impacts):
+        try:
+            build()
+        except ValueError as err:
+            return None if match in str(err) else f"refused with another message: {err}"
+        return f"accepted an input that should be refused ({match})"
+    return check
+
+
+def _light_ball(mass):
+    return _case(Scene(bounds=PLAY_AREA_2D), [[-1.0, 0.1], [1.0, 0.0]], [[1.0, 0.0], [-1.0, 0.0]], [mass, 1.0],
+                 [0.1, 0.1])
+
+
+def _fast_pair(speed):
+    return _case(Scene(bounds=None), [[-1.0, 0.05], [1.0, 0.0]], [[speed, 0.0], [-speed, 0.0]], [1.0, 1.0],
+                 [0.1, 0.1])
+
+
+def _tiny_radius(radius):
+    """A ball of ``radius`` in PhET's box, bouncing; another ball crossing its path."""
+    return _case(Scene(bounds=PLAY_AREA_2D), [[0.0, 0.0], [1.0, 0.5]], [[1.0, 0.5], [-0.5, -0.25]], [1.0, 1.0],
+                 [radius, 0.1])
+
+
+def _add_robustness_cells(add):
+    for exponent in (12, 13, 15, 18):
+        for e in (0.0, 0.5):
+            add(f"squeeze 1e{exponent} e={e:g}", "mass ratio", lambda r=10.0**exponent, e=e: _squeeze(r, e), 0.5, 1.5,
+                0.0, _check_squeeze(1.5), q=exponent == 15 and e == 0.0, cap=2000, ratio=10.0**exponent, e=e)
+    for e in (0.5, 0.0):
+        near = _near_wall(e)
+        add(f"near wall 0.5 mm offset 1e6 e={e:g}", "offset", lambda c=near: _shifted(c, 1e6), 0.1, 1.2, 10.0,
+            _check_translation(near, 0.1, 1.2), q=e == 0.5, e=e, offset=1e6)
+    for e in (1.0, 0.5):
+        three = _three_balls(e)
+        add(f"3 balls offset 1e6 e={e:g}", "offset", lambda c=three: _shifted(c, 1e6), 0.1, 2.0, 10.0,
+            _check_translation(three, 0.1, 2.0), e=e, offset=1e6)
+    lone = _case(Scene(bounds=PLAY_AREA_2D), [[0.3, -0.2]], [[0.7, 0.45]], [1.0], [0.15])
+    add("lone ball 1e6 steps dt=1/60", "long", lambda: lone, 1 / 60, 1e6 / 60, 2.0, _check_clock(lone, 1 / 60, 10**6),
+        T=1e6 / 60)
+    for e in (0.5, 0.0):
+        add(f"slow pair beside 1e3 m/s e={e:g}", "restitution", lambda e=e: _slow_pair(e, 1e3), 0.5, 1.0, 10.0,
+            _check_slow_pair(e, 0.5, 1.0), q=e == 0.5, e=e)
+    add("mass 1e-300 kg", "overflow", lambda: _light_ball(1e-300), 0.01, 2.0, 10.0,
+        _refuses(lambda: Simulator(*_light_ball(1e-310)), "ball 0: mass must be positive and finite, with a finite"),
+        q=True, ratio=1e300)
+    add("speed 1e100 m/s", "overflow", lambda: _fast_pair(1e100), 2e-101, 2e-100, 10.0,
+        _refuses(lambda: Simulator(*_fast_pair(1e200)), "ball 0: velocity must be finite, speed within"), speed=1e100)
+    add("no border dt=1e140", "overflow", lambda: _fast_pair(1.0), 1e140, 1e140, 1.0,
+        _refuses(lambda: Simulator(*_fast_pair(1e10)).step(1e145), "dt: a step of 1e+145 s would take ball"),
+        q=True, cap=100)
+    add("radius 1e-10 m", "overflow", lambda: _tiny_radius(1e-10), 0.01, 2.0, 10.0,
+        _refuses(lambda: Simulator(*_tiny_radius(1e-12)), "ball 0: radius 1e-12 m is too small"), radius=1e-10)
+    for e in (1.0, 0.5, 0.0):
+        add(f"no room 2r=H vy>0 e={e:g}", "touching", lambda e=e: _wedged(e, 1e-3), 0.01, 2.0, 2e3,
+            _refuses(lambda e=e: Simulator(*_wedged(e, 0.0)), "ball 0: radius 1 m leaves no room to move"),
+            q=e == 1.0, e=e)
 
 
 # --------------------------------------------------------------------------- running a cell

@@ -85,19 +85,18 @@ from .layout import (
 )
 from .ldp import least_distance
 from .motion import advance_all, ball_views, body_kinematics, has_rotation
-from .response import ball_ball, ball_wall, elastic_threshold, merge_bodies, stop_body
+from .response import ball_ball, ball_wall, group_threshold, impact_threshold, merge_bodies, stop_body
 from .toi import INF, ca_pair, ca_wall, toi_pair, toi_wall
+from .tolerance import CONTACT_RTOL, contact_tolerance
 
 #: Work counters (``BatchSimulator.stats``): pair predictions, wall predictions, events,
 #: rotating-cluster predictions, grid-cell crossings, stale calendar entries re-predicted.
 COUNTERS = ("pair_tests", "wall_tests", "events", "cluster_tests", "cell_crossings", "stale_events")
 PAIR_TESTS, WALL_TESTS, EVENTS, CLUSTER_TESTS, CELL_CROSSINGS, STALE_EVENTS = range(6)
 
-#: Contact tolerance (relative to the length scale): re-verifying a cluster event, and which
-#: balls touch in a contact group.
-_CONTACT_TOL = 1e-9
 #: Sweeps over a contact group in one instant before the cascade is replaced by its limit (see
-#: ``_settle_contact_group``). Cascades among comparable masses end within a few dozen sweeps.
+#: ``_settle_contact_group``). Cascades among comparable masses end within a few dozen sweeps; the
+#: criterion is a count, so it does not depend on the masses, and the limit always ends the cascade.
 _MAX_SWEEPS = 1000
 
 
@@ -193,20 +192,43 @@ def _predict_wall(i, now, horizon, pos, vel, mass, radius, body, omega, rot, bou
 
 
 @njit(inline="always")
+def _coord(i, pos):
+    """Magnitude of ball ``i``'s coordinates (what the round-off of its gaps is relative to)."""
+    return max(abs(pos[i, 0]), abs(pos[i, 1]))
+
+
+@njit(inline="always")
 def _touching(a, k, pos, radius):
-    """Balls ``a`` and ``k`` touch within the contact tolerance."""
+    """Balls ``a`` and ``k`` touch within the contact tolerance (``tolerance.contact_tolerance``:
+    1e-9 of the radii, or the round-off of their coordinates)."""
     dx = pos[k, 0] - pos[a, 0]
     dy = pos[k, 1] - pos[a, 1]
-    scale = radius[a] + radius[k] + abs(pos[a, 0]) + abs(pos[a, 1]) + abs(pos[k, 0]) + abs(pos[k, 1])
-    return math.sqrt(dx * dx + dy * dy) - radius[a] - radius[k] <= _CONTACT_TOL * scale
+    sigma = radius[a] + radius[k]
+    tol = contact_tolerance(sigma, max(_coord(a, pos), _coord(k, pos)), CONTACT_RTOL)
+    return math.sqrt(dx * dx + dy * dy) - sigma <= tol
+
+
+@njit(inline="always")
+def wall_contact(i, wall, pos, radius, bounds):
+    """Ball ``i`` touches ``wall`` within the contact tolerance (1e-9 of its diameter, or the
+    round-off of its coordinates and the wall's)."""
+    line = bounds[0] if wall == 0 else bounds[2] if wall == 1 else bounds[1] if wall == 2 else bounds[3]
+    coord = max(_coord(i, pos), abs(line))
+    return wall_gap(i, wall, pos, radius, bounds) <= contact_tolerance(2.0 * radius[i], coord, CONTACT_RTOL)
 
 
 @njit
 def _resolve_contact_group(
-    sc, t_abs, i0, j0, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, u_min, imp, n_imp, counters,
-    group, in_group, c_a, c_b, c_hit,
+    sc, t_abs, i0, j0, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, ratio, floor, imp, n_imp,
+    counters, group, in_group, c_a, c_b, c_hit,
 ):
     """Resolve, at one instant, every contact of the group of touching balls an impact started.
+
+    The impact was between ball ``i0`` and ball ``j0``, or the wall ``-1 - j0`` when ``j0 < 0``;
+    the caller has applied and reported it, so that contact is not reported again here (one
+    collision, one report, even when round-off leaves it closing at ~1e-16 m/s after a plastic
+    impulse). The group's regulariser speed comes from its own balls when it is formed
+    (``response.group_threshold`` of the collapse ``ratio`` and ``floor``).
 
     At e < 1 an impact inside a touching group (a train pressed against a wall, a crowd) starts a
     cascade of ever smaller impulses at the same instant: sequential impulses converge to the
@@ -214,14 +236,15 @@ def _resolve_contact_group(
     order apply the same pairwise impulses as the event loop would, one after another, without
     re-predicting every ball after each; the collapse regulariser ends it. A cascade still running
     after ``_MAX_SWEEPS`` sweeps (its convergence rate is set by a mass ratio) is finished by
-    ``_settle_contact_group``. Contacts are gaps within ``_CONTACT_TOL`` of zero. Every contact
-    that takes an impulse is reported once. Returns the group size (its balls are in ``group``).
+    ``_settle_contact_group``. Contacts are gaps within the contact tolerance of zero
+    (:func:`_touching`, :func:`wall_contact`). Every contact that takes an impulse is reported
+    once. Returns the group size (its balls are in ``group``).
     """
     n = pos.shape[0]
     for k in range(n):
         in_group[k] = False
     size = 0
-    for start in (i0, j0):
+    for start in (i0, j0):  # j0 < 0: a wall
         if start >= 0 and not in_group[start]:
             group[size] = start
             in_group[start] = True
@@ -246,16 +269,16 @@ def _resolve_contact_group(
                 if _touching(a, k, pos, radius):
                     c_a[n_contacts] = min(a, k)
                     c_b[n_contacts] = max(a, k)
-                    c_hit[n_contacts] = False
+                    c_hit[n_contacts] = j0 >= 0 and c_a[n_contacts] == min(i0, j0) and c_b[n_contacts] == max(i0, j0)
                     n_contacts += 1
         if has_walls:
-            scale = _CONTACT_TOL * (2.0 * radius[a] + abs(pos[a, 0]) + abs(pos[a, 1]))
             for wall in range(4 if dim == 2 else 2):
-                if wall_gap(a, wall, pos, radius, bounds) <= scale:
+                if wall_contact(a, wall, pos, radius, bounds):
                     c_a[n_contacts] = a
                     c_b[n_contacts] = -1 - wall
-                    c_hit[n_contacts] = False
+                    c_hit[n_contacts] = a == i0 and j0 == -1 - wall
                     n_contacts += 1
+    u_min = group_threshold(group, size, vel, inv_mass, ratio, floor)
     changed = True
     for _ in range(_MAX_SWEEPS):
         changed = False
@@ -329,11 +352,13 @@ def _settle_contact_group(
     between a wall and a ball ``M/m`` times heavier gets there only after about ``M/m`` sweeps.
     This jumps to that limit, regularised as everywhere else: the velocities closest to the
     current ones in the kinetic-energy metric at which every contact of the group separates at
-    ``u_min`` or faster (a least-distance problem in mass-weighted velocities, solved exactly by
-    Lawson & Hanson's NNLS). Momentum is conserved by ball-ball impulses and energy does not grow
-    by more than the regulariser's ``u_min`` allowance. Where no velocities separate every contact
-    (a chain wedged between opposite walls), the contacts are brought to rest instead, which is
-    always possible.
+    ``u_min`` or faster (a least-distance problem in mass-weighted velocities, solved by
+    ``ldp.least_distance`` whatever the mass ratio). Momentum is conserved by ball-ball impulses
+    and energy does not grow by more than the regulariser's ``u_min`` allowance. Where no
+    velocities separate every contact (a chain wedged between opposite walls), the contacts are
+    brought to rest instead, which is always possible. The result is checked: should round-off
+    still leave a contact closing, the group takes its centre-of-mass velocity (no wall among its
+    contacts) or stops (a wall among them), which ends the cascade in every case.
     """
     dof = 2 * size
     g_mat = np.zeros((n_contacts, dof))
@@ -344,6 +369,7 @@ def _settle_contact_group(
         slot[group[q]] = q
         root_w[q] = math.sqrt(inv_mass[group[q]])
     closing = np.empty(n_contacts)
+    fastest = 0.0
     for c in range(n_contacts):
         a = c_a[c]
         b = c_b[c]
@@ -359,6 +385,7 @@ def _settle_contact_group(
             g_mat[c, 2 * qb + 1] = ny * root_w[qb]
             sep += vel[b, 0] * nx + vel[b, 1] * ny
         closing[c] = -sep
+        fastest = max(fastest, abs(sep))
         h[c] = u_min - sep
     x, feasible = least_distance(g_mat, h)
     if not feasible:
@@ -369,10 +396,50 @@ def _settle_contact_group(
         i = group[q]
         vel[i, 0] += x[2 * q] * root_w[q]
         vel[i, 1] += x[2 * q + 1] * root_w[q]
+    if not _contacts_open(vel, pos, c_a, c_b, n_contacts, 16.0 * 2.0**-52 * fastest):
+        _stop_group(vel, inv_mass, group, size, c_b, n_contacts)
     for c in range(n_contacts):
         if closing[c] > 0.0:
             counters[EVENTS] += 1
             _record_contact(sc, t_abs, c, c_a, c_b, c_hit, pos, radius, bounds, closing[c], imp, n_imp)
+
+
+@njit
+def _contacts_open(vel, pos, c_a, c_b, n_contacts, slack):
+    """No contact of the group closes faster than ``slack`` (m/s)."""
+    for c in range(n_contacts):
+        a = c_a[c]
+        b = c_b[c]
+        nx, ny = _contact_normal(c, c_a, c_b, pos)
+        sep = -(vel[a, 0] * nx + vel[a, 1] * ny)
+        if b >= 0:
+            sep += vel[b, 0] * nx + vel[b, 1] * ny
+        if sep < -slack:
+            return False
+    return True
+
+
+@njit
+def _stop_group(vel, inv_mass, group, size, c_b, n_contacts):
+    """The last resort of :func:`_settle_contact_group`: every contact at rest, at once."""
+    on_wall = False
+    for c in range(n_contacts):
+        on_wall = on_wall or c_b[c] < 0
+    mass = 0.0
+    px = 0.0
+    py = 0.0
+    for q in range(size):
+        i = group[q]
+        m = 1.0 / inv_mass[i]
+        mass += m
+        px += m * vel[i, 0]
+        py += m * vel[i, 1]
+    vx = 0.0 if on_wall else px / mass
+    vy = 0.0 if on_wall else py / mass
+    for q in range(size):
+        i = group[q]
+        vel[i, 0] = vx
+        vel[i, 1] = vy
 
 
 def scratch_sizes(n):
@@ -588,15 +655,14 @@ def _finish(t_end, pos, vel, mass, body, omega, rot, sticky, cf, ci, hp):
 # ---------------------------------------------------------------------------- resolve
 @njit(inline="always")
 def _resolve_wall(sc, t_abs, bi, wall, pos, vel, inv_mass, radius, body, omega, bounds, has_walls, pairs, dim, e,
-                  u_min, sticky, cascades, imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit):
+                  ratio, floor, sticky, cascades, imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit):
     """Ball ``bi`` meets ``wall``. Returns how many balls' motion it changed (listed in ``involved``)."""
     n = pos.shape[0]
     n_inv = 0
     if sticky:
-        scale = radius[bi] + abs(pos[bi, 0]) + abs(pos[bi, 1])
         axis = 0 if wall < 2 else 1
         into = vel[bi, axis] < 0.0 if wall % 2 == 0 else vel[bi, axis] > 0.0
-        if wall_gap(bi, wall, pos, radius, bounds) <= _CONTACT_TOL * scale and into:
+        if wall_contact(bi, wall, pos, radius, bounds) and into:
             if omega[body[bi]] == 0.0:
                 snap_to_wall(bi, wall, pos, radius, bounds)
             x, y = wall_point(bi, wall, pos, radius, bounds)
@@ -612,6 +678,7 @@ def _resolve_wall(sc, t_abs, bi, wall, pos, vel, inv_mass, radius, body, omega, 
             n_inv = 1
         return n_inv
     snap_to_wall(bi, wall, pos, radius, bounds)
+    u_min = impact_threshold(bi, -1, vel, ratio, floor)
     speed = ball_wall(bi, wall, vel, e, u_min)
     if speed > 0.0:
         x, y = wall_point(bi, wall, pos, radius, bounds)
@@ -620,7 +687,7 @@ def _resolve_wall(sc, t_abs, bi, wall, pos, vel, inv_mass, radius, body, omega, 
     n_inv = 1
     if cascades and speed > 0.0:
         n_inv = _resolve_contact_group(
-            sc, t_abs, bi, -1, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, u_min,
+            sc, t_abs, bi, -1 - wall, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, ratio, floor,
             imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit,
         )
     return n_inv
@@ -628,18 +695,16 @@ def _resolve_wall(sc, t_abs, bi, wall, pos, vel, inv_mass, radius, body, omega, 
 
 @njit(inline="always")
 def _resolve_pair(sc, t_abs, bi, bj, pos, vel, mass, inv_mass, radius, body, omega, bounds, has_walls, pairs, dim, e,
-                  u_min, sticky, cascades, imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit):
+                  ratio, floor, sticky, cascades, imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit):
     """Balls ``bi`` and ``bj`` meet. Returns how many balls' motion it changed (in ``involved``)."""
     n = pos.shape[0]
     n_inv = 0
     dx = pos[bj, 0] - pos[bi, 0]
     dy = pos[bj, 1] - pos[bi, 1]
     dist = math.sqrt(dx * dx + dy * dy)
-    sigma = radius[bi] + radius[bj]
     closing = (vel[bj, 0] - vel[bi, 0]) * dx + (vel[bj, 1] - vel[bi, 1]) * dy
     if sticky:
-        scale = sigma + abs(pos[bi, 0]) + abs(pos[bi, 1])
-        if dist - sigma <= _CONTACT_TOL * scale and closing < 0.0:
+        if _touching(bi, bj, pos, radius) and closing < 0.0:
             x = pos[bi, 0] + radius[bi] * dx / dist
             y = pos[bi, 1] + radius[bi] * dy / dist
             record(imp, n_imp, sc, t_abs, bi, bj, -1, x, y, -closing / dist)
@@ -653,6 +718,7 @@ def _resolve_pair(sc, t_abs, bi, bj, pos, vel, mass, inv_mass, radius, body, ome
             involved[1] = bj
             n_inv = 2
         return n_inv
+    u_min = impact_threshold(bi, bj, vel, ratio, floor)
     speed = ball_ball(bi, bj, pos, vel, inv_mass, e, u_min)
     if speed > 0.0:
         x = pos[bi, 0] + radius[bi] * dx / dist
@@ -663,7 +729,7 @@ def _resolve_pair(sc, t_abs, bi, bj, pos, vel, mass, inv_mass, radius, body, ome
     n_inv = 2
     if cascades and speed > 0.0:
         n_inv = _resolve_contact_group(
-            sc, t_abs, bi, bj, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, u_min,
+            sc, t_abs, bi, bj, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, ratio, floor,
             imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit,
         )
     return n_inv
@@ -734,7 +800,6 @@ def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, coun
         t0 = time[sc]
         now = 0.0
         rot = sticky and has_rotation(body, omega)
-        u_min = elastic_threshold(vel, ratio, floor)
 
         # begin: everything afresh after a reset (and for rotating clusters, whose predictions reach
         # only to the end of a step), otherwise only the balls changed since the last step
@@ -813,12 +878,12 @@ def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, coun
             # resolve: the balls whose motion changed are listed in ``pending``
             if bj < 0:
                 n_pending = _resolve_wall(sc, t_abs, bi, cal.EV_WALL - code, pos, vel, inv_mass, radius, body, omega,
-                                          bounds, has_walls, pairs, dim, e, u_min, sticky, cascades, imp, n_imp,
-                                          counters, pending, in_group, c_a, c_b, c_hit)
+                                          bounds, has_walls, pairs, dim, e, ratio, floor, sticky, cascades, imp,
+                                          n_imp, counters, pending, in_group, c_a, c_b, c_hit)
             else:
                 n_pending = _resolve_pair(sc, t_abs, bi, bj, pos, vel, mass, inv_mass, radius, body, omega, bounds,
-                                          has_walls, pairs, dim, e, u_min, sticky, cascades, imp, n_imp, counters,
-                                          pending, in_group, c_a, c_b, c_hit)
+                                          has_walls, pairs, dim, e, ratio, floor, sticky, cascades, imp, n_imp,
+                                          counters, pending, in_group, c_a, c_b, c_hit)
             if sticky:
                 rot = has_rotation(body, omega)
             # invalidate: events that other balls hold with these become stale through the change

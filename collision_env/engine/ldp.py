@@ -25,6 +25,9 @@ from ._jit import njit
 
 #: Relative tolerance of the NNLS optimality test and of the feasibility test.
 _TOL = 1e-12
+#: Factor by which the scale grows when the residual is lost in round-off, and how many times.
+_RESCALE = 1e8
+_MAX_RESCALES = 40
 
 
 @njit
@@ -143,8 +146,8 @@ def least_distance(g_mat, h):
     """
     m, d = g_mat.shape
     x = np.zeros(d)
-    # Scale x by the largest distance any one constraint alone asks for, so that |x| is O(1) and
-    # the feasibility test below is scale-free (|E u - f|^2 = 1 / (1 + |x|^2) when feasible).
+    # The first scale s: the largest distance any one constraint alone asks for (the feasibility test
+    # is scale-free: |E u - f|^2 = 1 / (1 + |x / s|^2) when feasible).
     s = 0.0
     for c in range(m):
         norm = 0.0
@@ -156,30 +159,139 @@ def least_distance(g_mat, h):
             s = max(s, h[c] / math.sqrt(norm))
     if s == 0.0:  # x = 0 already satisfies every constraint
         return x, True
-    # E = [G^T; (h/s)^T], f = (0, ..., 0, 1); each column scaled to unit norm (u >= 0 is scale-free)
+    # Lawson & Hanson's x = -s E_top u / r is exact in exact arithmetic, but where the masses of a
+    # group differ by M/m its constraints are nearly dependent (condition ~sqrt(M/m)) and that
+    # formula loses everything at M/m ~ 1e12. The NNLS still finds which constraints hold with
+    # equality (u > 0), and the least-norm x meeting those with equality, by Householder QR of
+    # G_A^T (backward stable whatever the conditioning), is the solution when it meets the others.
+    # Infeasibility does not depend on s, while the accuracy of the NNLS does (|E u - f|^2 =
+    # 1 / (1 + |x / s|^2)): when the check fails, grow s and solve again; infeasible only when no
+    # scale up to 1e320 times the first gives an x that meets every constraint.
     e_mat = np.zeros((d + 1, m))
+    f = np.zeros(d + 1)
+    f[d] = 1.0
+    cols = np.empty(m, dtype=np.int64)
+    work = np.empty((d, m))
+    hh = np.empty(2 * m)
+    free = np.ones(d, dtype=np.bool_)
+    for c in range(m):
+        for k in range(d):
+            if g_mat[c, k] != 0.0:
+                free[k] = False
+    for _ in range(_MAX_RESCALES):
+        u = _ldp_dual(g_mat, h, s, e_mat, f)
+        n_cols = 0
+        for c in range(m):
+            if u[c] > 0.0:
+                cols[n_cols] = c
+                n_cols += 1
+        _least_norm(g_mat, h, cols, n_cols, x, work, hh)
+        for k in range(d):  # no constraint involves it: exactly 0 (not the round-off of the others)
+            if free[k]:
+                x[k] = 0.0
+        if _meets(g_mat, h, x):
+            return x, True
+        if s > 1e300 / _RESCALE:
+            break
+        s *= _RESCALE
+    for k in range(d):
+        x[k] = 0.0
+    return x, False
+
+
+@njit
+def _ldp_dual(g_mat, h, s, e_mat, f):
+    """Lawson & Hanson's NNLS dual of the LDP ``G x >= h`` at scale ``s``: returns ``u >= 0``
+    (``u > 0`` on the constraints that hold with equality at the solution)."""
+    m, d = g_mat.shape
+    # E = [G^T; (h/s)^T], f = (0, ..., 0, 1); each column scaled to unit norm (u >= 0 is scale-free)
     for c in range(m):
         hc = h[c] / s
         norm = hc * hc
         for k in range(d):
             norm += g_mat[c, k] * g_mat[c, k]
         norm = math.sqrt(norm)
+        for k in range(d + 1):
+            e_mat[k, c] = 0.0
         if norm == 0.0:
             continue
         for k in range(d):
             e_mat[k, c] = g_mat[c, k] / norm
         e_mat[d, c] = hc / norm
-    f = np.zeros(d + 1)
-    f[d] = 1.0
-    u = nnls(e_mat, f)
-    r_last = -1.0
-    for c in range(m):
-        r_last += e_mat[d, c] * u[c]
-    if not -r_last > _TOL:  # |E u - f| = 0: no x satisfies every constraint
-        return x, False
+    return nnls(e_mat, f)
+
+
+@njit
+def _least_norm(g_mat, h, cols, n_cols, x, work, hh):
+    """``x`` = the least-norm solution of ``G[cols] x = h[cols]``, by Householder QR of
+    ``G[cols]^T = Q R``: ``x = Q R^-T h[cols]``. A row that depends on earlier ones (a pivot at
+    round-off level) is skipped. ``work`` is (d, >= n_cols), ``hh`` has >= 2 n_cols entries."""
+    d = g_mat.shape[1]
+    for q in range(n_cols):
+        for k in range(d):
+            work[k, q] = g_mat[cols[q], k]
+    n_house = min(n_cols, d)
+    big = 0.0
+    for q in range(n_house):
+        norm = 0.0
+        for k in range(q, d):
+            norm += work[k, q] * work[k, q]
+        norm = math.sqrt(norm)
+        alpha = -norm if work[q, q] >= 0.0 else norm
+        work[q, q] -= alpha  # Householder vector v = work[q:, q]; H = I - 2 v v^T / |v|^2
+        vnorm2 = 0.0
+        for k in range(q, d):
+            vnorm2 += work[k, q] * work[k, q]
+        hh[q] = vnorm2
+        hh[n_cols + q] = alpha  # R[q, q]
+        big = max(big, norm)
+        if vnorm2 == 0.0:
+            continue
+        for c in range(q + 1, n_cols):
+            dot = 0.0
+            for k in range(q, d):
+                dot += work[k, q] * work[k, c]
+            t = 2.0 * dot / vnorm2
+            for k in range(q, d):
+                work[k, c] -= t * work[k, q]
+    # R^T z = h[cols] by forward substitution (R[q, c] = work[q, c] for c > q); z goes into x[:n_house]
     for k in range(d):
+        x[k] = 0.0
+    for q in range(n_house):
+        acc = h[cols[q]]
+        for p in range(q):
+            acc -= work[p, q] * x[p]
+        r = hh[n_cols + q]
+        x[q] = acc / r if abs(r) > 1e-14 * big else 0.0
+    # x = Q z = H_0 H_1 ... H_{n-1} z
+    for q in range(n_house - 1, -1, -1):
+        vnorm2 = hh[q]
+        if vnorm2 == 0.0:
+            continue
+        dot = 0.0
+        for k in range(q, d):
+            dot += work[k, q] * x[k]
+        t = 2.0 * dot / vnorm2
+        for k in range(q, d):
+            x[k] -= t * work[k, q]
+
+
+@njit
+def _meets(g_mat, h, x):
+    """``G x >= h`` up to the round-off of a backward-stable solve (relative to the largest ``|h|``
+    and the largest ``|G| |x|``: a solve is accurate norm-wise, not row by row)."""
+    m, d = g_mat.shape
+    size = 0.0
+    for c in range(m):
+        row = 0.0
+        for k in range(d):
+            row += abs(g_mat[c, k] * x[k])
+        size = max(size, max(row, abs(h[c])))
+    slack = 64.0 * 2.0**-52 * size
+    for c in range(m):
         acc = 0.0
-        for c in range(m):
-            acc += e_mat[k, c] * u[c]
-        x[k] = -s * acc / r_last
-    return x, True
+        for k in range(d):
+            acc += g_mat[c, k] * x[k]
+        if acc < h[c] - slack:
+            return False
+    return True

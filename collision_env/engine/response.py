@@ -10,13 +10,18 @@ Ball-wall: ``v_n' = -e v_n``.
 
 **Collapse regulariser.** With e < 1, hard disks can collide infinitely often in finite time
 (inelastic collapse; McNamara & Young 1992), and a touching train pressed against a wall at e = 0
-is resolved by an infinite cascade of ever smaller impulses at one instant. Per scene and step
-the engine sets a tiny speed
+is resolved by an infinite cascade of ever smaller impulses at one instant. Every impact gets a
+tiny speed from the balls it involves, and from nothing else:
 
-    u_min = max(collapse_ratio * (largest ball speed at the start of the step), collapse_floor)
+    u_min = max(collapse_ratio * s, collapse_floor)
 
-(defaults 1e-9 and 1e-15 m/s, far below anything measurable and far above the round-off of the
-velocities) and
+where ``s`` is the fastest of the two balls just before the impact (the ball alone for a wall
+impact) or, inside a contact group resolved at one instant, the group's kinetic-energy speed
+``sqrt(sum m v^2 / max m)`` when the group is formed (see :func:`group_threshold` and
+``exact._resolve_contact_group``). Defaults: ``collapse_ratio`` = 1e-9,
+``collapse_floor`` = 0 m/s. ``u_min`` is far below anything measurable and, at 1e-9 of the speeds
+involved, far above their round-off (2.2e-16 of them), so a pair set apart at ``u_min`` really
+separates. The rule
 
 - makes a collision whose normal closing speed is at most ``u_min`` leave the pair (or the ball
   and the wall) separating at ``u_min``: elastic, or a hair more (as DynamO's ``ElasticV`` and
@@ -27,11 +32,19 @@ velocities) and
 
 A cascade that the rule does not end quickly because it converges at a rate set by a mass ratio
 (a light ball pressed between a wall and a far heavier ball) is replaced by its limit after a
-fixed number of sweeps: see ``exact._settle_contact_group``.
+fixed number of sweeps, whatever the ratio: see ``exact._settle_contact_group``.
 
-The rule can add at most ``1/2 mu u_min^2`` of energy to a collision whose closing speed
-was below ``u_min`` (1e-18 of the kinetic energy with the default ratio), which is below the
-round-off of the energy itself. Elastic scenes are otherwise unaffected.
+Energy: the rule can add at most ``1/2 mu u_min^2`` to a collision whose closing speed was below
+``u_min``. With ``u_min = collapse_ratio * s`` that is at most ``collapse_ratio^2`` (1e-18) of the
+kinetic energy of the balls involved (the pair's reduced mass ``mu`` is at most either mass, and at
+most the group's heaviest), below the round-off of the energy itself, so at e < 1 the energy never
+grows beyond round-off, and balls that take no part in the impact have no say in it.
+A positive ``collapse_floor`` (an absolute minimum separation speed, m/s) trades that bound for
+``1/2 mu collapse_floor^2`` per collision. Elastic scenes are otherwise unaffected.
+
+The cheap modes (naive, posteriori) resolve each pair once per sub-step, so no cascade runs at one
+instant there; they keep one threshold per scene and sub-step, :func:`elastic_threshold`, relative
+to the scene's slowest moving ball, which bounds the energy it adds the same way.
 
 Stick scenes (e = 0, ``inelastic="stick"``): colliding bodies merge into one rigid cluster that
 keeps the total momentum and the total angular momentum about the new centre of mass
@@ -45,14 +58,51 @@ import math
 
 from ._jit import njit
 
+#: Closing speeds up to this many ulps of a group's fastest speed are round-off, not collisions.
+_ROUNDOFF_SPEED = 8.0 * 2.0**-52
+
 
 @njit(inline="always")
 def elastic_threshold(vel, collapse_ratio, collapse_floor):
-    """``u_min`` for one scene: the closing speed at or below which a collision is elastic."""
-    fastest = 0.0
+    """``u_min`` for one scene of the cheap modes: ``collapse_ratio`` times the speed of the scene's
+    slowest moving ball (a pair that collides has at least one ball that fast, so the rule adds at
+    most ``collapse_ratio^2`` of that pair's own energy), or ``collapse_floor``."""
+    slowest = math.inf
     for i in range(vel.shape[0]):
-        fastest = max(fastest, vel[i, 0] * vel[i, 0] + vel[i, 1] * vel[i, 1])
+        speed2 = vel[i, 0] * vel[i, 0] + vel[i, 1] * vel[i, 1]
+        if speed2 > 0.0:
+            slowest = min(slowest, speed2)
+    return max(collapse_ratio * math.sqrt(slowest), collapse_floor) if slowest < math.inf else collapse_floor
+
+
+@njit(inline="always")
+def impact_threshold(i, j, vel, collapse_ratio, collapse_floor):
+    """``u_min`` of an impact of ball ``i`` with ball ``j`` (``j < 0``: a wall), from their speeds."""
+    fastest = vel[i, 0] * vel[i, 0] + vel[i, 1] * vel[i, 1]
+    if j >= 0:
+        fastest = max(fastest, vel[j, 0] * vel[j, 0] + vel[j, 1] * vel[j, 1])
     return max(collapse_ratio * math.sqrt(fastest), collapse_floor)
+
+
+@njit(inline="always")
+def group_threshold(group, size, vel, inv_mass, collapse_ratio, collapse_floor):
+    """``u_min`` of a contact group (its balls are ``group[:size]``): ``collapse_ratio`` times the
+    group's kinetic-energy speed ``sqrt(sum m v^2 / max m)``, or a few ulps of its fastest ball's
+    speed (so that round-off never passes for a collision), or ``collapse_floor``.
+
+    Weighting by the heaviest mass bounds what the rule can add to any contact of the group, of
+    reduced mass ``mu <= max m``, by ``collapse_ratio^2`` of the group's energy, however the
+    masses differ (a fast light ball does not set the threshold of a slow heavy pair)."""
+    energy2 = 0.0
+    heaviest_inv = math.inf
+    fastest = 0.0
+    for q in range(size):
+        i = group[q]
+        speed2 = vel[i, 0] * vel[i, 0] + vel[i, 1] * vel[i, 1]
+        energy2 += speed2 / inv_mass[i]
+        heaviest_inv = min(heaviest_inv, inv_mass[i])
+        fastest = max(fastest, speed2)
+    return max(collapse_ratio * math.sqrt(energy2 * heaviest_inv), _ROUNDOFF_SPEED * math.sqrt(fastest), collapse_floor)
 
 
 @njit(inline="always")

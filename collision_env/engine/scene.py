@@ -7,6 +7,7 @@ properties (positions, velocities, masses, radii) belong to the simulator.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,6 +25,23 @@ CONSTANT_RADIUS = 0.15
 WALL_NAMES = ("left", "right", "bottom", "top")
 #: Wall codes: indices into ``WALL_NAMES``, as impact records and the kernels store them.
 WALL_LEFT, WALL_RIGHT, WALL_BOTTOM, WALL_TOP = 0, 1, 2, 3
+
+
+def _is_real(x):
+    """A real number that is not a boolean (numpy scalar types included)."""
+    return isinstance(x, numbers.Real) and not isinstance(x, (bool, np.bool_))
+
+
+def _real_tuple(values, field, expected):
+    """``values`` as a tuple of floats, each a real number (not a boolean or a string)."""
+    try:
+        items = tuple(values)
+    except TypeError:
+        raise ValueError(f"{field}: expected {expected}, got {values!r}") from None
+    for v in items:
+        if not _is_real(v):
+            raise ValueError(f"{field}: expected real numbers {expected}, got {v!r} ({type(v).__name__}) in {values!r}")
+    return tuple(float(v) for v in items)
 
 
 def radius_from_mass(mass: ArrayLike) -> np.ndarray:
@@ -59,11 +77,12 @@ class Scene:
     ball_collisions: bool = True
 
     def __post_init__(self) -> None:
+        if isinstance(self.dimension, (bool, np.bool_)) or not isinstance(self.dimension, numbers.Integral) \
+                or self.dimension not in (1, 2):
+            raise ValueError(f"scene dimension: must be 1 or 2 (an integer, not a boolean), got {self.dimension!r}")
+        object.__setattr__(self, "dimension", int(self.dimension))
         if self.bounds is not None:
-            try:
-                b = tuple(float(v) for v in self.bounds)
-            except (TypeError, ValueError):
-                raise ValueError(f"scene bounds: expected (xmin, ymin, xmax, ymax), got {self.bounds!r}") from None
+            b = _real_tuple(self.bounds, "scene bounds", "(xmin, ymin, xmax, ymax)")
             if len(b) != 4 or not all(math.isfinite(v) for v in b):
                 raise ValueError(f"scene bounds: expected four finite numbers, got {self.bounds!r}")
             if not (b[0] < b[2] and b[1] < b[3]):
@@ -71,17 +90,15 @@ class Scene:
             if self.dimension == 1 and not (b[1] < 0.0 < b[3]):
                 raise ValueError(f"scene bounds: a 1D scene needs ymin < 0 < ymax (balls move on y = 0), got {b}")
             object.__setattr__(self, "bounds", b)
-        try:
-            e = float(self.elasticity)
-        except (TypeError, ValueError):
-            raise ValueError(f"scene elasticity: expected a number in [0, 1], got {self.elasticity!r}") from None
-        if not (0.0 <= e <= 1.0):
+        if not _is_real(self.elasticity):
+            raise ValueError(f"scene elasticity: expected a number in [0, 1], got {self.elasticity!r}")
+        if not (0.0 <= float(self.elasticity) <= 1.0):
             raise ValueError(f"scene elasticity: must lie in [0, 1], got {self.elasticity!r}")
-        object.__setattr__(self, "elasticity", e)
-        if self.dimension not in (1, 2):
-            raise ValueError(f"scene dimension: must be 1 or 2, got {self.dimension!r}")
-        if self.inelastic not in ("slip", "stick"):
+        object.__setattr__(self, "elasticity", float(self.elasticity))
+        if not (isinstance(self.inelastic, str) and self.inelastic in ("slip", "stick")):
             raise ValueError(f"scene inelastic: must be 'slip' or 'stick', got {self.inelastic!r}")
+        if not isinstance(self.ball_collisions, (bool, np.bool_)):
+            raise ValueError(f"scene ball_collisions: expected True or False, got {self.ball_collisions!r}")
         object.__setattr__(self, "ball_collisions", bool(self.ball_collisions))
 
     @property

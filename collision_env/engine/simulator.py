@@ -8,7 +8,7 @@ copy of the physics for the single env and the vector env alike.
 from __future__ import annotations
 
 import copy
-import math
+import numbers
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -38,6 +38,7 @@ from .layout import (
     W_CALENDAR_VALID,
     W_GRID_NX,
     W_GRID_X0,
+    W_REMAINING,
     WORK_F,
     WORK_I,
 )
@@ -45,6 +46,7 @@ from .motion import BALL_FIELDS, apply_impulses
 from .scene import CONSTANT_RADIUS, WALL_NAMES, Scene, radius_from_mass
 from .substep import NAIVE, POSTERIORI, step_substeps, worst_case_impacts
 from .substep import scratch_size as substep_scratch_size
+from .tolerance import CONTACT_RTOL, EPS, roundoff
 
 MODES = ("naive", "posteriori", "exact")
 
@@ -64,6 +66,14 @@ IMPACT_DTYPE = np.dtype(
 
 #: Relative tolerance for "touching" in the start-state checks (exact contact is allowed).
 _CONTACT_RTOL = 1e-12
+#: Largest position (m), speed (m/s) and |dt| (s) accepted: squares and sums of these stay finite in
+#: float64 (the time-of-impact kernels square separations and relative velocities).
+_MAX_MAGNITUDE = 1e150
+#: A radius must span this many units in the last place of the scene's coordinates: contact is then
+#: resolved to better than 1e-4 of the radius (``tolerance.contact_tolerance``) anywhere in the scene.
+_MIN_RADIUS_ULPS = 2.0**16
+#: The largest finite float64.
+_FLOAT_MAX = np.finfo(np.float64).max
 
 
 class LiveArrays(NamedTuple):
@@ -114,14 +124,63 @@ def _copy_impacts(buf, out, sign, sort):
             j -= 1
 
 
-def _as_array(value, shape, field, label):
-    try:
-        arr = np.array(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise ValueError(f"{label}{field}: expected numbers of shape {shape}, got {value!r}") from None
-    if arr.shape != shape:
-        raise ValueError(f"{label}{field}: expected shape {shape}, got {arr.shape}")
+def _is_real(x):
+    """A real number that is not a boolean (Python or numpy scalar types alike)."""
+    return isinstance(x, numbers.Real) and not isinstance(x, (bool, np.bool_))
+
+
+def _real_number(value, field):
+    """``value`` as a float: a real number (numpy scalar types included), not a boolean or a string."""
+    if isinstance(value, float):  # the common case (np.float64 too), at the cost of one test
+        return value
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value[()]
+    if not _is_real(value):
+        raise ValueError(f"{field}: expected a number (real, not a boolean or a string), got {value!r} "
+                         f"({type(value).__name__})")
+    return float(value)
+
+
+def _real_array(value, shapes, field, where):
+    """A float64 copy of ``value``: real numbers (no booleans, strings or complex numbers) in one of
+    ``shapes``. ``where(index)`` names the ball of an element (for the error message)."""
+    if isinstance(value, np.ndarray) and value.dtype.kind in "iuf":
+        arr = value.astype(np.float64)
+    else:
+        try:
+            obj = np.array(value, dtype=object)
+        except ValueError:
+            raise ValueError(f"{field}: expected real numbers of shape {' or '.join(map(str, shapes))}, "
+                             f"got a ragged sequence") from None
+        if obj.shape in shapes:
+            for index, x in np.ndenumerate(obj):
+                if not _is_real(x):
+                    raise ValueError(f"{where(index)}{field} must be real numbers (not booleans, strings or complex), "
+                                     f"got {x!r} ({type(x).__name__})")
+        arr = obj.astype(np.float64) if obj.shape in shapes else obj
+    if arr.shape not in shapes:
+        raise ValueError(f"{field}: expected shape {' or '.join(map(str, shapes))}, got {arr.shape}")
     return arr
+
+
+@njit
+def _advance_clocks(time, clock, work_f, dt_abs, sign):
+    """Compensated clocks. ``clock[sc]`` = (the time at the start of the step, its compensation):
+    the exact time is their sum, and ``time`` (which the kernels read, and overwrite during the step)
+    its correctly rounded value. A scene that completed its step (``work_f[sc, 0]``, the time left
+    in it, is 0) advances by ``sign * dt_abs`` through Knuth's TwoSum and a renormalisation, so the
+    clock stays within an ulp of the exact sum of the steps. A scene that stopped short (the event
+    cap) keeps the time of its last event, as the kernel set it."""
+    a = sign * dt_abs
+    for sc in range(time.shape[0]):
+        start = clock[sc, 0]
+        if work_f[sc, W_REMAINING] == 0.0:
+            hi = start + a
+            b = hi - start
+            lo = clock[sc, 1] + ((start - (hi - b)) + (a - b))
+            time[sc] = hi + lo
+            clock[sc, 1] = lo - (time[sc] - hi)
+        clock[sc, 0] = time[sc]
 
 
 class BatchSimulator:
@@ -150,26 +209,34 @@ class BatchSimulator:
         issued.
     collapse_ratio, collapse_floor:
         The inelastic-collapse regulariser: a collision whose normal closing speed is at most
-        ``max(collapse_ratio * fastest speed at the step's start, collapse_floor)`` is elastic
-        (see :mod:`collision_env.engine.response`).
+        ``u_min = max(collapse_ratio * s, collapse_floor)`` leaves the pair separating at ``u_min``,
+        ``s`` being the fastest speed among the balls of the impact (exact mode; the cheap modes use
+        the scene's slowest moving ball), see :mod:`collision_env.engine.response`. The default
+        floor, 0, keeps energy from growing beyond round-off at e < 1.
+
+    Inputs are real numbers (numpy scalar types included; booleans, strings and complex numbers
+    are refused) with finite, representable values: positions and speeds up to 1e150, masses
+    whose inverse is finite, radii that span 2^16 units in the last place of the scene's
+    coordinates, and balls that have room to move in the box. Anything else raises a ``ValueError``
+    naming the field and the ball, and changes nothing.
     """
 
     def __init__(self, scene: Scene, positions: ArrayLike, velocities: ArrayLike, masses: ArrayLike,
                  radii: ArrayLike | str | None = None, *, mode: str = "exact", substeps: int = 1,
-                 max_events: int = 10_000, collapse_ratio: float = 1e-9, collapse_floor: float = 1e-15) -> None:
+                 max_events: int = 10_000, collapse_ratio: float = 1e-9, collapse_floor: float = 0.0) -> None:
         if not isinstance(scene, Scene):
             raise ValueError(f"scene: expected a collision_env.engine.Scene, got {type(scene).__name__}")
-        if mode not in MODES:
+        if not (isinstance(mode, str) and mode in MODES):
             raise ValueError(f"mode: must be one of {MODES}, got {mode!r}")
-        if isinstance(substeps, bool) or not isinstance(substeps, (int, np.integer)) or substeps < 1:
+        if isinstance(substeps, (bool, np.bool_)) or not isinstance(substeps, numbers.Integral) or substeps < 1:
             raise ValueError(f"substeps: must be a positive integer, got {substeps!r}")
         if mode == "exact" and substeps != 1:
             raise ValueError("substeps: exact mode resolves every event at its exact time; substeps must be 1")
-        if isinstance(max_events, bool) or not isinstance(max_events, (int, np.integer)) or max_events < 1:
+        if isinstance(max_events, (bool, np.bool_)) or not isinstance(max_events, numbers.Integral) or max_events < 1:
             raise ValueError(f"max_events: must be a positive integer, got {max_events!r}")
-        if not (isinstance(collapse_ratio, (int, float)) and 0.0 <= collapse_ratio < 1.0):
+        if not (_is_real(collapse_ratio) and 0.0 <= float(collapse_ratio) < 1.0):
             raise ValueError(f"collapse_ratio: must be a number in [0, 1), got {collapse_ratio!r}")
-        if not (isinstance(collapse_floor, (int, float)) and 0.0 <= collapse_floor < math.inf):
+        if not (_is_real(collapse_floor) and 0.0 <= float(collapse_floor) < _MAX_MAGNITUDE):
             raise ValueError(f"collapse_floor: must be a finite speed >= 0 (m/s), got {collapse_floor!r}")
         self.scene = scene
         self._mode = mode
@@ -178,12 +245,16 @@ class BatchSimulator:
         self._collapse_ratio = float(collapse_ratio)
         self._collapse_floor = float(collapse_floor)
 
-        pos = np.array(positions, dtype=np.float64) if not isinstance(positions, np.ndarray) else positions
-        if pos.ndim != 3 or pos.shape[-1] != 2:
-            raise ValueError(f"positions: expected shape (B, N, 2), got {np.shape(positions)}")
-        n_scenes, n = pos.shape[0], pos.shape[1]
+        try:
+            shape = np.shape(positions)
+        except ValueError:  # numpy refuses ragged nesting
+            shape = None
+        if shape is None or len(shape) != 3 or shape[-1] != 2:
+            got = "a ragged sequence" if shape is None else shape
+            raise ValueError(f"positions: expected shape (B, N, 2), got {got}")
+        n_scenes, n = shape[0], shape[1]
         if n_scenes < 1 or n < 1:
-            raise ValueError(f"positions: need at least one scene and one ball, got shape {pos.shape}")
+            raise ValueError(f"positions: need at least one scene and one ball, got shape {shape}")
         self._n_scenes = n_scenes
         self._n = n
         pos, vel, mass, radius = self._checked_balls(np.arange(n_scenes), positions, velocities, masses, radii)
@@ -198,6 +269,7 @@ class BatchSimulator:
         self._radius[...] = radius
         self._body = np.tile(np.arange(n, dtype=np.int64), (n_scenes, 1))
         self._time = np.zeros(n_scenes)
+        self._clock = np.zeros((n_scenes, 2))  # per scene: _time as the clock set it, its compensation
         self._capped = np.zeros(n_scenes, dtype=np.bool_)
         self._counters = np.zeros(len(COUNTERS), dtype=np.int64)
 
@@ -225,12 +297,15 @@ class BatchSimulator:
     def _checked_balls(self, scenes, positions, velocities, masses, radii):
         """Validate and return float64 copies of the balls of ``scenes`` (raises ValueError)."""
         k, n = len(scenes), self._n
-        pos = _as_array(positions, (k, n, 2), "positions", "")
-        vel = _as_array(velocities, (k, n, 2), "velocities", "")
-        m = np.array(masses, dtype=np.float64) if masses is not None else None
-        if m is None or m.shape not in ((n,), (k, n)):
-            raise ValueError(f"masses: expected shape ({n},) or ({k}, {n}), got {None if m is None else m.shape}")
-        m = np.broadcast_to(m, (k, n)).copy()
+
+        def where(index):
+            return self._label(scenes[index[0]], index[1]) if len(index) > 1 else self._label(scenes[0], index[0])
+
+        pos = _real_array(positions, [(k, n, 2)], "positions", where)
+        vel = _real_array(velocities, [(k, n, 2)], "velocities", where)
+        if masses is None:
+            raise ValueError(f"masses: expected shape ({n},) or ({k}, {n}), got None")
+        m = np.broadcast_to(_real_array(masses, [(n,), (k, n)], "masses", where), (k, n)).copy()
         if radii is None:
             r = radius_from_mass(m)
         elif isinstance(radii, str):
@@ -238,10 +313,7 @@ class BatchSimulator:
                 raise ValueError(f"radii: expected None, 'constant' or an array, got {radii!r}")
             r = np.full((k, n), CONSTANT_RADIUS)
         else:
-            r = np.array(radii, dtype=np.float64)
-            if r.shape not in ((n,), (k, n)):
-                raise ValueError(f"radii: expected shape ({n},) or ({k}, {n}), got {r.shape}")
-            r = np.broadcast_to(r, (k, n)).copy()
+            r = np.broadcast_to(_real_array(radii, [(n,), (k, n)], "radii", where), (k, n)).copy()
 
         def fail(mask, message):
             bad = np.argwhere(mask)
@@ -249,17 +321,40 @@ class BatchSimulator:
                 s, i = bad[0][0], bad[0][1]
                 raise ValueError(self._label(scenes[s], i) + message(s, i))
 
-        fail(~np.isfinite(pos).all(-1), lambda s, i: f"position must be finite, got {tuple(pos[s, i])}")
-        fail(~np.isfinite(vel).all(-1), lambda s, i: f"velocity must be finite, got {tuple(vel[s, i])}")
-        fail(~(np.isfinite(m) & (m > 0)), lambda s, i: f"mass must be positive and finite, got {m[s, i]}")
-        fail(~(np.isfinite(r) & (r > 0)), lambda s, i: f"radius must be positive and finite, got {r[s, i]}")
+        big = _MAX_MAGNITUDE
+        with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+            speed = np.hypot(vel[..., 0], vel[..., 1])
+            fail(~(np.abs(pos) <= big).all(-1),
+                 lambda s, i: f"position must be finite, within {big:g} m, got {tuple(pos[s, i])}")
+            fail(~(np.abs(vel) <= big).all(-1) | ~(speed <= big),
+                 lambda s, i: f"velocity must be finite, speed within {big:g} m/s, got {tuple(vel[s, i])}")
+            fail(~(np.isfinite(m) & (m > 0) & np.isfinite(1.0 / m)),
+                 lambda s, i: f"mass must be positive and finite, with a finite inverse, got {m[s, i]}")
+            fail(~np.isfinite(0.5 * m * speed * speed),
+                 lambda s, i: f"velocity {tuple(vel[s, i])} gives mass {m[s, i]} a kinetic energy beyond float64")
+        fail(~(np.isfinite(r) & (r > 0) & (r <= big)),
+             lambda s, i: f"radius must be positive and finite, got {r[s, i]}")
         scene = self.scene
+        # the coordinates' magnitude in each scene: the border, or the balls' own extent
+        extent = np.max(np.abs(pos) + r[..., None], axis=(1, 2))
+        if scene.bounds is not None:
+            extent = np.maximum(extent, max(abs(v) for v in scene.bounds))
+        smallest = _MIN_RADIUS_ULPS * EPS * extent
+        fail(r < smallest[:, None], lambda s, i: f"radius {r[s, i]:.6g} m is too small for float64 to resolve its "
+                                                 f"contacts at coordinates of {extent[s]:.6g} m "
+                                                 f"(at least {smallest[s]:.3g} m)")
         if scene.dimension == 1:
             fail(pos[..., 1] != 0.0, lambda s, i: f"position y must be 0 in a 1D scene, got {pos[s, i, 1]}")
             fail(vel[..., 1] != 0.0, lambda s, i: f"velocity y must be 0 in a 1D scene, got {vel[s, i, 1]}")
         if scene.bounds is not None:
             xmin, ymin, xmax, ymax = scene.bounds
-            tol = _CONTACT_RTOL * (np.abs(pos).max(-1) + r)
+            # a ball needs room to move across the box: more than the contact tolerance of the walls
+            for lo, hi, name in ((xmin, xmax, "width"), (ymin, ymax, "height"))[:scene.dimension]:
+                room = (hi - lo) - 2.0 * r
+                fail(room <= CONTACT_RTOL * 2.0 * r + roundoff(extent[:, None]),
+                     lambda s, i, size=hi - lo, name=name: f"radius {r[s, i]:.6g} m leaves no room to move: its "
+                                                            f"diameter is the box {name} {size:.6g} m or more")
+            tol = _CONTACT_RTOL * r + roundoff(np.abs(pos).max(-1))
             out = (pos[..., 0] - r < xmin - tol) | (pos[..., 0] + r > xmax + tol)
             if scene.dimension == 2:
                 out |= (pos[..., 1] - r < ymin - tol) | (pos[..., 1] + r > ymax + tol)
@@ -330,13 +425,17 @@ class BatchSimulator:
 
         Returns the impacts inside the step as an array of :data:`IMPACT_DTYPE`, ordered by scene
         and then by the order in which they happened.
+
+        ``dt`` is a real number (numpy scalars included) of at most 1e150 s; without a border, the
+        step must also keep every ball within 1e150 m. The clocks are compensated sums: after any
+        number of steps ``time`` is within an ulp of the exact sum of the ``dt`` taken (forward and
+        back again returns it to exactly where it was).
         """
-        try:
-            dt = float(dt)
-        except (TypeError, ValueError):
-            raise ValueError(f"dt: expected a number of seconds, got {dt!r}") from None
-        if not math.isfinite(dt):
-            raise ValueError(f"dt: must be finite, got {dt}")
+        dt = _real_number(dt, "dt")
+        if not abs(dt) <= _MAX_MAGNITUDE:
+            raise ValueError(f"dt: must be finite and at most {_MAX_MAGNITUDE:g} s, got {dt}")
+        if self.scene.bounds is None:
+            self._check_reach(dt)
         e = self.scene.elasticity
         if dt < 0.0 and e == 0.0:
             raise ValueError("dt: cannot step backwards with elasticity 0 "
@@ -359,6 +458,7 @@ class BatchSimulator:
             if sign < 0:
                 np.negative(self._vel, out=self._vel)
                 np.negative(self._omega, out=self._omega)
+            _advance_clocks(self._time, self._clock, self._work_f, abs(dt), sign)
         if self._n_imp[1]:
             warnings.warn(
                 f"event cap of {self.max_events} per step reached in scene(s) {np.flatnonzero(self._capped).tolist()}; "
@@ -367,6 +467,14 @@ class BatchSimulator:
                 stacklevel=2,
             )
         return self._impacts(chunks, sign)
+
+    def _check_reach(self, dt):
+        """Without a border, a step of ``dt`` must keep every ball within the representable range."""
+        reach = np.abs(self._pos).max(-1) + np.hypot(self._vel[..., 0], self._vel[..., 1]) * abs(dt)
+        if not (reach <= _MAX_MAGNITUDE).all():
+            s, i = np.argwhere(~(reach <= _MAX_MAGNITUDE))[0]
+            raise ValueError(f"dt: a step of {dt:g} s would take {self._label(s, i).rstrip(': ')} beyond "
+                             f"{_MAX_MAGNITUDE:g} m (no border), where positions are no longer representable")
 
     def _run(self, dt_abs):
         chunks = []
@@ -488,15 +596,32 @@ class BatchSimulator:
         the function this calls.)
         """
         if check:
-            dv = _as_array(dv, (self._n_scenes, self._n, 2), "nudge", "")
+            dv = _real_array(dv, [(self._n_scenes, self._n, 2)], "nudge", lambda index: self._label(*index[:2]))
             # one cheap test on the common path; find the culprit only when there is one
-            if not np.isfinite(dv).all():
-                s, i = np.argwhere(~np.isfinite(dv).all(-1))[0]
-                raise ValueError(f"{self._label(s, i)}nudge must be finite, got {tuple(dv[s, i])}")
+            if not (np.abs(dv) <= _MAX_MAGNITUDE).all():
+                s, i = np.argwhere(~(np.abs(dv) <= _MAX_MAGNITUDE).all(-1))[0]
+                raise ValueError(f"{self._label(s, i)}nudge must be finite, within {_MAX_MAGNITUDE:g} m/s, "
+                                 f"got {tuple(dv[s, i])}")
             if self.scene.dimension == 1 and dv[..., 1].any():
                 s, i = np.argwhere(dv[..., 1] != 0.0)[0]
                 raise ValueError(f"{self._label(s, i)}nudge y must be 0 in a 1D scene, got {dv[s, i, 1]}")
+            self._check_nudged_speeds(dv)
         apply_impulses(self._balls, self._body, dv, self.scene.sticky)
+
+    def _check_nudged_speeds(self, dv: np.ndarray) -> None:
+        """The speeds a nudge can give stay representable (bounded through the clusters' spin by the
+        largest change of any of their members: a rigid impulse moves no point faster than that)."""
+        if self.scene.sticky:
+            most = np.abs(dv).max(axis=(1, 2), keepdims=True)[..., 0]
+            limit = np.abs(self._vel).max(-1) + np.broadcast_to(most, self._mass.shape) * self._n
+        else:
+            limit = np.abs(self._vel + dv).max(-1)
+        with np.errstate(over="ignore"):
+            bad = ~(limit <= _MAX_MAGNITUDE / 2) | ~np.isfinite(self._mass * limit * limit)
+        if bad.any():
+            s, i = np.argwhere(bad)[0]
+            raise ValueError(f"{self._label(s, i)}nudge {tuple(dv[s, i])} would give a speed beyond the representable "
+                             f"range (speeds up to {_MAX_MAGNITUDE:g} m/s, finite kinetic energy)")
 
     def set_scenes(self, index: ArrayLike, positions: ArrayLike, velocities: ArrayLike, masses: ArrayLike | None = None,
                    radii: ArrayLike | str | None = None, time: ArrayLike = 0.0) -> None:
@@ -506,6 +631,9 @@ class BatchSimulator:
         ``radii`` default to those the scenes had. Validated like the constructor; on error
         nothing changes.
         """
+        time = _real_number(time, "time")
+        if not abs(time) <= _MAX_MAGNITUDE:
+            raise ValueError(f"time: must be finite and at most {_MAX_MAGNITUDE:g} s, got {time}")
         idx = np.arange(self._n_scenes)[index]
         idx = np.atleast_1d(idx)
         if masses is None:
@@ -522,6 +650,7 @@ class BatchSimulator:
         self._omega[idx] = 0.0
         self._time[idx] = time
         self._invalidate(idx)
+        self._clock[idx] = (time, 0.0)
 
     def get_state(self) -> dict[str, np.ndarray]:
         """A dict of array copies that :meth:`set_state` restores exactly."""
@@ -533,13 +662,15 @@ class BatchSimulator:
             "clusters": self._body.copy(),
             "omega": self._omega.copy(),
             "time": self._time.copy(),
+            "time_compensation": self._clock[:, 1].copy(),
         }
 
     def set_state(self, state: Mapping[str, ArrayLike]) -> None:
-        """Restore a state from :meth:`get_state` (shapes are checked; values are trusted)."""
+        """Restore a state from :meth:`get_state` (shapes, number types and finiteness are checked;
+        the physics of the values is trusted)."""
         shapes = {"positions": self._pos.shape, "velocities": self._vel.shape, "masses": self._mass.shape,
                   "radii": self._radius.shape, "clusters": self._body.shape, "omega": self._omega.shape,
-                  "time": self._time.shape}
+                  "time": self._time.shape, "time_compensation": self._time.shape}
         arrays = {}
         for key, shape in shapes.items():
             if key not in state:
@@ -547,6 +678,12 @@ class BatchSimulator:
             a = np.asarray(state[key])
             if a.shape != shape:
                 raise ValueError(f"state {key}: expected shape {shape}, got {a.shape}")
+            kinds = "iu" if key == "clusters" else "iuf"
+            if a.dtype.kind not in kinds:
+                raise ValueError(f"state {key}: expected {'integers' if key == 'clusters' else 'real numbers'}, "
+                                f"got dtype {a.dtype}")
+            if not np.isfinite(a).all():
+                raise ValueError(f"state {key}: values must be finite")
             arrays[key] = a
         np.copyto(self._pos, arrays["positions"])
         np.copyto(self._vel, arrays["velocities"])
@@ -556,6 +693,8 @@ class BatchSimulator:
         np.copyto(self._body, arrays["clusters"])
         np.copyto(self._omega, arrays["omega"])
         np.copyto(self._time, arrays["time"])
+        self._clock[:, 0] = arrays["time"]
+        self._clock[:, 1] = arrays["time_compensation"]
         self._invalidate(np.arange(self._n_scenes))
 
     def copy(self) -> BatchSimulator:
@@ -593,8 +732,13 @@ class Simulator:
 
     def __init__(self, scene: Scene, positions: ArrayLike, velocities: ArrayLike, masses: ArrayLike,
                  radii: ArrayLike | str | None = None, mode: str = "exact", substeps: int = 1, **options: Any) -> None:
-        if np.ndim(positions) != 2:
-            raise ValueError(f"positions: expected shape (N, 2), got {np.shape(positions)}")
+        try:
+            shape = np.shape(positions)
+        except ValueError:  # numpy refuses ragged nesting
+            shape = None
+        if shape is None or len(shape) != 2:
+            got = "a ragged sequence" if shape is None else shape
+            raise ValueError(f"positions: expected shape (N, 2), got {got}")
         self._batch = BatchSimulator(scene, [positions], [velocities], masses, radii, mode=mode, substeps=substeps,
                                      **options)
 
@@ -649,12 +793,10 @@ class Simulator:
     def set_balls(self, positions: ArrayLike | None = None, velocities: ArrayLike | None = None) -> None:
         """Replace positions and/or velocities (validated; on error nothing changes). Time is kept."""
         b = self._batch
-        b.set_scenes(
-            [0],
-            b._pos if positions is None else np.asarray(positions, dtype=np.float64)[None],
-            b._vel if velocities is None else np.asarray(velocities, dtype=np.float64)[None],
-            time=b._time[0],
-        )
+        clock = b._clock[0].copy()
+        b.set_scenes([0], b._pos if positions is None else [positions], b._vel if velocities is None else [velocities],
+                     time=b._time[0])
+        b._clock[0] = clock
 
     def get_state(self) -> dict[str, np.ndarray]:
         """A dict of array copies (no batch axis) that :meth:`set_state` restores exactly."""

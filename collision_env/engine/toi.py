@@ -25,12 +25,18 @@ import math
 
 from ._jit import njit
 from .motion import position_at
+from .tolerance import contact_tolerance
 
 INF = math.inf
 
 #: Iteration cap for conservative advancement; a prediction that hits it is returned as a
 #: "check point" that the event loop re-verifies (no collision unless the balls really touch).
 CA_MAX_ITERATIONS = 2000
+#: Conservative advancement stops within 1e-12 of the radii of contact, or within a quarter of the
+#: contact tolerance's round-off term (``tolerance.contact_tolerance``), so that the contact it
+#: finds always passes the engine's contact test.
+CA_RTOL = 1e-12
+_CA_ROUNDOFF_SHARE = 0.25
 
 
 @njit(inline="always")
@@ -165,8 +171,9 @@ def ca_pair(ki, kj, sigma, horizon):
     """
     rel = math.hypot(ki[2] - kj[2], ki[3] - kj[3])
     bound = rel + abs(ki[6]) * math.hypot(ki[4], ki[5]) + abs(kj[6]) * math.hypot(kj[4], kj[5])
-    scale = sigma + abs(ki[0]) + abs(ki[1]) + abs(kj[0]) + abs(kj[1])
-    return _ca_solve(True, ki, kj, sigma, -1, ki, bound, horizon, 1e-12 * scale)
+    coord = max(abs(ki[0]), abs(ki[1]), abs(kj[0]), abs(kj[1])) + math.hypot(ki[4], ki[5]) + math.hypot(kj[4], kj[5])
+    tol = _CA_ROUNDOFF_SHARE * contact_tolerance(sigma, coord, CA_RTOL)
+    return _ca_solve(True, ki, kj, sigma, -1, ki, bound, horizon, tol)
 
 
 @njit
@@ -175,11 +182,12 @@ def ca_wall(k, r, bounds, dim, horizon):
     best = INF
     best_wall = -1
     spin = abs(k[6]) * math.hypot(k[4], k[5])
-    scale = r + abs(k[0]) + abs(k[1]) + abs(bounds[0]) + abs(bounds[3])
+    coord = max(abs(k[0]), abs(k[1]), abs(bounds[0]), abs(bounds[1]), abs(bounds[2]), abs(bounds[3]))
+    tol = _CA_ROUNDOFF_SHARE * contact_tolerance(r, coord + math.hypot(k[4], k[5]), CA_RTOL)
     n_walls = 4 if dim == 2 else 2
     for wall in range(n_walls):
         normal_speed = abs(k[2]) if wall < 2 else abs(k[3])
-        t = _ca_solve(False, k, k, r, wall, bounds, normal_speed + spin, min(horizon, best), 1e-12 * scale)
+        t = _ca_solve(False, k, k, r, wall, bounds, normal_speed + spin, min(horizon, best), tol)
         if t < best:
             best = t
             best_wall = wall

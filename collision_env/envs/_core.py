@@ -272,6 +272,21 @@ class TaskCore:
         self.batch.set_scenes(idx, eps.positions, eps.velocities, masses=eps.masses, radii=eps.radii, time=0.0)
         self._write_episode(idx, eps)
 
+    @staticmethod
+    def check_actions(actions, field: str = "action") -> None:
+        """Raise ValueError unless ``actions`` holds real numbers: a complex, string or boolean action
+        would otherwise be cast to float64 silently (its imaginary part dropped, ``"0.5"`` parsed,
+        ``True`` read as 1). The envs call this on the action as given, before they convert it."""
+        if isinstance(actions, np.ndarray) and actions.dtype.kind in "iuf":
+            return  # the common path: one test
+        try:
+            values = np.asarray(actions, dtype=object).ravel()
+        except ValueError:
+            raise ValueError(f"{field}: expected real numbers, got a ragged sequence") from None
+        for x in values:
+            if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, float, np.integer, np.floating)):
+                raise ValueError(f"{field}: expected real numbers, got {x!r} ({type(x).__name__}) in {actions!r}")
+
     def advance(self, actions: np.ndarray, active: np.ndarray, dt: float) -> np.ndarray:
         """Nudge (actions (B, A) float64; inactive rows get none) and step the engine by dt.
 

@@ -157,6 +157,7 @@ class CollisionTargetEnv(gym.Env):
         return obs[0], info
 
     def step(self, action: ArrayLike) -> tuple[np.ndarray, SupportsFloat, bool, bool, dict[str, Any]]:
+        TaskCore.check_actions(action)
         a = self._action  # (1, A) float64, the kernel's input (reused: the kernel only reads it)
         if getattr(action, "shape", None) == self.action_space.shape:
             a[0] = action

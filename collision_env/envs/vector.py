@@ -153,6 +153,7 @@ class CollisionTargetVectorEnv(VectorEnv):
     def step(self, actions: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         if self._rngs[0] is None:
             raise ResetNeeded("call reset() before step() on the vector env")
+        TaskCore.check_actions(actions, "actions")
         a = np.asarray(actions, dtype=np.float64)
         if a.shape != self.action_space.shape:
             raise ValueError(f"actions: expected shape {self.action_space.shape}, got {a.shape}")

@@ -1,0 +1,34 @@
+"""How close counts as touching: contact tolerances from the local geometry.
+
+A gap is "zero" when it is within a small fraction of the size of the features involved (the
+radii) or within the round-off of the coordinates it is computed from, whichever is larger. The
+round-off term is the resolution of float64 at those coordinates (a few units in the last place):
+no gap can be resolved more finely than that, wherever the scene is. Neither term grows with
+the distance from the origin beyond that resolution: 1e6 m away, a 0.1 m ball's contact tolerance
+is ~2e-9 m (eight units in the last place of 1e6), where a tolerance relative to ``|x| + |y|`` would
+be a millimetre.
+"""
+
+from __future__ import annotations
+
+from ._jit import njit
+
+#: Contact tolerance relative to the feature size (radii, diameters).
+CONTACT_RTOL = 1e-9
+#: Units in the last place of the coordinates that a computed gap may be off by.
+ROUNDOFF_ULPS = 8.0
+#: float64 machine epsilon (the spacing of float64 numbers relative to their size).
+EPS = 2.0**-52
+
+
+@njit(inline="always")
+def roundoff(coord):
+    """The round-off (m) of a gap computed from coordinates of magnitude up to ``coord``."""
+    return ROUNDOFF_ULPS * EPS * coord
+
+
+@njit(inline="always")
+def contact_tolerance(length, coord, rtol):
+    """Largest gap (m) that counts as contact between features of size ``length`` (m), computed
+    from coordinates of magnitude up to ``coord`` (m): ``rtol * length`` or the round-off."""
+    return max(rtol * length, roundoff(coord))
