@@ -548,11 +548,13 @@ def _predict(i, now, horizon, rebuild, pos, vel, mass, radius, body, omega, rot,
             best_t = t_wall
             best_code = cal.EV_WALL - wall
     if pairs:
-        cx0, cx1, cy0, cy1 = grid.block(ci[i, C_CELL], nx, ny)
+        # one cell (small scenes): the partners are simply every other ball, in index order
+        one_cell = nx * ny == 1
+        cx0, cx1, cy0, cy1 = (0, 0, 0, 0) if one_cell else grid.block(ci[i, C_CELL], nx, ny)
         for cy in range(cy0, cy1 + 1):
             for cx in range(cx0, cx1 + 1):
-                k = ci[cy * nx + cx, C_CELL_HEAD]
-                while k >= 0:
+                k = (i + 1 if rebuild else 0) if one_cell else ci[cy * nx + cx, C_CELL_HEAD]
+                while 0 <= k < n:
                     if k != i and (k > i or not rebuild):
                         if rot:
                             t = _predict_pair(i, k, now, horizon, pos, vel, mass, radius, body, omega, rot, ki, kj,
@@ -568,7 +570,7 @@ def _predict(i, now, horizon, rebuild, pos, vel, mass, radius, body, omega, rot,
                                 best_code = k
                                 best_stamp = ci[k, C_CHANGES]
                             cal.offer_pair(k, t, i, n, not rebuild, cf, ci, hp)
-                    k = ci[k, C_CELL_NEXT]
+                    k = k + 1 if one_cell else ci[k, C_CELL_NEXT]
         if nx * ny > 1:
             tau, direction = grid.crossing(pos[i, 0], pos[i, 1], vel[i, 0], vel[i, 1], ci[i, C_CELL], x0, y0,
                                            hx, hy, nx, ny)
@@ -616,7 +618,7 @@ def _begin_changed_balls(pos, vel, cf, ci, geo, pending):
             pending[n_changed] = i
             n_changed += 1
             ci[i, C_CHANGES] += 1
-            c = grid.cell_of(pos[i, 0], pos[i, 1], x0, y0, hx, hy, nx, ny)
+            c = grid.cell_of(pos[i, 0], pos[i, 1], x0, y0, hx, hy, nx, ny) if nx * ny > 1 else 0
             if c != ci[i, C_CELL]:
                 grid.unlink(i, ci)
                 grid.link(i, c, ci)
