@@ -221,12 +221,21 @@ def ppo_kwargs(hp: dict) -> dict:
 
     from stable_baselines3 import PPO
 
-    known = set(inspect.signature(PPO.__init__).parameters) - {"self", "policy", "env", "seed", "device",
-                                                                "tensorboard_log", "verbose", "_init_setup_model"}
+    known = set(inspect.signature(PPO.__init__).parameters) - {
+        "self",
+        "policy",
+        "env",
+        "seed",
+        "device",
+        "tensorboard_log",
+        "verbose",
+        "_init_setup_model",
+    }
     unknown = sorted(set(hp) - known - set(RUN_KEYS))
     if unknown:
-        raise UsageError(f"hyperparameters: unknown key(s) {unknown}; PPO takes {sorted(known)} "
-                         f"and the file also {list(RUN_KEYS)}")
+        raise UsageError(
+            f"hyperparameters: unknown key(s) {unknown}; PPO takes {sorted(known)} and the file also {list(RUN_KEYS)}"
+        )
     policy = hp.get("policy", "MlpPolicy")
     if policy not in PPO.policy_aliases:
         raise UsageError(f"policy: expected one of {sorted(PPO.policy_aliases)}, got {policy!r}")
@@ -248,8 +257,18 @@ def ppo_kwargs(hp: dict) -> dict:
 
 #: PPO keywords that take a number (the first three also a schedule, lin_<x>).
 _SCHEDULES = ("learning_rate", "clip_range", "clip_range_vf")
-_NUMBERS = _SCHEDULES + ("n_steps", "batch_size", "n_epochs", "gamma", "gae_lambda", "ent_coef", "vf_coef",
-                         "max_grad_norm", "target_kl", "sde_sample_freq")
+_NUMBERS = _SCHEDULES + (
+    "n_steps",
+    "batch_size",
+    "n_epochs",
+    "gamma",
+    "gae_lambda",
+    "ent_coef",
+    "vf_coef",
+    "max_grad_norm",
+    "target_kl",
+    "sde_sample_freq",
+)
 
 
 def as_int(name: str, value: Any, low: int = 1) -> int:
@@ -267,8 +286,13 @@ def as_int(name: str, value: Any, low: int = 1) -> int:
 def add_progress_flags(parser) -> None:
     """``--progress`` / ``--no-progress`` (default: a progress bar when stdout is a terminal)."""
     bar = parser.add_mutually_exclusive_group()
-    bar.add_argument("--progress", dest="progress", action="store_true", default=None,
-                     help="show SB3's progress bar (default: when stdout is a terminal)")
+    bar.add_argument(
+        "--progress",
+        dest="progress",
+        action="store_true",
+        default=None,
+        help="show SB3's progress bar (default: when stdout is a terminal)",
+    )
     bar.add_argument("--no-progress", dest="progress", action="store_false")
 
 

@@ -196,10 +196,17 @@ def play(env, factory: PolicyFactory, episodes: int, seed: int, frames: list | N
     success = [r[0] for r in rows]
     lo, hi = wilson_interval(sum(success), len(success))
     mean = lambda k: float(np.mean([r[k] for r in rows]))  # noqa: E731
-    return {"episodes": episodes, "success_rate": float(np.mean(success)), "success_ci95": [lo, hi],
-            "mean_return": mean(1), "mean_nudge": mean(2), "mean_nudge_cost": cost_per * mean(2),
-            "mean_targets_hit": mean(3), "mean_length": mean(4),
-            "seconds": round(time.perf_counter() - start, 2)}
+    return {
+        "episodes": episodes,
+        "success_rate": float(np.mean(success)),
+        "success_ci95": [lo, hi],
+        "mean_return": mean(1),
+        "mean_nudge": mean(2),
+        "mean_nudge_cost": cost_per * mean(2),
+        "mean_targets_hit": mean(3),
+        "mean_length": mean(4),
+        "seconds": round(time.perf_counter() - start, 2),
+    }
 
 
 def make_env(env_id: str, env_kwargs: dict, render_mode: str | None = None):
@@ -207,8 +214,7 @@ def make_env(env_id: str, env_kwargs: dict, render_mode: str | None = None):
 
     import collision_env  # noqa: F401
 
-    return gym.make(env_id, max_episode_steps=episode_steps(env_id, env_kwargs), render_mode=render_mode,
-                    **env_kwargs)
+    return gym.make(env_id, max_episode_steps=episode_steps(env_id, env_kwargs), render_mode=render_mode, **env_kwargs)
 
 
 def eval_kwargs(run: dict, mode: str | None, substeps: int | None) -> dict:
@@ -222,8 +228,16 @@ def eval_kwargs(run: dict, mode: str | None, substeps: int | None) -> dict:
     return kwargs
 
 
-def evaluate(run_dir: str | Path, *, episodes: int = 100, mode: str | None = None, substeps: int | None = None,
-             seed: int = EVAL_SEED, baselines: tuple = BASELINES, model: str = "final") -> dict:
+def evaluate(
+    run_dir: str | Path,
+    *,
+    episodes: int = 100,
+    mode: str | None = None,
+    substeps: int | None = None,
+    seed: int = EVAL_SEED,
+    baselines: tuple = BASELINES,
+    model: str = "final",
+) -> dict:
     """Evaluate the run (and the baselines) on the same episodes; returns the results dict."""
     run = read_any_run(run_dir)
     env_id = check_env_id(run["env_id"])
@@ -237,10 +251,19 @@ def evaluate(run_dir: str | Path, *, episodes: int = 100, mode: str | None = Non
     if "scripted" in baselines:
         policies["scripted"] = scripted_baseline(env)
     trained = run.get("env_kwargs") or {}
-    results = {"env_id": env_id, "run": str(run_dir), "trainer": "rllib" if is_rllib_run(run) else "sb3",
-               "model": model, "train_mode": trained.get("mode", "exact"),
-               "train_substeps": int(trained.get("substeps", 1)), "mode": kwargs.get("mode", "exact"),
-               "substeps": int(kwargs.get("substeps", 1)), "episodes": episodes, "seed": seed, "policies": {}}
+    results = {
+        "env_id": env_id,
+        "run": str(run_dir),
+        "trainer": "rllib" if is_rllib_run(run) else "sb3",
+        "model": model,
+        "train_mode": trained.get("mode", "exact"),
+        "train_substeps": int(trained.get("substeps", 1)),
+        "mode": kwargs.get("mode", "exact"),
+        "substeps": int(kwargs.get("substeps", 1)),
+        "episodes": episodes,
+        "seed": seed,
+        "policies": {},
+    }
     for name, factory in policies.items():
         results["policies"][name] = None if factory is None else play(env, factory, episodes, seed)
     env.close()
@@ -259,8 +282,16 @@ def check_video_path(path: str | Path) -> Path:
     return path
 
 
-def record(run_dir: str | Path, path: str | Path, *, episodes: int = 1, mode: str | None = None,
-           substeps: int | None = None, seed: int = EVAL_SEED, model: str = "final") -> Path:
+def record(
+    run_dir: str | Path,
+    path: str | Path,
+    *,
+    episodes: int = 1,
+    mode: str | None = None,
+    substeps: int | None = None,
+    seed: int = EVAL_SEED,
+    model: str = "final",
+) -> Path:
     """Record the trained policy's first ``episodes`` evaluation episodes as a GIF or MP4 (by suffix)."""
     import imageio.v2 as imageio
 
@@ -289,11 +320,13 @@ def markdown(results: dict) -> str:
     """The results as a Markdown table, one row per policy."""
     mode = results["mode"] + (f" k={results['substeps']}" if results["substeps"] != 1 else "")
     train = results["train_mode"] + (f" k={results['train_substeps']}" if results["train_substeps"] != 1 else "")
-    lines = [f"{results['env_id']}: {results['episodes']} episodes (seeds {results['seed']}...), "
-             f"evaluated in {mode} mode, trained in {train} mode",
-             "",
-             "| policy | success (95 % CI) | mean return | mean nudge (m/s) | nudge cost | targets hit | steps |",
-             "|---|---:|---:|---:|---:|---:|---:|"]
+    lines = [
+        f"{results['env_id']}: {results['episodes']} episodes (seeds {results['seed']}...), "
+        f"evaluated in {mode} mode, trained in {train} mode",
+        "",
+        "| policy | success (95 % CI) | mean return | mean nudge (m/s) | nudge cost | targets hit | steps |",
+        "|---|---:|---:|---:|---:|---:|---:|",
+    ]
     trained = "RLlib PPO" if results.get("trainer") == "rllib" else "PPO"
     names = {"ppo": f"{trained} (this run, deterministic)", "random": "random", "scripted": SCRIPTED_LABEL}
     for key, r in results["policies"].items():
@@ -301,14 +334,22 @@ def markdown(results: dict) -> str:
             lines.append(f"| {names.get(key, key)} | n/a | | | | | |")
             continue
         lo, hi = r["success_ci95"]
-        lines.append(f"| {names.get(key, key)} | {pct(r['success_rate'])} ({pct(lo)}–{pct(hi)}) | "
-                     f"{r['mean_return']:.3f} | {r['mean_nudge']:.2f} | {r['mean_nudge_cost']:.3f} | "
-                     f"{r['mean_targets_hit']:.2f} | {r['mean_length']:.0f} |")
+        lines.append(
+            f"| {names.get(key, key)} | {pct(r['success_rate'])} ({pct(lo)}–{pct(hi)}) | "
+            f"{r['mean_return']:.3f} | {r['mean_nudge']:.2f} | {r['mean_nudge_cost']:.3f} | "
+            f"{r['mean_targets_hit']:.2f} | {r['mean_length']:.0f} |"
+        )
     return "\n".join(lines)
 
 
-def results_path(run_dir: str | Path, run: dict, json_path: str | None, mode: str | None, substeps: int | None,
-                 overwrite: bool = False) -> Path:
+def results_path(
+    run_dir: str | Path,
+    run: dict,
+    json_path: str | None,
+    mode: str | None,
+    substeps: int | None,
+    overwrite: bool = False,
+) -> Path:
     """Where to write the results, decided before evaluating: never an earlier evaluation's file.
 
     ``--json PATH`` is used as given (an existing file needs ``overwrite``); the default
@@ -330,8 +371,11 @@ def results_path(run_dir: str | Path, run: dict, json_path: str | None, mode: st
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="python -m agents.evaluate", description=__doc__.split("\n\n")[0],
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(
+        prog="python -m agents.evaluate",
+        description=__doc__.split("\n\n")[0],
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument("run", help="a run folder written by agents.train_ppo or agents.train_rllib")
     p.add_argument("--episodes", type=int, default=100)
     p.add_argument("--mode", choices=("exact", "posteriori", "naive"), help="engine mode (default: the run's)")
@@ -349,22 +393,37 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> dict:
     args = build_parser().parse_args(argv)
-    videos = ([args.video] if args.video else []) + ([args.gif or Path(args.run) / "episodes.gif"]
-                                                     if args.gif is not None else [])
+    videos = ([args.video] if args.video else []) + (
+        [args.gif or Path(args.run) / "episodes.gif"] if args.gif is not None else []
+    )
     for video in videos:  # fail on a bad path before the evaluation, not after it
         check_video_path(video)
     as_int("record episodes", args.record_episodes)
     run = read_any_run(args.run)
     out = results_path(args.run, run, args.json, args.mode, args.substeps, args.overwrite)
-    results = evaluate(args.run, episodes=args.episodes, mode=args.mode, substeps=args.substeps, seed=args.seed,
-                       baselines=() if args.no_baselines else BASELINES, model=args.model)
+    results = evaluate(
+        args.run,
+        episodes=args.episodes,
+        mode=args.mode,
+        substeps=args.substeps,
+        seed=args.seed,
+        baselines=() if args.no_baselines else BASELINES,
+        model=args.model,
+    )
     print(markdown(results))
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(results, indent=1))
     print(f"results: {out}")
     for video in videos:
-        path = record(args.run, video, episodes=args.record_episodes, mode=args.mode, substeps=args.substeps,
-                      seed=args.seed, model=args.model)
+        path = record(
+            args.run,
+            video,
+            episodes=args.record_episodes,
+            mode=args.mode,
+            substeps=args.substeps,
+            seed=args.seed,
+            model=args.model,
+        )
         print(f"video:   {path}")
     return results
 

@@ -33,8 +33,9 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> Path:
     args = build_parser().parse_args(argv)
     episodes = as_int("episodes", args.episodes)  # checked before training, not after it
-    run_dir = train(args.env, timesteps=args.timesteps, seed=args.seed, output=args.output,
-                    progress=wants_progress(args.progress))
+    run_dir = train(
+        args.env, timesteps=args.timesteps, seed=args.seed, output=args.output, progress=wants_progress(args.progress)
+    )
     print(f"evaluating over {episodes} episodes in exact mode, beside the random and scripted baselines ...")
     results = evaluate(run_dir, episodes=episodes, mode="exact")
     (run_dir / "eval-exact.json").write_text(json.dumps(results, indent=1))

@@ -55,8 +55,9 @@ def make_env(config: dict[str, Any]):
     num_envs = kwargs.pop("num_envs", None)
     if num_envs is None:
         return gym.make(env_id, **kwargs)
-    return ListFriendlyInfos(gym.make_vec(env_id, num_envs=int(num_envs), vectorization_mode="vector_entry_point",
-                                          **kwargs))
+    return ListFriendlyInfos(
+        gym.make_vec(env_id, num_envs=int(num_envs), vectorization_mode="vector_entry_point", **kwargs)
+    )
 
 
 def rllib_env_name(env_id: str) -> str:

@@ -40,8 +40,12 @@ def throughput(env_id: str, envs_per_runner: int, steps: int, repeats: int = 3) 
     warm_up(env_id, {})
     start_ray(None, 1)
     try:
-        algos = {mode: build_config(env_id, {}, hp, env_runners=0, envs_per_runner=envs_per_runner,
-                                    vectorize=mode, seed=0).build_algo() for mode in ("native", "sync")}
+        algos = {
+            mode: build_config(
+                env_id, {}, hp, env_runners=0, envs_per_runner=envs_per_runner, vectorize=mode, seed=0
+            ).build_algo()
+            for mode in ("native", "sync")
+        }
         best = {mode: float("inf") for mode in algos}
         for algo in algos.values():
             algo.env_runner.sample(num_timesteps=steps // 4)  # first episodes, connector set-up
@@ -76,13 +80,14 @@ def placement_table(run: dict) -> list[str]:
         nodes.setdefault(spot["node_id"], len(nodes) + 1)
     lines = ["| env runner | Ray node | node address | on the driver's (head) node | pid |", "|---:|---|---|---|---:|"]
     for spot in run["runner_placement"]:
-        lines.append(f"| {spot['runner']} | node {nodes[spot['node_id']]} (`{spot['node_id'][:12]}`) | "
-                     f"{spot['node_address']} | {'yes' if spot['driver_node'] else 'no'} | {spot['pid']} |")
+        lines.append(
+            f"| {spot['runner']} | node {nodes[spot['node_id']]} (`{spot['node_id'][:12]}`) | "
+            f"{spot['node_address']} | {'yes' if spot['driver_node'] else 'no'} | {spot['pid']} |"
+        )
     return lines
 
 
-def block(env_id: str, rates: dict, run: dict, results: dict, cluster: dict | None,
-          seconds: float) -> str:
+def block(env_id: str, rates: dict, run: dict, results: dict, cluster: dict | None, seconds: float) -> str:
     from agents.evaluate import markdown
 
     v = run["versions"]
@@ -94,11 +99,13 @@ def block(env_id: str, rates: dict, run: dict, results: dict, cluster: dict | No
         f"**Throughput**: env steps/s of one env runner sampling `{env_id}` with its policy (one torch thread), "
         "both vectorisations alternating in the same process (best of 3):",
         "",
-        "| sub-envs per runner | native vector env (`\"vector_entry_point\"`) | RLlib's default (`\"sync\"`: one "
+        '| sub-envs per runner | native vector env (`"vector_entry_point"`) | RLlib\'s default (`"sync"`: one '
         "`gym.make` per sub-env) | native ÷ default |",
         "|---:|---:|---:|---:|",
-        *(f"| {n} | {_rate(r['native'])} | {_rate(r['sync'])} | **{r['native'] / r['sync']:.2f}** |"
-          for n, r in rates.items()),
+        *(
+            f"| {n} | {_rate(r['native'])} | {_rate(r['sync'])} | **{r['native'] / r['sync']:.2f}** |"
+            for n, r in rates.items()
+        ),
         "",
         f"**Training**: `python -m agents.train_rllib --env {env_id}` ({run['env_runners']} env runners x "
         f"{run['envs_per_runner']} envs, native): the deterministic policy reached "
@@ -128,8 +135,13 @@ def block(env_id: str, rates: dict, run: dict, results: dict, cluster: dict | No
 def main(argv: list[str] | None = None) -> str:
     p = argparse.ArgumentParser(prog="python -m agents.rllib_report", description=__doc__.split("\n\n")[0])
     p.add_argument("--env", default=DEFAULT_ENV)
-    p.add_argument("--envs-per-runner", type=int, nargs="+", default=[16, 128],
-                   help="sub-envs per runner to measure throughput at (default: %(default)s)")
+    p.add_argument(
+        "--envs-per-runner",
+        type=int,
+        nargs="+",
+        default=[16, 128],
+        help="sub-envs per runner to measure throughput at (default: %(default)s)",
+    )
     p.add_argument("--steps", type=int, default=8192, help="env steps per throughput repeat")
     p.add_argument("--cluster", help="a run folder of train_rllib --address on a multi-node cluster")
     p.add_argument("--readme", help="write the block into this README (between its agents:rllib markers)")
@@ -138,8 +150,10 @@ def main(argv: list[str] | None = None) -> str:
     rates = {}
     for n in args.envs_per_runner:
         rates[n] = throughput(args.env, n, max(args.steps, 64 * n))
-        print(f"throughput, {n} sub-envs: native {_rate(rates[n]['native'])} env steps/s, "
-              f"sync {_rate(rates[n]['sync'])}", flush=True)
+        print(
+            f"throughput, {n} sub-envs: native {_rate(rates[n]['native'])} env steps/s, sync {_rate(rates[n]['sync'])}",
+            flush=True,
+        )
     with tempfile.TemporaryDirectory() as tmp:
         run, results = training_run(args.env, Path(tmp))
     cluster = load_yaml(Path(args.cluster) / CONFIG_FILE) if args.cluster else None

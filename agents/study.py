@@ -69,9 +69,19 @@ def train_and_evaluate(task: dict) -> dict:
 
     torch.set_num_threads(1)
     name = run_label(task["env_id"], task["mode"], task["substeps"], task["seed"])
-    run_dir = train(task["env_id"], timesteps=task["timesteps"], seed=task["seed"], mode=task["mode"],
-                    substeps=task["substeps"], output=task["output"], run_name=name, eval_freq=0, save_freq=0,
-                    overwrite=True, log=lambda *a: None)
+    run_dir = train(
+        task["env_id"],
+        timesteps=task["timesteps"],
+        seed=task["seed"],
+        mode=task["mode"],
+        substeps=task["substeps"],
+        output=task["output"],
+        run_name=name,
+        eval_freq=0,
+        save_freq=0,
+        overwrite=True,
+        log=lambda *a: None,
+    )
     run = read_run(run_dir)
     out = {**task, "run": str(run_dir), "train_seconds": run["train_seconds"], "timesteps_done": run["timesteps_done"]}
     exact = evaluate(run_dir, episodes=task["episodes"], mode="exact", baselines=())
@@ -146,14 +156,16 @@ def modes_table(rows: list) -> str:
     tables = []
     for env_id, groups in _by_env_and_mode(rows).items():
         first = next(iter(groups.values()))[0]
-        lines = [f"**`{env_id}`**: PPO with the shipped hyperparameters ({first['timesteps_done']:,} steps), "
-                 f"trained under each engine mode, evaluated deterministically on the same {first['episodes']} "
-                 "episodes. Success: mean ± standard deviation over seeds, then each seed's figure; training "
-                 "time: median over seeds.",
-                 "",
-                 "| trained in | success, evaluated exact | per seed | success in its own mode | "
-                 "training time (s) | ÷ exact's |",
-                 "|---|---:|---:|---:|---:|---:|"]
+        lines = [
+            f"**`{env_id}`**: PPO with the shipped hyperparameters ({first['timesteps_done']:,} steps), "
+            f"trained under each engine mode, evaluated deterministically on the same {first['episodes']} "
+            "episodes. Success: mean ± standard deviation over seeds, then each seed's figure; training "
+            "time: median over seeds.",
+            "",
+            "| trained in | success, evaluated exact | per seed | success in its own mode | "
+            "training time (s) | ÷ exact's |",
+            "|---|---:|---:|---:|---:|---:|",
+        ]
         exact_rows = groups.get(("exact", 1))
         exact_time = _seconds(exact_rows) if exact_rows else None
         for (mode, k), rs in groups.items():
@@ -161,8 +173,10 @@ def modes_table(rows: list) -> str:
             own = [r["own"]["success_rate"] for r in rs]
             secs = _seconds(rs)
             ratio = f"{secs / exact_time:.2f}" if exact_time else "n/a"
-            lines.append(f"| {_label(mode, k)} | {_spread(exact)} | {' / '.join(pct(x) for x in exact)} | "
-                         f"{_spread(own)} | {secs:.0f} | {ratio} |")
+            lines.append(
+                f"| {_label(mode, k)} | {_spread(exact)} | {' / '.join(pct(x) for x in exact)} | "
+                f"{_spread(own)} | {secs:.0f} | {ratio} |"
+            )
         tables.append("\n".join(lines))
     return "\n\n".join(tables)
 
@@ -177,16 +191,24 @@ def modes_reading(rows: list) -> str:
             continue
         ref = statistics.fmean(r["exact"]["success_rate"] for r in exact_rows)
         diffs = [statistics.fmean(r["exact"]["success_rate"] for r in rs) - ref for rs in cheap.values()]
-        spread = max(statistics.stdev([r["exact"]["success_rate"] for r in rs]) if len(rs) > 1 else 0.0
-                     for rs in groups.values())
+        spread = max(
+            statistics.stdev([r["exact"]["success_rate"] for r in rs]) if len(rs) > 1 else 0.0 for rs in groups.values()
+        )
         ratios = [_seconds(rs) / _seconds(exact_rows) for rs in cheap.values()]
         worst = min(diffs)
-        verdict = ("within the seed-to-seed spread" if max(abs(d) for d in diffs) <= spread
-                   else f"at worst {100 * -worst:.0f} points below" if worst < 0 else "no worse")
-        out.append(f"- `{env_id}`: policies trained in the cheaper modes succeed in exact mode "
-                   f"{pct(ref + min(diffs))}–{pct(ref + max(diffs))} against exact-trained {pct(ref)}, "
-                   f"{verdict} (largest standard deviation over seeds {100 * spread:.0f} points), after "
-                   f"{min(ratios):.2f}–{max(ratios):.2f}× exact mode's training time.")
+        verdict = (
+            "within the seed-to-seed spread"
+            if max(abs(d) for d in diffs) <= spread
+            else f"at worst {100 * -worst:.0f} points below"
+            if worst < 0
+            else "no worse"
+        )
+        out.append(
+            f"- `{env_id}`: policies trained in the cheaper modes succeed in exact mode "
+            f"{pct(ref + min(diffs))}–{pct(ref + max(diffs))} against exact-trained {pct(ref)}, "
+            f"{verdict} (largest standard deviation over seeds {100 * spread:.0f} points), after "
+            f"{min(ratios):.2f}–{max(ratios):.2f}× exact mode's training time."
+        )
     return "\n".join(out)
 
 
@@ -196,13 +218,14 @@ def presets_table(rows: list, base: list) -> str:
         return ""
     by_env = {b["env_id"]: b for b in base}
     episodes = rows[0]["episodes"]
-    lines = [f"Every preset, PPO in exact mode with the shipped hyperparameters, beside the baselines on the same "
-             f"{episodes} evaluation episodes (success rate; mean return in brackets). PPO: mean ± standard "
-             "deviation over seeds, then each seed; training time: median over seeds.",
-             "",
-             "| env | steps | PPO success | per seed | PPO return | random | scripted (exact aim) "
-             "| training time (s) |",
-             "|---|---:|---:|---:|---:|---:|---:|---:|"]
+    lines = [
+        f"Every preset, PPO in exact mode with the shipped hyperparameters, beside the baselines on the same "
+        f"{episodes} evaluation episodes (success rate; mean return in brackets). PPO: mean ± standard "
+        "deviation over seeds, then each seed; training time: median over seeds.",
+        "",
+        "| env | steps | PPO success | per seed | PPO return | random | scripted (exact aim) | training time (s) |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|",
+    ]
     order = [b["env_id"] for b in base]  # the presets in the order they were asked for
     groups: dict = {}
     for r in sorted(rows, key=lambda r: order.index(r["env_id"]) if r["env_id"] in order else len(order)):
@@ -213,9 +236,11 @@ def presets_table(rows: list, base: list) -> str:
         ret = statistics.fmean(r["exact"]["mean_return"] for r in rs)
         b = by_env.get(env_id, {})
         fmt = lambda p: "n/a" if p is None else f"{pct(p['success_rate'])} ({p['mean_return']:.2f})"  # noqa: E731
-        lines.append(f"| `{env_id}` | {rs[0]['timesteps_done']:,} | {_spread(succ)} | "
-                     f"{' / '.join(pct(x) for x in succ)} | {ret:.2f} | {fmt(b.get('random'))} | "
-                     f"{fmt(b.get('scripted'))} | {_seconds(rs):.0f} |")
+        lines.append(
+            f"| `{env_id}` | {rs[0]['timesteps_done']:,} | {_spread(succ)} | "
+            f"{' / '.join(pct(x) for x in succ)} | {ret:.2f} | {fmt(b.get('random'))} | "
+            f"{fmt(b.get('scripted'))} | {_seconds(rs):.0f} |"
+        )
     return "\n".join(lines)
 
 
@@ -236,10 +261,16 @@ def plot(rows: list, path: Path) -> Path | None:
         for i, rs in enumerate(groups.values()):
             exact = [100 * r["exact"]["success_rate"] for r in rs]
             own = [100 * r["own"]["success_rate"] for r in rs]
-            ax1.bar(i - 0.2, statistics.fmean(exact), 0.4, color="tab:blue",
-                    label="evaluated exact" if i == 0 else None)
-            ax1.bar(i + 0.2, statistics.fmean(own), 0.4, color="tab:gray",
-                    label="evaluated in its own mode" if i == 0 else None)
+            ax1.bar(
+                i - 0.2, statistics.fmean(exact), 0.4, color="tab:blue", label="evaluated exact" if i == 0 else None
+            )
+            ax1.bar(
+                i + 0.2,
+                statistics.fmean(own),
+                0.4,
+                color="tab:gray",
+                label="evaluated in its own mode" if i == 0 else None,
+            )
             ax1.plot([i - 0.2] * len(exact), exact, "k.", ms=6)
             ax1.plot([i + 0.2] * len(own), own, "k.", ms=6)
             ax2.bar(i, _seconds(rs), 0.6, color="tab:orange")
@@ -268,8 +299,10 @@ def render(data: dict, docs: Path, readme: Path | None) -> None:
 
     docs.mkdir(parents=True, exist_ok=True)
     meta = data["meta"]
-    stamp = (f"Generated by `python -m agents.study` ({meta['date']}, {meta['machine']}, {meta['cpus']} CPUs, "
-             f"{meta['jobs']} run(s) at a time, {meta['minutes']:.0f} min); do not edit by hand.")
+    stamp = (
+        f"Generated by `python -m agents.study` ({meta['date']}, {meta['machine']}, {meta['cpus']} CPUs, "
+        f"{meta['jobs']} run(s) at a time, {meta['minutes']:.0f} min); do not edit by hand."
+    )
     modes = modes_table(data["rows"])
     presets = presets_table(data["rows"], data["baselines"])
     png = plot(data["rows"], docs / "modes.png")
@@ -294,8 +327,11 @@ def render(data: dict, docs: Path, readme: Path | None) -> None:
 
 # --------------------------------------------------------------------------------------- main
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="python -m agents.study", description=__doc__.split("\n\n")[0],
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(
+        prog="python -m agents.study",
+        description=__doc__.split("\n\n")[0],
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument("--part", choices=("modes", "presets", "both"), default="both")
     p.add_argument("--envs", nargs="+", default=list(DEFAULT_ENVS), help="presets of the modes part")
     p.add_argument("--modes", nargs="+", default=list(DEFAULT_MODES), metavar="MODE:K")
@@ -350,28 +386,53 @@ def main(argv: list[str] | None = None) -> dict:
     common = {"episodes": as_int("episodes", args.episodes), "output": args.output}
     tasks = []
     if args.part in ("modes", "both"):
-        tasks += [{"part": "modes", "env_id": e, "mode": m, "substeps": k, "seed": s, "timesteps": steps(e),
-                   **common} for e in envs for m, k in modes for s in seeds]
+        tasks += [
+            {"part": "modes", "env_id": e, "mode": m, "substeps": k, "seed": s, "timesteps": steps(e), **common}
+            for e in envs
+            for m, k in modes
+            for s in seeds
+        ]
     if args.part in ("presets", "both"):
         for env_id in presets:
             if args.part == "both" and env_id in envs and ("exact", 1) in modes:
                 continue  # the modes part trains this preset in exact mode over the same seeds already
-            tasks += [{"part": "presets", "env_id": env_id, "mode": "exact", "substeps": 1, "seed": s,
-                       "timesteps": steps(env_id), **common} for s in seeds]
+            tasks += [
+                {
+                    "part": "presets",
+                    "env_id": env_id,
+                    "mode": "exact",
+                    "substeps": 1,
+                    "seed": s,
+                    "timesteps": steps(env_id),
+                    **common,
+                }
+                for s in seeds
+            ]
     start = time.perf_counter()
     print(f"{len(tasks)} training runs, {args.jobs} at a time ...")
     rows = _run_all(train_and_evaluate, tasks, args.jobs, print)
     if args.part == "both":  # the shared runs count for the presets table too
-        rows += [{**r, "part": "presets"} for r in rows
-                 if r["part"] == "modes" and r["mode"] == "exact" and r["env_id"] in presets]
+        rows += [
+            {**r, "part": "presets"}
+            for r in rows
+            if r["part"] == "modes" and r["mode"] == "exact" and r["env_id"] in presets
+        ]
     base = []
     if args.part in ("presets", "both"):
         print("baselines ...")
         base = _run_all(baselines, [{"env_id": e, "episodes": args.episodes} for e in presets], args.jobs, print)
-    data = {"meta": {"date": timestamp(), "machine": machine(), "cpus": cpus(), "jobs": args.jobs,
-                     "minutes": (time.perf_counter() - start) / 60,
-                     "versions": versions(["gymnasium", "stable_baselines3", "torch"])},
-            "rows": rows, "baselines": base}
+    data = {
+        "meta": {
+            "date": timestamp(),
+            "machine": machine(),
+            "cpus": cpus(),
+            "jobs": args.jobs,
+            "minutes": (time.perf_counter() - start) / 60,
+            "versions": versions(["gymnasium", "stable_baselines3", "torch"]),
+        },
+        "rows": rows,
+        "baselines": base,
+    }
     docs.mkdir(parents=True, exist_ok=True)
     (docs / "study.json").write_text(json.dumps(data, indent=1))
     render(data, docs, readme)

@@ -69,8 +69,9 @@ LOG_FILE = "train.log"
 CALLBACK_DEFAULTS = {"eval_freq": 50_000, "eval_episodes": 20, "save_freq": 250_000}
 
 
-def make_vec_env(env_id: str, n_envs: int, seed: int, env_kwargs: dict, vec_env: str = "native",
-                 monitor_dir: Path | None = None):
+def make_vec_env(
+    env_id: str, n_envs: int, seed: int, env_kwargs: dict, vec_env: str = "native", monitor_dir: Path | None = None
+):
     """An SB3 ``VecEnv`` of ``n_envs`` sub-envs (sub-env i seeded ``seed + i``), monitored.
 
     ``native``: the batched env through :func:`collision_env.envs.sb3.make_sb3_vec_env` (one
@@ -82,9 +83,13 @@ def make_vec_env(env_id: str, n_envs: int, seed: int, env_kwargs: dict, vec_env:
     if vec_env == "native":
         from collision_env.envs.sb3 import make_sb3_vec_env
 
-        return make_sb3_vec_env(env_id, n_envs, seed=seed,
-                                monitor_file=None if monitor_dir is None else str(monitor_dir / "monitor.csv"),
-                                **kwargs)
+        return make_sb3_vec_env(
+            env_id,
+            n_envs,
+            seed=seed,
+            monitor_file=None if monitor_dir is None else str(monitor_dir / "monitor.csv"),
+            **kwargs,
+        )
     from stable_baselines3.common.env_util import make_vec_env as sb3_make_vec_env
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
 
@@ -94,7 +99,10 @@ def make_vec_env(env_id: str, n_envs: int, seed: int, env_kwargs: dict, vec_env:
 
     # "module:id" makes gym.make import collision_env first, in a subprocess too
     return sb3_make_vec_env(
-        f"collision_env:{env_id}", n_envs=n_envs, seed=seed, env_kwargs=kwargs,
+        f"collision_env:{env_id}",
+        n_envs=n_envs,
+        seed=seed,
+        env_kwargs=kwargs,
         vec_env_cls=DummyVecEnv if vec_env == "dummy" else SubprocVecEnv,
         vec_env_kwargs={} if vec_env == "dummy" else {"start_method": start_method},
         monitor_dir=None if monitor_dir is None else str(monitor_dir),
@@ -138,8 +146,16 @@ def _wrap_normalize(venv, settings: dict | None, gamma: float, training: bool):
     return VecNormalize(venv, training=False, gamma=gamma, **{**settings, "norm_reward": False})
 
 
-def _callbacks(run_dir: Path, eval_env, eval_seed: int, n_envs: int, eval_freq: int, eval_episodes: int,
-               save_freq: int, normalized: bool) -> list:
+def _callbacks(
+    run_dir: Path,
+    eval_env,
+    eval_seed: int,
+    n_envs: int,
+    eval_freq: int,
+    eval_episodes: int,
+    save_freq: int,
+    normalized: bool,
+) -> list:
     from stable_baselines3.common.callbacks import BaseCallback, CheckpointCallback, EvalCallback
 
     class SeededEvalCallback(EvalCallback):
@@ -159,13 +175,27 @@ def _callbacks(run_dir: Path, eval_env, eval_seed: int, n_envs: int, eval_freq: 
 
     out = []
     if eval_freq:
-        out.append(SeededEvalCallback(eval_env, n_eval_episodes=eval_episodes, eval_freq=max(eval_freq // n_envs, 1),
-                                      best_model_save_path=str(run_dir), log_path=str(run_dir / "eval"),
-                                      deterministic=True, verbose=0,
-                                      callback_on_new_best=SaveBestStatistics() if normalized else None))
+        out.append(
+            SeededEvalCallback(
+                eval_env,
+                n_eval_episodes=eval_episodes,
+                eval_freq=max(eval_freq // n_envs, 1),
+                best_model_save_path=str(run_dir),
+                log_path=str(run_dir / "eval"),
+                deterministic=True,
+                verbose=0,
+                callback_on_new_best=SaveBestStatistics() if normalized else None,
+            )
+        )
     if save_freq:
-        out.append(CheckpointCallback(save_freq=max(save_freq // n_envs, 1), save_path=str(run_dir / "checkpoints"),
-                                      name_prefix="model", save_vecnormalize=normalized))
+        out.append(
+            CheckpointCallback(
+                save_freq=max(save_freq // n_envs, 1),
+                save_path=str(run_dir / "checkpoints"),
+                name_prefix="model",
+                save_vecnormalize=normalized,
+            )
+        )
     return out
 
 
@@ -212,13 +242,28 @@ def default_run_name(env_id: str, mode: str, substeps: int, seed: int) -> str:
     return f"{run_label(env_id, mode, substeps, seed)}-{time.strftime('%Y%m%d-%H%M%S')}"
 
 
-def train(env_id: str = DEFAULT_ENV, *, timesteps: float | None = None, n_envs: int | None = None, seed: int = 0,
-          mode: str | None = None, substeps: int | None = None, env_kwargs: dict | None = None,
-          output: str | Path = "runs", run_name: str | None = None, hyperparams: str | Path = HYPERPARAMS,
-          vec_env: str = "native", eval_freq: int = CALLBACK_DEFAULTS["eval_freq"],
-          eval_episodes: int = CALLBACK_DEFAULTS["eval_episodes"], save_freq: int = CALLBACK_DEFAULTS["save_freq"],
-          progress: bool = False, threads: int = 1, overwrite: bool = False, verbose: int = 0,
-          log=None) -> Path:
+def train(
+    env_id: str = DEFAULT_ENV,
+    *,
+    timesteps: float | None = None,
+    n_envs: int | None = None,
+    seed: int = 0,
+    mode: str | None = None,
+    substeps: int | None = None,
+    env_kwargs: dict | None = None,
+    output: str | Path = "runs",
+    run_name: str | None = None,
+    hyperparams: str | Path = HYPERPARAMS,
+    vec_env: str = "native",
+    eval_freq: int = CALLBACK_DEFAULTS["eval_freq"],
+    eval_episodes: int = CALLBACK_DEFAULTS["eval_episodes"],
+    save_freq: int = CALLBACK_DEFAULTS["save_freq"],
+    progress: bool = False,
+    threads: int = 1,
+    overwrite: bool = False,
+    verbose: int = 0,
+    log=None,
+) -> Path:
     """Train PPO on ``env_id`` and write the run folder; returns its path.
 
     ``mode``/``substeps`` set the engine's fidelity (they override ``env_kwargs``, which override
@@ -263,32 +308,46 @@ def train(env_id: str = DEFAULT_ENV, *, timesteps: float | None = None, n_envs: 
     torch.set_num_threads(threads)
     callbacks_cfg = {"eval_freq": eval_freq, "eval_episodes": eval_episodes, "save_freq": save_freq}
     config = {
-        "env_id": env_id, "env_kwargs": kwargs, "episode_steps": steps, "seed": seed, "n_envs": n_envs,
-        "n_timesteps": timesteps, "vec_env": vec_env, "callbacks": callbacks_cfg, "threads": threads,
+        "env_id": env_id,
+        "env_kwargs": kwargs,
+        "episode_steps": steps,
+        "seed": seed,
+        "n_envs": n_envs,
+        "n_timesteps": timesteps,
+        "vec_env": vec_env,
+        "callbacks": callbacks_cfg,
+        "threads": threads,
         "hyperparams": {**hp, "n_envs": n_envs, "n_timesteps": timesteps, "env_kwargs": dict(kwargs)},
-        "hyperparams_file": str(hyperparams), "versions": versions(["gymnasium", "stable_baselines3", "torch"]),
+        "hyperparams_file": str(hyperparams),
+        "versions": versions(["gymnasium", "stable_baselines3", "torch"]),
     }
     write_yaml(run_dir / CONFIG_FILE, config)
 
     gamma = float(algo_kwargs.get("gamma", 0.99))
-    venv = _wrap_normalize(make_vec_env(env_id, n_envs, seed, kwargs, vec_env, monitor_dir=run_dir), norm, gamma,
-                           training=True)
+    venv = _wrap_normalize(
+        make_vec_env(env_id, n_envs, seed, kwargs, vec_env, monitor_dir=run_dir), norm, gamma, training=True
+    )
     eval_env = None
     if eval_freq:
         eval_seed = seed + EVAL_SEED_OFFSET
-        eval_env = _wrap_normalize(make_vec_env(env_id, min(eval_episodes, 4), eval_seed, kwargs, vec_env), norm,
-                                   gamma, training=False)
-    callbacks = _callbacks(run_dir, eval_env, seed + EVAL_SEED_OFFSET, n_envs, eval_freq, eval_episodes, save_freq,
-                           norm is not None)
+        eval_env = _wrap_normalize(
+            make_vec_env(env_id, min(eval_episodes, 4), eval_seed, kwargs, vec_env), norm, gamma, training=False
+        )
+    callbacks = _callbacks(
+        run_dir, eval_env, seed + EVAL_SEED_OFFSET, n_envs, eval_freq, eval_episodes, save_freq, norm is not None
+    )
     try:
-        model = PPO(policy, venv, seed=seed, device="cpu", tensorboard_log=str(run_dir / "tb"), verbose=verbose,
-                    **algo_kwargs)
+        model = PPO(
+            policy, venv, seed=seed, device="cpu", tensorboard_log=str(run_dir / "tb"), verbose=verbose, **algo_kwargs
+        )
     except (TypeError, ValueError, AssertionError) as err:  # a bad value in the hyperparameter file
         venv.close()
         shutil.rmtree(run_dir)
         raise UsageError(f"PPO rejected the hyperparameters for {env_id}: {err}") from None
-    log(f"training PPO on {env_id} (mode={mode}, substeps={substeps}) for {timesteps:,} steps, "
-        f"{n_envs} envs ({vec_env}), seed {seed} -> {run_dir}")
+    log(
+        f"training PPO on {env_id} (mode={mode}, substeps={substeps}) for {timesteps:,} steps, "
+        f"{n_envs} envs ({vec_env}), seed {seed} -> {run_dir}"
+    )
     start = time.perf_counter()
     log_file = None
     if not progress:  # no bar: progress lines in the log instead (and in train.log)
@@ -318,8 +377,11 @@ def train(env_id: str = DEFAULT_ENV, *, timesteps: float | None = None, n_envs: 
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="python -m agents.train_ppo", description=__doc__.split("\n\n")[0],
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(
+        prog="python -m agents.train_ppo",
+        description=__doc__.split("\n\n")[0],
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument("--env", help=f"registered env id (default: {DEFAULT_ENV}, or the run's with a run config)")
     p.add_argument("--timesteps", type=float, help="total env steps (default: the entry's n_timesteps)")
     p.add_argument("--n-envs", type=int, help="parallel sub-envs (default: the entry's n_envs)")
@@ -330,15 +392,25 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--output", default="runs", help="folder for run folders (default: %(default)s)")
     p.add_argument("--run-name", help="run folder name (default: <env>-<mode>-s<seed>-<time>)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing run folder")
-    p.add_argument("--hyperparams", default=str(HYPERPARAMS),
-                   help="hyperparameter YAML, or a run's config.yml to repeat it (default: the shipped file)")
-    p.add_argument("--vec-env", choices=VEC_ENVS,
-                   help="native batched env (default), or SB3's dummy/subproc over gym.make")
-    p.add_argument("--eval-freq", type=int, help=f"env steps between evaluations, 0: none "
-                                                 f"(default {CALLBACK_DEFAULTS['eval_freq']})")
+    p.add_argument(
+        "--hyperparams",
+        default=str(HYPERPARAMS),
+        help="hyperparameter YAML, or a run's config.yml to repeat it (default: the shipped file)",
+    )
+    p.add_argument(
+        "--vec-env", choices=VEC_ENVS, help="native batched env (default), or SB3's dummy/subproc over gym.make"
+    )
+    p.add_argument(
+        "--eval-freq",
+        type=int,
+        help=f"env steps between evaluations, 0: none (default {CALLBACK_DEFAULTS['eval_freq']})",
+    )
     p.add_argument("--eval-episodes", type=int, help=f"default {CALLBACK_DEFAULTS['eval_episodes']}")
-    p.add_argument("--save-freq", type=int, help=f"env steps between checkpoints, 0: none "
-                                                 f"(default {CALLBACK_DEFAULTS['save_freq']})")
+    p.add_argument(
+        "--save-freq",
+        type=int,
+        help=f"env steps between checkpoints, 0: none (default {CALLBACK_DEFAULTS['save_freq']})",
+    )
     p.add_argument("--threads", type=int, default=1, help="torch threads (default: %(default)s)")
     add_progress_flags(p)
     p.add_argument("-v", "--verbose", type=int, default=0, help="SB3 verbosity (1: print training statistics)")
@@ -352,15 +424,26 @@ def main(argv: list[str] | None = None) -> Path:
     run = data if is_run_config(data) else {}
     pick = lambda given, key, default: given if given is not None else run.get(key, default)  # noqa: E731
     callbacks = {**CALLBACK_DEFAULTS, **run.get("callbacks", {})}
-    run_dir = train(pick(args.env, "env_id", DEFAULT_ENV), timesteps=args.timesteps, n_envs=args.n_envs,
-                    seed=pick(args.seed, "seed", 0), mode=args.mode, substeps=args.substeps,
-                    env_kwargs=parse_env_kwargs(args.env_kwargs), output=args.output, run_name=args.run_name,
-                    hyperparams=args.hyperparams, vec_env=pick(args.vec_env, "vec_env", "native"),
-                    eval_freq=callbacks["eval_freq"] if args.eval_freq is None else args.eval_freq,
-                    eval_episodes=callbacks["eval_episodes"] if args.eval_episodes is None else args.eval_episodes,
-                    save_freq=callbacks["save_freq"] if args.save_freq is None else args.save_freq,
-                    progress=wants_progress(args.progress), threads=args.threads, overwrite=args.overwrite,
-                    verbose=args.verbose)
+    run_dir = train(
+        pick(args.env, "env_id", DEFAULT_ENV),
+        timesteps=args.timesteps,
+        n_envs=args.n_envs,
+        seed=pick(args.seed, "seed", 0),
+        mode=args.mode,
+        substeps=args.substeps,
+        env_kwargs=parse_env_kwargs(args.env_kwargs),
+        output=args.output,
+        run_name=args.run_name,
+        hyperparams=args.hyperparams,
+        vec_env=pick(args.vec_env, "vec_env", "native"),
+        eval_freq=callbacks["eval_freq"] if args.eval_freq is None else args.eval_freq,
+        eval_episodes=callbacks["eval_episodes"] if args.eval_episodes is None else args.eval_episodes,
+        save_freq=callbacks["save_freq"] if args.save_freq is None else args.save_freq,
+        progress=wants_progress(args.progress),
+        threads=args.threads,
+        overwrite=args.overwrite,
+        verbose=args.verbose,
+    )
     print(f"model:       {run_dir / MODEL_FILE}")
     print(f"config:      {run_dir / CONFIG_FILE}")
     print(f"tensorboard: tensorboard --logdir {run_dir / 'tb'}")

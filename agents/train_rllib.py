@@ -52,8 +52,18 @@ CHECKPOINT_DIR = "checkpoint"
 LOG_FILE = "train.log"
 ALGORITHM = "rllib-ppo"
 #: Keys of an rllib_ppo.yml entry that are not PPOConfig.training() keywords.
-RUN_KEYS = ("iterations", "env_runners", "envs_per_runner", "vectorize", "target_success", "eval_episodes",
-            "eval_every", "fcnet_hiddens", "fcnet_activation", "env_kwargs")
+RUN_KEYS = (
+    "iterations",
+    "env_runners",
+    "envs_per_runner",
+    "vectorize",
+    "target_success",
+    "eval_episodes",
+    "eval_every",
+    "fcnet_hiddens",
+    "fcnet_activation",
+    "env_kwargs",
+)
 
 
 def training_kwargs(hp: dict) -> dict:
@@ -68,13 +78,16 @@ def training_kwargs(hp: dict) -> dict:
     known |= set(inspect.signature(AlgorithmConfig.training).parameters) - {"self"}
     unknown = sorted(set(hp) - known - set(RUN_KEYS))
     if unknown:
-        raise UsageError(f"hyperparameters: unknown key(s) {unknown}; PPOConfig.training takes {sorted(known)} "
-                         f"and the file also {list(RUN_KEYS)}")
+        raise UsageError(
+            f"hyperparameters: unknown key(s) {unknown}; PPOConfig.training takes {sorted(known)} "
+            f"and the file also {list(RUN_KEYS)}"
+        )
     return {k: v for k, v in hp.items() if k not in RUN_KEYS}
 
 
-def build_config(env_id: str, env_kwargs: dict, hp: dict, *, env_runners: int, envs_per_runner: int,
-                 vectorize: str, seed: int):
+def build_config(
+    env_id: str, env_kwargs: dict, hp: dict, *, env_runners: int, envs_per_runner: int, vectorize: str, seed: int
+):
     """The PPOConfig of a run (new API stack, torch, the learner in the driver process)."""
     from ray.rllib.algorithms.ppo import PPOConfig
     from ray.rllib.core.rl_module.default_model_config import DefaultModelConfig
@@ -87,11 +100,19 @@ def build_config(env_id: str, env_kwargs: dict, hp: dict, *, env_runners: int, e
         PPOConfig()
         .environment(env=rllib_env_name(env_id), env_config={"env_id": env_id, **env_kwargs})
         .framework("torch")
-        .env_runners(num_env_runners=env_runners, num_envs_per_env_runner=envs_per_runner,
-                     gym_env_vectorize_mode=VECTORIZE_MODES[vectorize], num_cpus_per_env_runner=1)
+        .env_runners(
+            num_env_runners=env_runners,
+            num_envs_per_env_runner=envs_per_runner,
+            gym_env_vectorize_mode=VECTORIZE_MODES[vectorize],
+            num_cpus_per_env_runner=1,
+        )
         .learners(num_learners=0)
-        .rl_module(model_config=DefaultModelConfig(fcnet_hiddens=list(hp.get("fcnet_hiddens", [64, 64])),
-                                                   fcnet_activation=hp.get("fcnet_activation", "tanh")))
+        .rl_module(
+            model_config=DefaultModelConfig(
+                fcnet_hiddens=list(hp.get("fcnet_hiddens", [64, 64])),
+                fcnet_activation=hp.get("fcnet_activation", "tanh"),
+            )
+        )
         .training(**training_kwargs(hp))
         .debugging(seed=seed, log_level="ERROR")
     )
@@ -108,8 +129,13 @@ def success_rate(module, env_id: str, env_kwargs: dict, episodes: int, seed: int
     import collision_env  # noqa: F401
     from agents.rllib_policy import deterministic_actions
 
-    venv = gym.make_vec(env_id, num_envs=episodes, vectorization_mode="vector_entry_point",
-                        max_episode_steps=episode_steps(env_id, env_kwargs), **env_kwargs)
+    venv = gym.make_vec(
+        env_id,
+        num_envs=episodes,
+        vectorization_mode="vector_entry_point",
+        max_episode_steps=episode_steps(env_id, env_kwargs),
+        **env_kwargs,
+    )
     obs, _ = venv.reset(seed=seed)
     success = np.zeros(episodes, dtype=bool)
     done = np.zeros(episodes, dtype=bool)
@@ -147,8 +173,15 @@ def runner_placement(algo) -> list[dict]:
     out = []
     for i, spot in enumerate(algo.env_runner_group.foreach_env_runner(where, local_env_runner=False), start=1):
         node = nodes.get(spot["node_id"], {})
-        out.append({"runner": i, "node_id": spot["node_id"], "node_address": node.get("NodeManagerAddress"),
-                    "driver_node": spot["node_id"] == head, "pid": spot["pid"]})
+        out.append(
+            {
+                "runner": i,
+                "node_id": spot["node_id"],
+                "node_address": node.get("NodeManagerAddress"),
+                "driver_node": spot["node_id"] == head,
+                "pid": spot["pid"],
+            }
+        )
     return out
 
 
@@ -160,9 +193,15 @@ def _versions() -> dict:
     import collision_env
     from collision_env.engine import BACKEND
 
-    versions = {"python": platform.python_version(), "numpy": np.__version__, "gymnasium": gymnasium.__version__,
-                "ray": ray.__version__, "torch": torch.__version__, "collision_env": collision_env.__version__,
-                "engine_backend": BACKEND}
+    versions = {
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "gymnasium": gymnasium.__version__,
+        "ray": ray.__version__,
+        "torch": torch.__version__,
+        "collision_env": collision_env.__version__,
+        "engine_backend": BACKEND,
+    }
     return {name: str(v) for name, v in versions.items()}
 
 
@@ -191,12 +230,27 @@ def start_ray(address: str | None, num_cpus: int, node_ip_address: str | None = 
         ray.init(num_cpus=num_cpus, include_dashboard=False, _node_ip_address="127.0.0.1", log_to_driver=False)
 
 
-def train(env_id: str = DEFAULT_ENV, *, iterations: int | None = None, env_runners: int | None = None,
-          envs_per_runner: int | None = None, vectorize: str | None = None, address: str | None = None,
-          node_ip_address: str | None = None,
-          seed: int = 0, mode: str | None = None, substeps: int | None = None, env_kwargs: dict | None = None,
-          output: str | Path = "runs", run_name: str | None = None, hyperparams: str | Path = HYPERPARAMS,
-          target_success: float | None = None, overwrite: bool = False, threads: int = 1, log=None) -> Path:
+def train(
+    env_id: str = DEFAULT_ENV,
+    *,
+    iterations: int | None = None,
+    env_runners: int | None = None,
+    envs_per_runner: int | None = None,
+    vectorize: str | None = None,
+    address: str | None = None,
+    node_ip_address: str | None = None,
+    seed: int = 0,
+    mode: str | None = None,
+    substeps: int | None = None,
+    env_kwargs: dict | None = None,
+    output: str | Path = "runs",
+    run_name: str | None = None,
+    hyperparams: str | Path = HYPERPARAMS,
+    target_success: float | None = None,
+    overwrite: bool = False,
+    threads: int = 1,
+    log=None,
+) -> Path:
     """Train RLlib PPO on ``env_id`` and write the run folder; returns its path.
 
     Arguments left as None come from the hyperparameter entry. Everything is validated before Ray
@@ -231,8 +285,9 @@ def train(env_id: str = DEFAULT_ENV, *, iterations: int | None = None, env_runne
         from ray.rllib.algorithms.ppo import PPOConfig  # noqa: F401
     except ImportError:
         raise UsageError('RLlib is not installed: pip install -e ".[distributed]" (Ray with RLlib, torch)') from None
-    config = build_config(env_id, kwargs_env, hp, env_runners=env_runners, envs_per_runner=envs_per_runner,
-                          vectorize=vectorize, seed=seed)  # validates the PPO keywords
+    config = build_config(
+        env_id, kwargs_env, hp, env_runners=env_runners, envs_per_runner=envs_per_runner, vectorize=vectorize, seed=seed
+    )  # validates the PPO keywords
 
     label = env_id.split("/")[-1].rsplit("-v", 1)[0].lower()
     run_dir = Path(output) / (run_name or f"{label}-rllib-{mode}-s{seed}-{time.strftime('%Y%m%d-%H%M%S')}")
@@ -253,24 +308,40 @@ def train(env_id: str = DEFAULT_ENV, *, iterations: int | None = None, env_runne
 
     torch.set_num_threads(threads)
     record = {
-        "algorithm": ALGORITHM, "env_id": env_id, "env_kwargs": kwargs, "episode_steps": steps, "seed": seed,
-        "iterations": iterations, "env_runners": env_runners, "envs_per_runner": envs_per_runner,
-        "vectorize": vectorize, "target_success": target, "eval_episodes": eval_episodes, "eval_seed": EVAL_SEED,
-        "address": address, "node_ip_address": node_ip_address, "hyperparams": {**hp, "env_kwargs": dict(kwargs)},
-        "hyperparams_file": str(hyperparams), "versions": _versions(),
+        "algorithm": ALGORITHM,
+        "env_id": env_id,
+        "env_kwargs": kwargs,
+        "episode_steps": steps,
+        "seed": seed,
+        "iterations": iterations,
+        "env_runners": env_runners,
+        "envs_per_runner": envs_per_runner,
+        "vectorize": vectorize,
+        "target_success": target,
+        "eval_episodes": eval_episodes,
+        "eval_seed": EVAL_SEED,
+        "address": address,
+        "node_ip_address": node_ip_address,
+        "hyperparams": {**hp, "env_kwargs": dict(kwargs)},
+        "hyperparams_file": str(hyperparams),
+        "versions": _versions(),
     }
     write_yaml(run_dir / CONFIG_FILE, record)
     setup_start = time.perf_counter()
     warm_up(env_id, kwargs)  # compile (or load) the kernels once here, not in every runner at once
     start_ray(address, max(env_runners, 1), node_ip_address)
     try:
-        say(f"training RLlib PPO on {env_id} (mode={mode}) for up to {iterations} iterations, {env_runners} env "
-            f"runners x {envs_per_runner} envs ({vectorize}), seed {seed} -> {run_dir}")
+        say(
+            f"training RLlib PPO on {env_id} (mode={mode}) for up to {iterations} iterations, {env_runners} env "
+            f"runners x {envs_per_runner} envs ({vectorize}), seed {seed} -> {run_dir}"
+        )
         algo = config.build_algo()
         placement = runner_placement(algo)
         for spot in placement:
-            say(f"env runner {spot['runner']}: node {spot['node_id'][:12]} ({spot['node_address']}"
-                f"{', the driver node' if spot['driver_node'] else ''}), pid {spot['pid']}")
+            say(
+                f"env runner {spot['runner']}: node {spot['node_id'][:12]} ({spot['node_address']}"
+                f"{', the driver node' if spot['driver_node'] else ''}), pid {spot['pid']}"
+            )
         history = []
         start = time.perf_counter()
         setup_seconds = start - setup_start
@@ -279,12 +350,20 @@ def train(env_id: str = DEFAULT_ENV, *, iterations: int | None = None, env_runne
             result = algo.train()
             env_steps = int(result.get("num_env_steps_sampled_lifetime", env_steps))
             ret = result.get("env_runners", {}).get("episode_return_mean", float("nan"))
-            line = (f"iteration {it}: {env_steps:,} env steps, episode return {ret:.2f}, "
-                    f"{time.perf_counter() - start:.0f} s")
+            line = (
+                f"iteration {it}: {env_steps:,} env steps, episode return {ret:.2f}, "
+                f"{time.perf_counter() - start:.0f} s"
+            )
             if it % eval_every == 0 or it == iterations:
                 success = success_rate(algo.get_module(), env_id, kwargs, eval_episodes, EVAL_SEED)
-                history.append({"iteration": it, "env_steps": env_steps, "success": success,
-                                "seconds": round(time.perf_counter() - start, 2)})
+                history.append(
+                    {
+                        "iteration": it,
+                        "env_steps": env_steps,
+                        "success": success,
+                        "seconds": round(time.perf_counter() - start, 2),
+                    }
+                )
                 line += f", evaluation success {100 * success:.0f} %"
                 if success >= target:
                     say(line + f" (target {100 * target:.0f} % reached)")
@@ -295,28 +374,46 @@ def train(env_id: str = DEFAULT_ENV, *, iterations: int | None = None, env_runne
         algo.stop()
     finally:
         ray.shutdown()  # stops the local instance; with --address it only disconnects from the cluster
-    record.update({"setup_seconds": round(setup_seconds, 2), "train_seconds": round(seconds, 2),
-                   "iterations_done": it, "env_steps_done": env_steps, "evaluations": history,
-                   "final_success": history[-1]["success"] if history else None, "runner_placement": placement})
+    record.update(
+        {
+            "setup_seconds": round(setup_seconds, 2),
+            "train_seconds": round(seconds, 2),
+            "iterations_done": it,
+            "env_steps_done": env_steps,
+            "evaluations": history,
+            "final_success": history[-1]["success"] if history else None,
+            "runner_placement": placement,
+        }
+    )
     write_yaml(run_dir / CONFIG_FILE, record)
-    say(f"trained {env_steps:,} env steps in {seconds:.0f} s ({env_steps / seconds:,.0f} steps/s); "
-        f"checkpoint {run_dir / CHECKPOINT_DIR}")
+    say(
+        f"trained {env_steps:,} env steps in {seconds:.0f} s ({env_steps / seconds:,.0f} steps/s); "
+        f"checkpoint {run_dir / CHECKPOINT_DIR}"
+    )
     log_file.close()
     return run_dir
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="python -m agents.train_rllib", description=__doc__.split("\n\n")[0],
-                                formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__)
+    p = argparse.ArgumentParser(
+        prog="python -m agents.train_rllib",
+        description=__doc__.split("\n\n")[0],
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog=__doc__,
+    )
     p.add_argument("--env", default=DEFAULT_ENV, help="registered env id (default: %(default)s)")
     p.add_argument("--iterations", type=int, help="most training iterations (default: the entry's)")
     p.add_argument("--env-runners", type=int, help="remote env runners (default: the entry's)")
     p.add_argument("--envs-per-runner", type=int, help="sub-envs per env runner (default: the entry's)")
-    p.add_argument("--vectorize", choices=("native", "sync"),
-                   help="native batched vector env per runner (default), or RLlib's sync vectorisation")
+    p.add_argument(
+        "--vectorize",
+        choices=("native", "sync"),
+        help="native batched vector env per runner (default), or RLlib's sync vectorisation",
+    )
     p.add_argument("--address", help="join this Ray cluster (host:port of `ray start --head`); default: local Ray")
-    p.add_argument("--node-ip-address", help="with --address: this machine's address in the cluster "
-                                             "(default: Ray's guess)")
+    p.add_argument(
+        "--node-ip-address", help="with --address: this machine's address in the cluster (default: Ray's guess)"
+    )
     p.add_argument("--target-success", type=float, help="stop at this evaluation success share (default: 0.9)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--mode", choices=("exact", "posteriori", "naive"), help="engine fidelity mode (default: exact)")
@@ -332,13 +429,26 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> Path:
     args = build_parser().parse_args(argv)
-    run_dir = train(args.env, iterations=args.iterations, env_runners=args.env_runners,
-                    envs_per_runner=args.envs_per_runner, vectorize=args.vectorize, address=args.address,
-                    node_ip_address=args.node_ip_address,
-                    seed=args.seed, mode=args.mode, substeps=args.substeps,
-                    env_kwargs=parse_env_kwargs(args.env_kwargs), output=args.output, run_name=args.run_name,
-                    hyperparams=args.hyperparams, target_success=args.target_success, overwrite=args.overwrite,
-                    threads=args.threads, log=lambda line: print(line, flush=True))
+    run_dir = train(
+        args.env,
+        iterations=args.iterations,
+        env_runners=args.env_runners,
+        envs_per_runner=args.envs_per_runner,
+        vectorize=args.vectorize,
+        address=args.address,
+        node_ip_address=args.node_ip_address,
+        seed=args.seed,
+        mode=args.mode,
+        substeps=args.substeps,
+        env_kwargs=parse_env_kwargs(args.env_kwargs),
+        output=args.output,
+        run_name=args.run_name,
+        hyperparams=args.hyperparams,
+        target_success=args.target_success,
+        overwrite=args.overwrite,
+        threads=args.threads,
+        log=lambda line: print(line, flush=True),
+    )
     print(f"checkpoint: {run_dir / CHECKPOINT_DIR}")
     print(f"config:     {run_dir / CONFIG_FILE}")
     print(f"evaluate:   python -m agents.evaluate {run_dir}")

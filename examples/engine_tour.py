@@ -16,20 +16,30 @@ from collision_env.engine import BACKEND, PLAY_AREA_1D, Scene, Simulator
 def head_on():
     sim = Simulator(Scene(bounds=None), [[-1, 0], [1, 0]], [[1, 0], [-0.5, 0]], [0.5, 1.5])
     (hit,) = sim.step(2.0)
-    print(f"PhET Intro head-on: contact at t = {hit.time:.6f} s at x = {hit.point[0]:.6f} m; "
-          f"velocities after: {sim.velocities[:, 0].round(6).tolist()} m/s")
+    print(
+        f"PhET Intro head-on: contact at t = {hit.time:.6f} s at x = {hit.point[0]:.6f} m; "
+        f"velocities after: {sim.velocities[:, 0].round(6).tolist()} m/s"
+    )
 
 
 def pi_billiard(digits=5):
     scene = Scene(bounds=(0.0, -1.0, 1e9, 1.0), dimension=1)
-    sim = Simulator(scene, [[1.0, 0.0], [2.0, 0.0]], [[0.0, 0.0], [-1.0, 0.0]], [1.0, 100.0 ** (digits - 1)],
-                    radii=[0.1, 0.1], max_events=10**7)
+    sim = Simulator(
+        scene,
+        [[1.0, 0.0], [2.0, 0.0]],
+        [[0.0, 0.0], [-1.0, 0.0]],
+        [1.0, 100.0 ** (digits - 1)],
+        radii=[0.1, 0.1],
+        max_events=10**7,
+    )
     start = time.perf_counter()
     count = sum(len(sim.step(100.0)) for _ in range(20))
     seconds = time.perf_counter() - start
     energy_error = sim.kinetic_energy() / (0.5 * 100.0 ** (digits - 1)) - 1
-    print(f"Galperin's pi billiard, mass ratio 100^{digits - 1}: {count} collisions "
-          f"({count / seconds:,.0f} events/s), energy error {energy_error:+.1e}")
+    print(
+        f"Galperin's pi billiard, mass ratio 100^{digits - 1}: {count} collisions "
+        f"({count / seconds:,.0f} events/s), energy error {energy_error:+.1e}"
+    )
 
 
 def modes():

@@ -67,8 +67,10 @@ def main(argv=None) -> None:
         name = env_id.split("/")[1].removesuffix("-v0").lower()
         iio.imwrite(out / f"{name}.png", still)
         iio.imwrite(out / f"{name}.gif", np.stack(frames), duration=int(1000 / args.fps), loop=0)
-        print(f"{env_id:36s} {len(frames):4d} frames, targets hit {info['targets_hit']}, "
-              f"success {info['is_success']} -> {out / name}.png/.gif")
+        print(
+            f"{env_id:36s} {len(frames):4d} frames, targets hit {info['targets_hit']}, "
+            f"success {info['is_success']} -> {out / name}.png/.gif"
+        )
 
 
 if __name__ == "__main__":

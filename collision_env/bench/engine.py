@@ -90,8 +90,10 @@ def random_balls(rng, n, bounds, radius, speed=1.0, gap=1.05):
 def _pairs(impacts) -> list[tuple[int, int]]:
     """Impacts as comparable keys: ``(i, j)`` (i < j) for a ball pair, ``(i, -1)`` for a wall."""
     rows = as_impacts(impacts)
-    return [(int(b), -1) if o < 0 else (int(min(b, o)), int(max(b, o))) for b, o in zip(rows["ball"], rows["other"],
-                                                                                          strict=True)]
+    return [
+        (int(b), -1) if o < 0 else (int(min(b, o)), int(max(b, o)))
+        for b, o in zip(rows["ball"], rows["other"], strict=True)
+    ]
 
 
 def bench_gas(quick, n=50, horizon=20.0):
@@ -189,19 +191,27 @@ def bench_gas(quick, n=50, horizon=20.0):
     ):
         o = summary(ours_t)
         p = summary(peer_t_)
-        rows.append({
-            "how": label,
-            "ours_events": int(ours_n),
-            "ours_s": o,
-            "ours_events_per_s": ours_n / o["best"],
-            "billiards_events": int(peer_n),
-            "billiards_s": p,
-            "billiards_events_per_s": peer_n / p["best"],
-            "speedup_best": (ours_n / o["best"]) / (peer_n / p["best"]),
-            "speedup_median": (ours_n / o["median"]) / (peer_n / p["median"]),
-        })
-    return {"n": n, "radius": GAS_RADIUS, "box": [-GAS_HALF, GAS_HALF], "rows": rows, "check": check,
-            "full_horizon": full}
+        rows.append(
+            {
+                "how": label,
+                "ours_events": int(ours_n),
+                "ours_s": o,
+                "ours_events_per_s": ours_n / o["best"],
+                "billiards_events": int(peer_n),
+                "billiards_s": p,
+                "billiards_events_per_s": peer_n / p["best"],
+                "speedup_best": (ours_n / o["best"]) / (peer_n / p["best"]),
+                "speedup_median": (ours_n / o["median"]) / (peer_n / p["median"]),
+            }
+        )
+    return {
+        "n": n,
+        "radius": GAS_RADIUS,
+        "box": [-GAS_HALF, GAS_HALF],
+        "rows": rows,
+        "check": check,
+        "full_horizon": full,
+    }
 
 
 # ---------------------------------------------------------------------------------------- 2. per step
@@ -265,8 +275,9 @@ def bench_batch(quick):
     rows = []
     for mode, k in MODE_CONFIGS:
         batch = BatchSimulator(Scene(), pos, vel, masses, radii, mode=mode, substeps=k)
-        singles = [Simulator(Scene(), pos[s], vel[s], masses[s], radii=radii[s], mode=mode, substeps=k)
-                   for s in range(b)]
+        singles = [
+            Simulator(Scene(), pos[s], vel[s], masses[s], radii=radii[s], mode=mode, substeps=k) for s in range(b)
+        ]
         batch_start = batch.get_state()
         single_starts = [sim.get_state() for sim in singles]
 
@@ -291,16 +302,18 @@ def bench_batch(quick):
         tb = summary(repeat(run_batch, repeats, reset_batch), per=steps * b)
         tl = summary(repeat(run_loop, repeats, reset_loop), per=steps * b)
         diff = max(float(np.abs(batch.positions[s] - singles[s].positions).max()) for s in range(b))
-        rows.append({
-            "mode": f"{mode}/{k}",
-            "batch_scene_steps_per_s": 1.0 / tb["best"],
-            "loop_scene_steps_per_s": 1.0 / tl["best"],
-            "speedup_best": tl["best"] / tb["best"],
-            "speedup_median": tl["median"] / tb["median"],
-            "batch_s_per_scene_step": tb,
-            "loop_s_per_scene_step": tl,
-            "max_position_diff_m": diff,
-        })
+        rows.append(
+            {
+                "mode": f"{mode}/{k}",
+                "batch_scene_steps_per_s": 1.0 / tb["best"],
+                "loop_scene_steps_per_s": 1.0 / tl["best"],
+                "speedup_best": tl["best"] / tb["best"],
+                "speedup_median": tl["median"] / tb["median"],
+                "batch_s_per_scene_step": tb,
+                "loop_s_per_scene_step": tl,
+                "max_position_diff_m": diff,
+            }
+        )
     return {"scenes": b, "balls": n, "steps": steps, "dt": FRAME, "rows": rows}
 
 
@@ -383,10 +396,16 @@ def render_markdown(results):
             cells = [f"{m[k]['best']:.2f} ({m[k]['median']:.2f})" for k in names]
             ratio = m["exact/1"]["best"] / m["naive/1"]["best"]
             peer = f"{m['exact/1']['best'] / m['pymunk']['best']:.1f}" if "pymunk" in m else "n/a"
-            lines.append(f"| {r['balls']} | " + " | ".join(cells) + f" | {ratio:.2f} | {peer} | "
-                         f"{m['exact/1']['impacts_per_step']:.3f} |")
-        lines += ["", "Mode names are `mode/substeps`; pymunk is the C peer (impulse solver, no time of impact) "
-                  "stepping the same balls, set up as the study's `pymunk it=10`.", ""]
+            lines.append(
+                f"| {r['balls']} | " + " | ".join(cells) + f" | {ratio:.2f} | {peer} | "
+                f"{m['exact/1']['impacts_per_step']:.3f} |"
+            )
+        lines += [
+            "",
+            "Mode names are `mode/substeps`; pymunk is the C peer (impulse solver, no time of impact) "
+            "stepping the same balls, set up as the study's `pymunk it=10`.",
+            "",
+        ]
     bt = results.get("batch")
     if bt:
         lines += [
@@ -457,16 +476,22 @@ def main(argv=None):
     parser.add_argument("--markdown", metavar="PATH", help="write the tables to PATH")
     parser.add_argument("--readme", metavar="PATH", help="replace the README block between the bench:engine markers")
     parser.add_argument("--render", metavar="JSON", help="do not measure: render the tables of a --json file")
-    parser.add_argument("--only", choices=("gas", "per_step", "batch"), action="append",
-                        help="run only this part (repeatable)")
+    parser.add_argument(
+        "--only", choices=("gas", "per_step", "batch"), action="append", help="run only this part (repeatable)"
+    )
     args = parser.parse_args(argv)
 
     if args.render:
         with open(args.render) as fh:
             results = json.load(fh)
     else:
-        results = _jsonable(run(quick=args.quick, parts=tuple(args.only or ("gas", "per_step", "batch")),
-                                log=lambda msg: print(msg, file=sys.stderr, flush=True)))
+        results = _jsonable(
+            run(
+                quick=args.quick,
+                parts=tuple(args.only or ("gas", "per_step", "batch")),
+                log=lambda msg: print(msg, file=sys.stderr, flush=True),
+            )
+        )
         if args.json:
             with open(args.json, "w") as fh:
                 json.dump(results, fh, indent=1)

@@ -38,8 +38,16 @@ class EngineRunner(Runner):
         return self.mode
 
     def start(self, case):
-        self._sim = BatchSimulator(case.scene, case.positions[None], case.velocities[None], case.masses,
-                                   case.radii, mode=self.mode, substeps=self.substeps, max_events=self.max_events)
+        self._sim = BatchSimulator(
+            case.scene,
+            case.positions[None],
+            case.velocities[None],
+            case.masses,
+            case.radii,
+            mode=self.mode,
+            substeps=self.substeps,
+            max_events=self.max_events,
+        )
         self._capped = False
 
     def step(self, dt, record=True):
@@ -67,8 +75,10 @@ def engine_runners(full: bool) -> list[Runner]:
 
 #: the knobs each peer is measured at, ``(full run, quick run)``
 PEER_KNOBS = {
-    "pymunk": ([{"iterations": 10}, {"iterations": 10, "substeps": 8}, {"iterations": 30}],
-               [{"iterations": 10}, {"iterations": 10, "substeps": 8}]),
+    "pymunk": (
+        [{"iterations": 10}, {"iterations": 10, "substeps": 8}, {"iterations": 30}],
+        [{"iterations": 10}, {"iterations": 10, "substeps": 8}],
+    ),
     "billiards": ([{}], [{}]),
 }
 

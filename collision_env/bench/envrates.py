@@ -48,21 +48,36 @@ def env_rates(quick: bool, log=print):
         return lambda: gym.make_vec(env_id, num_envs=nvec, vectorization_mode="vector_entry_point", **kw)
 
     single, vec = _rates(lambda: gym.make("CartPole-v1"), vector("CartPole-v1"), seconds)
-    rows = [{"env": "CartPole-v1", "scene": "anchor", "mode": "—", "single_steps_per_s": single,
-             "vector_steps_per_s": vec}]
+    rows = [
+        {"env": "CartPole-v1", "scene": "anchor", "mode": "—", "single_steps_per_s": single, "vector_steps_per_s": vec}
+    ]
     for env_id in ids:
         for mode, k in MODES:
             kw = {"mode": mode, "substeps": k}
             try:
                 single, vec = _rates(lambda env_id=env_id, kw=kw: gym.make(env_id, **kw), vector(env_id, **kw), seconds)
             except Exception as exc:  # an env that cannot run a mode is a result
-                rows.append({"env": env_id, "scene": MATCHING_SCENE.get(env_id, ""), "mode": f"{mode} k={k}",
-                             "single_steps_per_s": float("nan"), "vector_steps_per_s": float("nan"),
-                             "note": f"{type(exc).__name__}: {exc}"})
+                rows.append(
+                    {
+                        "env": env_id,
+                        "scene": MATCHING_SCENE.get(env_id, ""),
+                        "mode": f"{mode} k={k}",
+                        "single_steps_per_s": float("nan"),
+                        "vector_steps_per_s": float("nan"),
+                        "note": f"{type(exc).__name__}: {exc}",
+                    }
+                )
                 continue
             label = mode if mode != "posteriori" else f"posteriori k={k}"
-            rows.append({"env": env_id, "scene": MATCHING_SCENE.get(env_id, "—"), "mode": label,
-                         "single_steps_per_s": single, "vector_steps_per_s": vec})
+            rows.append(
+                {
+                    "env": env_id,
+                    "scene": MATCHING_SCENE.get(env_id, "—"),
+                    "mode": label,
+                    "single_steps_per_s": single,
+                    "vector_steps_per_s": vec,
+                }
+            )
         log(f"  env {env_id}: done")
     return rows
 

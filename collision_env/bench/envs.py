@@ -89,12 +89,14 @@ def _fmt_rate(x: float) -> str:
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(prog="python -m collision_env.bench.envs", description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        prog="python -m collision_env.bench.envs",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     parser.add_argument("--seconds", type=float, default=1.0, help="time per measurement (s)")
     parser.add_argument("--num-envs", type=int, default=1024, help="sub-envs of the vector env")
-    parser.add_argument("--modes", nargs="+", default=["exact"], choices=MODES,
-                        help="engine modes to time the envs in")
+    parser.add_argument("--modes", nargs="+", default=["exact"], choices=MODES, help="engine modes to time the envs in")
     parser.add_argument("--ids", nargs="+", default=list(collision_env.ENV_IDS), help="env ids")
     parser.add_argument("--markdown", metavar="PATH", help="also write the tables to PATH")
     parser.add_argument("--readme", metavar="PATH", help="replace the README block between the bench:envs markers")
@@ -113,8 +115,9 @@ def main(argv=None) -> None:
             env.close()
 
     n = args.num_envs
-    cart_vec = vector_env_steps_per_s(gym.make_vec("CartPole-v1", n, vectorization_mode="vector_entry_point"),
-                                      args.seconds)
+    cart_vec = vector_env_steps_per_s(
+        gym.make_vec("CartPole-v1", n, vectorization_mode="vector_entry_point"), args.seconds
+    )
     vector = [f"| `CartPoleVectorEnv` | | {_fmt_rate(cart_vec)} | | 1.000 |"]
     for env_id in args.ids:
         for mode in args.modes:
@@ -126,26 +129,29 @@ def main(argv=None) -> None:
             venv.close()
 
     v = versions(["gymnasium"])
-    text = "\n".join([
-        f"`python -m collision_env.bench.envs` on {machine()}, {cpus()} CPUs, "
-        f"Python {v['python']}, gymnasium {v['gymnasium']}, numpy {v['numpy']}, engine backend "
-        f"`{v['backend']}`; {timestamp()}, {time.perf_counter() - started:.0f} s. Each figure is the "
-        f"best of {REPEATS} slices of {args.seconds:g} s, measured in the same run as CartPole: compare the ratios.",
-        "",
-        "Single env via `gym.make` (default wrappers, random actions, resets included); *engine* is the part "
-        "spent in the engine's `nudge` + `step`:",
-        "",
-        "| id | mode | µs per step | engine µs | × CartPole-v1 |",
-        "|---|---|---:|---:|---:|",
-        *single,
-        "",
-        f"Native vector env, {n} sub-envs (next-step autoreset, random actions); *engine* is the engine's share "
-        "of the step:",
-        "",
-        "| id | mode | env-steps/s | engine | × CartPoleVectorEnv |",
-        "|---|---|---:|---:|---:|",
-        *vector,
-    ])
+    text = "\n".join(
+        [
+            f"`python -m collision_env.bench.envs` on {machine()}, {cpus()} CPUs, "
+            f"Python {v['python']}, gymnasium {v['gymnasium']}, numpy {v['numpy']}, engine backend "
+            f"`{v['backend']}`; {timestamp()}, {time.perf_counter() - started:.0f} s. Each figure is the "
+            f"best of {REPEATS} slices of {args.seconds:g} s, measured in the same run as CartPole: "
+            "compare the ratios.",
+            "",
+            "Single env via `gym.make` (default wrappers, random actions, resets included); *engine* is the part "
+            "spent in the engine's `nudge` + `step`:",
+            "",
+            "| id | mode | µs per step | engine µs | × CartPole-v1 |",
+            "|---|---|---:|---:|---:|",
+            *single,
+            "",
+            f"Native vector env, {n} sub-envs (next-step autoreset, random actions); *engine* is the engine's share "
+            "of the step:",
+            "",
+            "| id | mode | env-steps/s | engine | × CartPoleVectorEnv |",
+            "|---|---|---:|---:|---:|",
+            *vector,
+        ]
+    )
     print(text)
     if args.markdown:
         with open(args.markdown, "w") as fh:

@@ -112,14 +112,20 @@ def _train_on_wall(n, e, r=0.1, inelastic="slip"):
     """``n`` balls touching each other and the left wall, all moving left at 1 m/s; 1D."""
     pos = [[-2.0 + r + 2 * r * k, 0.0] for k in range(n)]
     vel = [[-1.0, 0.0]] * n
-    return _case(Scene(bounds=PLAY_AREA_1D, elasticity=e, dimension=1, inelastic=inelastic), pos, vel, np.ones(n),
-                 np.full(n, r))
+    return _case(
+        Scene(bounds=PLAY_AREA_1D, elasticity=e, dimension=1, inelastic=inelastic), pos, vel, np.ones(n), np.full(n, r)
+    )
 
 
 def _wall_touch(e):
     """A ball touching the right wall and moving into it, another touching it from the left, 2D."""
-    return _case(Scene(bounds=PLAY_AREA_2D, elasticity=e), [[1.9, 0.0], [1.7, 0.0]], [[1.0, 0.3], [0.5, 0.0]],
-                 [1.0, 1.0], [0.1, 0.1])
+    return _case(
+        Scene(bounds=PLAY_AREA_2D, elasticity=e),
+        [[1.9, 0.0], [1.7, 0.0]],
+        [[1.0, 0.3], [0.5, 0.0]],
+        [1.0, 1.0],
+        [0.1, 0.1],
+    )
 
 
 def _wedged(e, gap):
@@ -134,8 +140,13 @@ def _slide(e):
 
 def _simultaneous(e):
     """Ball 0 catches up with ball 1 just as ball 1 hits the right wall, at t = 0.5 s."""
-    return _case(Scene(bounds=PLAY_AREA_2D, elasticity=e), [[1.1, 0.0], [1.4, 0.0]], [[1.2, 0.0], [1.0, 0.0]],
-                 [1.0, 1.0], [0.1, 0.1])
+    return _case(
+        Scene(bounds=PLAY_AREA_2D, elasticity=e),
+        [[1.1, 0.0], [1.4, 0.0]],
+        [[1.2, 0.0], [1.0, 0.0]],
+        [1.0, 1.0],
+        [0.1, 0.1],
+    )
 
 
 def _mass_gas(ratio, e):
@@ -157,8 +168,7 @@ def _hex_pack(e, inelastic="slip"):
             pos.append([(k - (count - 1) / 2) * 2 * r, row * math.sqrt(3) * r])
     pos.append([-1.5, 0.013])
     vel = [[0.0, 0.0]] * 19 + [[5.0, 0.0]]
-    return _case(Scene(bounds=PLAY_AREA_2D, elasticity=e, inelastic=inelastic), pos, vel, np.ones(20),
-                 np.full(20, r))
+    return _case(Scene(bounds=PLAY_AREA_2D, elasticity=e, inelastic=inelastic), pos, vel, np.ones(20), np.full(20, r))
 
 
 def _heavy_cradle(ratio):
@@ -174,14 +184,20 @@ def _heavy_cradle(ratio):
 def _inelastic_pi(ratio, e):
     """Galperin's geometry at restitution ``e``: wall, light ball at rest, heavy ball coming in."""
     c = pi_billiard(2, 1)
-    return _case(Scene(bounds=c.scene.bounds, elasticity=e, dimension=1), c.positions, c.velocities,
-                 [1.0, ratio], c.radii)
+    return _case(
+        Scene(bounds=c.scene.bounds, elasticity=e, dimension=1), c.positions, c.velocities, [1.0, ratio], c.radii
+    )
 
 
 def _stuck_pair_corner():
     """Two balls that stick on contact, heading together for the top-right corner; 2D, stick."""
-    return _case(Scene(bounds=PLAY_AREA_2D, elasticity=0.0, inelastic="stick"), [[0.5, 0.2], [1.0, 0.5]],
-                 [[1.5, 0.9], [0.5, 0.3]], [1.0, 2.0], [0.15, 0.2])
+    return _case(
+        Scene(bounds=PLAY_AREA_2D, elasticity=0.0, inelastic="stick"),
+        [[0.5, 0.2], [1.0, 0.5]],
+        [[1.5, 0.9], [0.5, 0.3]],
+        [1.0, 2.0],
+        [0.15, 0.2],
+    )
 
 
 def _stuck_gas(n):
@@ -194,6 +210,7 @@ def _check_pi(digits):
     def check(sim, count, impacts):
         want = pi_collisions(digits)
         return None if count == want else f"{count} collisions, expected {want}"
+
     return check
 
 
@@ -204,11 +221,13 @@ def _check_corner(e):
         if np.allclose(v, want, rtol=1e-12, atol=1e-15):
             return None
         return f"velocity after the corner {v.tolist()}, expected {want.tolist()}"
+
     return check
 
 
 def _check_cradle(n):
     """After the chain (and before the far ball reaches the wall) only the far ball moves, at 1 m/s."""
+
     def check(sim, count, impacts):
         v = sim.velocities[:, 0]
         want = np.zeros(n)
@@ -216,6 +235,7 @@ def _check_cradle(n):
         if np.allclose(v, want, rtol=0, atol=1e-12):
             return None
         return f"velocities after the chain {np.round(v, 12).tolist()}, expected {want.tolist()}"
+
     return check
 
 
@@ -228,11 +248,13 @@ def _lone_position(x0, v, lo, hi, t):
 
 def _check_lone(case, t_end):
     """Final position, and (when kept) every impact's time and point, against the analytic bounce."""
+
     def check(sim, count, impacts):
         (x0, y0), (vx, vy), r = case.positions[0], case.velocities[0], case.radii[0]
         b = case.scene.bounds
-        want = np.array([_lone_position(x0, vx, b[0] + r, b[2] - r, t_end),
-                         _lone_position(y0, vy, b[1] + r, b[3] - r, t_end)])
+        want = np.array(
+            [_lone_position(x0, vx, b[0] + r, b[2] - r, t_end), _lone_position(y0, vy, b[1] + r, b[3] - r, t_end)]
+        )
         err = float(np.hypot(*(sim.positions[0] - want)))
         # round-off in the event times moves the ball along the wall a little at every bounce: allow
         # 1e-12 of the path length (about 5000 ulps), or 1e-6 of a radius
@@ -255,6 +277,7 @@ def _check_lone(case, t_end):
             if not np.all((coord == b[axis]) | (coord == b[axis + 2])):
                 return "an impact point is not exactly on its wall"
         return None
+
     return check
 
 
@@ -265,6 +288,7 @@ def _check_graze(hit):
             ok = count == 0 and np.array_equal(v, [[1.0, 0.0], [-1.0, 0.0]])
             return None if ok else f"{count} impacts for a miss / exact graze, velocities {v.tolist()}"
         return None if count == 1 else f"{count} impacts for a (near-grazing) hit, expected 1"
+
     return check
 
 
@@ -286,43 +310,94 @@ def cells(quick: bool = False) -> list[Cell]:
             def build(v=v):
                 c = gas(8, radius=0.1, packing=8 * math.pi * 0.01 / 8.0, speed=v, seed=4)
                 return c
+
             add(f"gas8 v={v:g} dt={dt:g}", "speed x dt", build, dt, steps * dt, rate, q=q, speed=v)
     # radius: a gas of 4 (3 at r = 0.5), speed 1
     for r in (1e-4, 1e-3, 1e-2, 0.1, 0.5):
         n = 3 if r >= 0.5 else 4
         for dt in (1e-3, 0.1):
+
             def build(r=r, n=n):
                 c = gas(n, radius=r, packing=n * math.pi * r * r / 8.0, speed=1.0, seed=6)
                 return c
-            add(f"gas{n} r={r:g} dt={dt:g}", "radius", build, dt, 5.0, _box_rate(n, 1.0, PLAY_AREA_2D, r),
-                q=(dt == 0.1 and r in (1e-4, 0.5)), radius=r)
+
+            add(
+                f"gas{n} r={r:g} dt={dt:g}",
+                "radius",
+                build,
+                dt,
+                5.0,
+                _box_rate(n, 1.0, PLAY_AREA_2D, r),
+                q=(dt == 0.1 and r in (1e-4, 0.5)),
+                radius=r,
+            )
     # mass ratio: Galperin's billiard (count must be exact) and a heavy ball in a gas
     for digits in (1, 2, 3, 4, 5, 6):
         for dt in (1e-3, 1.0):
             if digits == 6 and dt < 1:
                 continue  # the 3.1 million collisions happen within microseconds: one step size is enough
-            add(f"pi billiard 1e{2 * digits} dt={dt:g}", "mass ratio", lambda d=digits: pi_billiard(2, d), dt,
-                12.0 if digits < 4 else 8.0, 0.0, _check_pi(digits),
+            add(
+                f"pi billiard 1e{2 * digits} dt={dt:g}",
+                "mass ratio",
+                lambda d=digits: pi_billiard(2, d),
+                dt,
+                12.0 if digits < 4 else 8.0,
+                0.0,
+                _check_pi(digits),
                 q=(digits in (2, 6) and dt == 1.0) or (digits == 3 and dt == 1e-3),
-                cap=pi_collisions(digits) + 10_000, ratio=100.0**digits)
+                cap=pi_collisions(digits) + 10_000,
+                ratio=100.0**digits,
+            )
     for ratio in (1e3, 1e6, 1e9, 1e12):
         for e in (1.0, 0.5):
-            add(f"heavy in gas 1e{round(math.log10(ratio))} e={e:g}", "mass ratio",
-                lambda ratio=ratio, e=e: _mass_gas(ratio, e), 0.01, 20.0, _box_rate(4, 1.0, PLAY_AREA_2D, 0.2),
-                q=(ratio == 1e12), ratio=ratio, e=e)
+            add(
+                f"heavy in gas 1e{round(math.log10(ratio))} e={e:g}",
+                "mass ratio",
+                lambda ratio=ratio, e=e: _mass_gas(ratio, e),
+                0.01,
+                20.0,
+                _box_rate(4, 1.0, PLAY_AREA_2D, 0.2),
+                q=(ratio == 1e12),
+                ratio=ratio,
+                e=e,
+            )
     # restitution: pile-up into a wall, a 2D gas cooling, stick clusters
     for e in (0.0, 0.05, 0.5, 1.0):
         for dt in (0.01, 1.0):
-            add(f"pile-up 8 e={e:g} dt={dt:g}", "restitution", lambda e=e: inelastic_pileup(8, e), dt, 4.0,
-                _box_rate(8, 1.5, PLAY_AREA_1D, 0.1) * 10, q=(dt == 0.01 and e in (0.0, 0.05)), e=e)
-        add(f"gas16 cooling e={e:g}", "restitution",
-            lambda e=e: gas(16, radius=0.1, packing=0.4, speed=1.0, seed=7, elasticity=e), 0.05, 20.0,
-            _box_rate(16, 1.0, (-1, -0.5, 1, 0.5), 0.1) * 10, q=(e == 0.05), e=e)
+            add(
+                f"pile-up 8 e={e:g} dt={dt:g}",
+                "restitution",
+                lambda e=e: inelastic_pileup(8, e),
+                dt,
+                4.0,
+                _box_rate(8, 1.5, PLAY_AREA_1D, 0.1) * 10,
+                q=(dt == 0.01 and e in (0.0, 0.05)),
+                e=e,
+            )
+        add(
+            f"gas16 cooling e={e:g}",
+            "restitution",
+            lambda e=e: gas(16, radius=0.1, packing=0.4, speed=1.0, seed=7, elasticity=e),
+            0.05,
+            20.0,
+            _box_rate(16, 1.0, (-1, -0.5, 1, 0.5), 0.1) * 10,
+            q=(e == 0.05),
+            e=e,
+        )
     add("gas16 stick e=0", "restitution", lambda: _stuck_gas(16), 0.05, 20.0, 2e3, q=True, e=0.0)
     add("stuck pair into corner", "restitution", _stuck_pair_corner, 0.01, 5.0, 100.0, e=0.0)
     for ratio in (1e6, 1e12):
-        add(f"pi geometry 1e{round(math.log10(ratio))} e=0.05", "mass ratio",
-            lambda ratio=ratio: _inelastic_pi(ratio, 0.05), 0.01, 8.0, 1e3, q=ratio == 1e6, ratio=ratio, e=0.05)
+        add(
+            f"pi geometry 1e{round(math.log10(ratio))} e=0.05",
+            "mass ratio",
+            lambda ratio=ratio: _inelastic_pi(ratio, 0.05),
+            0.01,
+            8.0,
+            1e3,
+            q=ratio == 1e6,
+            ratio=ratio,
+            e=0.05,
+        )
     # a touching row of alternating light and heavy balls: each light ball then rattles between two
     # heavy ones, ~pi sqrt(ratio) collisions per squeeze (1e9 already gives 4e7 events in 3 s, so the
     # grid stops at 1e6 here; the pi billiard covers 1e12)
@@ -331,44 +406,102 @@ def cells(quick: bool = False) -> list[Cell]:
     from .scenes import explore_2d
 
     for dt in (1e-6, 1e-4, 1e-2, 1.0):
-        add(f"explore_2d 4 dt={dt:g}", "dt", lambda: explore_2d(4), dt, min(2000 * dt, 50.0), 20.0,
-            q=dt in (1e-6, 1.0))
+        add(f"explore_2d 4 dt={dt:g}", "dt", lambda: explore_2d(4), dt, min(2000 * dt, 50.0), 20.0, q=dt in (1e-6, 1.0))
     # long episodes: a lone ball (analytic position), PhET's four balls, an inelastic gas
     lone = _case(Scene(bounds=PLAY_AREA_2D), [[0.3, -0.2]], [[0.7, 0.45]], [1.0], [0.15])
     for t_end, dt in ((1e4, 1.0), (1e5, 1.0), (1e5, 100.0)):
-        add(f"lone ball T={t_end:g} dt={dt:g}", "long", lambda: lone, dt, t_end, 2.0, _check_lone(lone, t_end),
-            q=(t_end, dt) == (1e4, 1.0), T=t_end)
+        add(
+            f"lone ball T={t_end:g} dt={dt:g}",
+            "long",
+            lambda: lone,
+            dt,
+            t_end,
+            2.0,
+            _check_lone(lone, t_end),
+            q=(t_end, dt) == (1e4, 1.0),
+            T=t_end,
+        )
     tiny = _case(Scene(bounds=PLAY_AREA_2D), [[0.3, -0.2]], [[7000.0, 4500.0]], [1.0], [1e-4])
-    add("lone tiny ball v=8e3 r=1e-4 T=100", "long", lambda: tiny, 1.0, 100.0, 1e4, _check_lone(tiny, 100.0),
-        T=100.0)
+    add("lone tiny ball v=8e3 r=1e-4 T=100", "long", lambda: tiny, 1.0, 100.0, 1e4, _check_lone(tiny, 100.0), T=100.0)
     add("explore_2d 4 T=1e5 dt=100", "long", lambda: explore_2d(4), 100.0, 1e5, 20.0, q=False, T=1e5)
-    add("gas16 e=0.5 T=1e5 dt=100", "long",
-        lambda: gas(16, radius=0.1, packing=0.4, speed=1.0, seed=7, elasticity=0.5), 100.0, 1e5, 2e3, T=1e5)
+    add(
+        "gas16 e=0.5 T=1e5 dt=100",
+        "long",
+        lambda: gas(16, radius=0.1, packing=0.4, speed=1.0, seed=7, elasticity=0.5),
+        100.0,
+        1e5,
+        2e3,
+        T=1e5,
+    )
     # touching at the start
     for e in (1.0, 0.5, 0.05, 0.0):
         chk = _check_cradle(5) if e == 1.0 else None
-        add(f"cradle 5 touching e={e:g}", "touching", lambda e=e: _cradle(5, e), 0.01, 1.0, 100.0, chk,
-            q=e in (1.0, 0.05), e=e)
-        add(f"train on wall 5 e={e:g}", "touching", lambda e=e: _train_on_wall(5, e), 0.01, 2.0, 1e3,
-            q=e in (0.0, 0.05), e=e)
+        add(
+            f"cradle 5 touching e={e:g}",
+            "touching",
+            lambda e=e: _cradle(5, e),
+            0.01,
+            1.0,
+            100.0,
+            chk,
+            q=e in (1.0, 0.05),
+            e=e,
+        )
+        add(
+            f"train on wall 5 e={e:g}",
+            "touching",
+            lambda e=e: _train_on_wall(5, e),
+            0.01,
+            2.0,
+            1e3,
+            q=e in (0.0, 0.05),
+            e=e,
+        )
         add(f"wall touch pair e={e:g}", "touching", lambda e=e: _wall_touch(e), 0.01, 3.0, 100.0, q=e == 1.0, e=e)
         add(f"wedged 2r=H-2e-6 e={e:g}", "touching", lambda e=e: _wedged(e, 2e-6), 0.01, 2.0, 3e5, q=e == 1.0, e=e)
     for e in (1.0, 0.05, 0.0):
         add(f"hex pack 19 touching e={e:g}", "touching", lambda e=e: _hex_pack(e), 0.01, 3.0, 1e4, q=e == 0.05, e=e)
     add("hex pack 19 touching stick", "touching", lambda: _hex_pack(0.0, "stick"), 0.01, 3.0, 1e4, e=0.0)
-    add("train on wall 5 stick", "touching", lambda: _train_on_wall(5, 0.0, inelastic="stick"), 0.01, 2.0, 1e3,
-        q=True, e=0.0)
+    add(
+        "train on wall 5 stick",
+        "touching",
+        lambda: _train_on_wall(5, 0.0, inelastic="stick"),
+        0.01,
+        2.0,
+        1e3,
+        q=True,
+        e=0.0,
+    )
     # exact corner hits, simultaneous wall + ball, sliding along a wall
     for e in (1.0, 0.5, 0.05, 0.0):
-        add(f"corner hit e={e:g}", "corner", lambda e=e: _corner(e), 0.6, 0.6, 10.0, _check_corner(e),
-            q=e in (1.0, 0.0), e=e)
-        add(f"ball+wall same instant e={e:g}", "corner", lambda e=e: _simultaneous(e), 0.01, 3.0, 100.0,
-            q=e == 1.0, e=e)
+        add(
+            f"corner hit e={e:g}",
+            "corner",
+            lambda e=e: _corner(e),
+            0.6,
+            0.6,
+            10.0,
+            _check_corner(e),
+            q=e in (1.0, 0.0),
+            e=e,
+        )
+        add(
+            f"ball+wall same instant e={e:g}", "corner", lambda e=e: _simultaneous(e), 0.01, 3.0, 100.0, q=e == 1.0, e=e
+        )
         add(f"slide along wall e={e:g}", "grazing", lambda e=e: _slide(e), 0.01, 3.0, 10.0, q=e == 1.0, e=e)
     # grazing ball-ball contacts (free space)
     for delta, hit in ((1e-3, True), (1e-8, True), (1e-12, True), (0.0, False), (-1e-12, False)):
-        add(f"graze 1-{delta:g}", "grazing", lambda d=delta: _two_ball_graze(d), 0.013, 2.0, 10.0, _check_graze(hit),
-            q=delta in (1e-12, 0.0), delta=delta)
+        add(
+            f"graze 1-{delta:g}",
+            "grazing",
+            lambda d=delta: _two_ball_graze(d),
+            0.013,
+            2.0,
+            10.0,
+            _check_graze(hit),
+            q=delta in (1e-12, 0.0),
+            delta=delta,
+        )
     _add_robustness_cells(add)
     return [c for c in out if c.quick] if quick else out
 
@@ -380,17 +513,24 @@ def cells(quick: bool = False) -> list[Cell]:
 # naming the ball and the field.
 def _squeeze(ratio, e):
     """A ball ``ratio`` times heavier presses a light ball at rest against the left wall; 1D."""
-    return _case(Scene(bounds=PLAY_AREA_1D, elasticity=e, dimension=1), [[-1.9, 0.0], [-1.5, 0.0]],
-                 [[0.0, 0.0], [-1.0, 0.0]], [1.0, ratio], [0.1, 0.1])
+    return _case(
+        Scene(bounds=PLAY_AREA_1D, elasticity=e, dimension=1),
+        [[-1.9, 0.0], [-1.5, 0.0]],
+        [[0.0, 0.0], [-1.0, 0.0]],
+        [1.0, ratio],
+        [0.1, 0.1],
+    )
 
 
 def _check_squeeze(t_end):
     """The clock reached the end, and the heavy ball stopped against the light one (the cascade's limit)."""
+
     def check(sim, count, impacts):
         if abs(sim.time - t_end) > 1e-12 * t_end:
             return f"clock at {sim.time!r} s, expected {t_end:g} s"
         v = float(np.abs(sim.velocities[1]).max())
         return None if v <= 1e-6 else f"heavy ball still at {v:.3g} m/s against the wall"
+
     return check
 
 
@@ -398,20 +538,33 @@ def _shifted(case, offset):
     """``case`` translated by ``offset`` m along x (and y in 2D), border included."""
     b = case.scene.bounds
     dy = offset if case.scene.dimension == 2 else 0.0
-    scene = Scene(bounds=(b[0] + offset, b[1] + dy, b[2] + offset, b[3] + dy), elasticity=case.scene.elasticity,
-                  dimension=case.scene.dimension)
+    scene = Scene(
+        bounds=(b[0] + offset, b[1] + dy, b[2] + offset, b[3] + dy),
+        elasticity=case.scene.elasticity,
+        dimension=case.scene.dimension,
+    )
     return Case(scene, case.positions + np.array([offset, dy]), *case[2:])
 
 
 def _near_wall(e):
     """Ball 0 rests 0.5 mm from the left wall; ball 1 hits it, and only then does it reach the wall; 1D."""
-    return _case(Scene(bounds=PLAY_AREA_1D, elasticity=e, dimension=1), [[-1.8995, 0.0], [-1.0, 0.0]],
-                 [[0.0, 0.0], [-1.0, 0.0]], [1.0, 1.0], [0.1, 0.1])
+    return _case(
+        Scene(bounds=PLAY_AREA_1D, elasticity=e, dimension=1),
+        [[-1.8995, 0.0], [-1.0, 0.0]],
+        [[0.0, 0.0], [-1.0, 0.0]],
+        [1.0, 1.0],
+        [0.1, 0.1],
+    )
 
 
 def _three_balls(e):
-    return _case(Scene(bounds=PLAY_AREA_2D, elasticity=e), [[-1.2, -0.4], [0.0, 0.3], [1.1, -0.2]],
-                 [[0.9, 0.4], [-0.3, -0.8], [-0.7, 0.5]], [1.0, 2.0, 0.5], [0.2, 0.25, 0.15])
+    return _case(
+        Scene(bounds=PLAY_AREA_2D, elasticity=e),
+        [[-1.2, -0.4], [0.0, 0.3], [1.1, -0.2]],
+        [[0.9, 0.4], [-0.3, -0.8], [-0.7, 0.5]],
+        [1.0, 2.0, 0.5],
+        [0.2, 0.25, 0.15],
+    )
 
 
 def _run_exact(case, dt, duration):
@@ -423,6 +576,7 @@ def _run_exact(case, dt, duration):
 
 def _check_translation(case, dt, duration):
     """The same impacts (who and when, within the coordinates' round-off) as the scene at the origin."""
+
     def check(sim, count, impacts):
         want, _ = _run_exact(case, dt, duration)
         if impacts is None or len(impacts) != len(want):
@@ -431,6 +585,7 @@ def _check_translation(case, dt, duration):
             return "another impact sequence than at the origin"
         worst = float(np.max(np.abs(impacts["time"] - want["time"]), initial=0.0))
         return None if worst <= 1e-8 else f"impact times off those at the origin by up to {worst:.3g} s"
+
     return check
 
 
@@ -443,18 +598,25 @@ def _check_clock(case, dt, steps):
         if abs(sim.time - exact) > 2 * math.ulp(exact):
             return f"clock {sim.time!r} s off the exact sum {exact!r} s by {sim.time - exact:.3g} s"
         return lone(sim, count, impacts)
+
     return check
 
 
 def _slow_pair(e, fast):
     """A pair closing at 2e-9 m/s in the middle of the box, and ball 2 far off at ``fast`` m/s."""
     r = 0.1
-    return _case(Scene(bounds=None, elasticity=e), [[-r - 1e-9, 0.0], [r + 1e-9, 0.0], [5.0, 5.0]],
-                 [[1e-9, 0.0], [-1e-9, 0.0], [fast, fast]], [1.0, 1.0, 1.0], [r, r, r])
+    return _case(
+        Scene(bounds=None, elasticity=e),
+        [[-r - 1e-9, 0.0], [r + 1e-9, 0.0], [5.0, 5.0]],
+        [[1e-9, 0.0], [-1e-9, 0.0], [fast, fast]],
+        [1.0, 1.0, 1.0],
+        [r, r, r],
+    )
 
 
 def _check_slow_pair(e, dt, duration):
     """The pair ends as it would alone: separating at ``e`` times its closing speed, no energy gained."""
+
     def check(sim, count, impacts):
         _, alone = _run_exact(_slow_pair(e, 0.0), dt, duration)
         if not np.array_equal(sim.velocities[:2], alone.velocities[:2]):
@@ -463,69 +625,160 @@ def _check_slow_pair(e, dt, duration):
         want = np.array([-e * 1e-9, e * 1e-9])
         ok = np.allclose(v, want, rtol=1e-6, atol=1e-9 * 1e-9)
         return None if ok else f"the pair separates at {v.tolist()} m/s, expected {want.tolist()}"
+
     return check
 
 
 def _refuses(build, match):
     """A check that the input ``build()`` makes is refused with a ValueError saying ``match``."""
+
     def check(sim, count, impacts):
         try:
             build()
         except ValueError as err:
             return None if match in str(err) else f"refused with another message: {err}"
         return f"accepted an input that should be refused ({match})"
+
     return check
 
 
 def _light_ball(mass):
-    return _case(Scene(bounds=PLAY_AREA_2D), [[-1.0, 0.1], [1.0, 0.0]], [[1.0, 0.0], [-1.0, 0.0]], [mass, 1.0],
-                 [0.1, 0.1])
+    return _case(
+        Scene(bounds=PLAY_AREA_2D), [[-1.0, 0.1], [1.0, 0.0]], [[1.0, 0.0], [-1.0, 0.0]], [mass, 1.0], [0.1, 0.1]
+    )
 
 
 def _fast_pair(speed):
-    return _case(Scene(bounds=None), [[-1.0, 0.05], [1.0, 0.0]], [[speed, 0.0], [-speed, 0.0]], [1.0, 1.0],
-                 [0.1, 0.1])
+    return _case(Scene(bounds=None), [[-1.0, 0.05], [1.0, 0.0]], [[speed, 0.0], [-speed, 0.0]], [1.0, 1.0], [0.1, 0.1])
 
 
 def _tiny_radius(radius):
     """A ball of ``radius`` in PhET's box, bouncing; another ball crossing its path."""
-    return _case(Scene(bounds=PLAY_AREA_2D), [[0.0, 0.0], [1.0, 0.5]], [[1.0, 0.5], [-0.5, -0.25]], [1.0, 1.0],
-                 [radius, 0.1])
+    return _case(
+        Scene(bounds=PLAY_AREA_2D), [[0.0, 0.0], [1.0, 0.5]], [[1.0, 0.5], [-0.5, -0.25]], [1.0, 1.0], [radius, 0.1]
+    )
 
 
 def _add_robustness_cells(add):
     for exponent in (12, 13, 15, 18):
         for e in (0.0, 0.5):
-            add(f"squeeze 1e{exponent} e={e:g}", "mass ratio", lambda r=10.0**exponent, e=e: _squeeze(r, e), 0.5, 1.5,
-                0.0, _check_squeeze(1.5), q=exponent == 15 and e == 0.0, cap=2000, ratio=10.0**exponent, e=e)
+            add(
+                f"squeeze 1e{exponent} e={e:g}",
+                "mass ratio",
+                lambda r=10.0**exponent, e=e: _squeeze(r, e),
+                0.5,
+                1.5,
+                0.0,
+                _check_squeeze(1.5),
+                q=exponent == 15 and e == 0.0,
+                cap=2000,
+                ratio=10.0**exponent,
+                e=e,
+            )
     for e in (0.5, 0.0):
         near = _near_wall(e)
-        add(f"near wall 0.5 mm offset 1e6 e={e:g}", "offset", lambda c=near: _shifted(c, 1e6), 0.1, 1.2, 10.0,
-            _check_translation(near, 0.1, 1.2), q=e == 0.5, e=e, offset=1e6)
+        add(
+            f"near wall 0.5 mm offset 1e6 e={e:g}",
+            "offset",
+            lambda c=near: _shifted(c, 1e6),
+            0.1,
+            1.2,
+            10.0,
+            _check_translation(near, 0.1, 1.2),
+            q=e == 0.5,
+            e=e,
+            offset=1e6,
+        )
     for e in (1.0, 0.5):
         three = _three_balls(e)
-        add(f"3 balls offset 1e6 e={e:g}", "offset", lambda c=three: _shifted(c, 1e6), 0.1, 2.0, 10.0,
-            _check_translation(three, 0.1, 2.0), e=e, offset=1e6)
+        add(
+            f"3 balls offset 1e6 e={e:g}",
+            "offset",
+            lambda c=three: _shifted(c, 1e6),
+            0.1,
+            2.0,
+            10.0,
+            _check_translation(three, 0.1, 2.0),
+            e=e,
+            offset=1e6,
+        )
     lone = _case(Scene(bounds=PLAY_AREA_2D), [[0.3, -0.2]], [[0.7, 0.45]], [1.0], [0.15])
-    add("lone ball 1e6 steps dt=1/60", "long", lambda: lone, 1 / 60, 1e6 / 60, 2.0, _check_clock(lone, 1 / 60, 10**6),
-        T=1e6 / 60)
+    add(
+        "lone ball 1e6 steps dt=1/60",
+        "long",
+        lambda: lone,
+        1 / 60,
+        1e6 / 60,
+        2.0,
+        _check_clock(lone, 1 / 60, 10**6),
+        T=1e6 / 60,
+    )
     for e in (0.5, 0.0):
-        add(f"slow pair beside 1e3 m/s e={e:g}", "restitution", lambda e=e: _slow_pair(e, 1e3), 0.5, 1.0, 10.0,
-            _check_slow_pair(e, 0.5, 1.0), q=e == 0.5, e=e)
-    add("mass 1e-300 kg", "overflow", lambda: _light_ball(1e-300), 0.01, 2.0, 10.0,
+        add(
+            f"slow pair beside 1e3 m/s e={e:g}",
+            "restitution",
+            lambda e=e: _slow_pair(e, 1e3),
+            0.5,
+            1.0,
+            10.0,
+            _check_slow_pair(e, 0.5, 1.0),
+            q=e == 0.5,
+            e=e,
+        )
+    add(
+        "mass 1e-300 kg",
+        "overflow",
+        lambda: _light_ball(1e-300),
+        0.01,
+        2.0,
+        10.0,
         _refuses(lambda: Simulator(*_light_ball(1e-310)), "ball 0: mass must be positive and finite, with a finite"),
-        q=True, ratio=1e300)
-    add("speed 1e100 m/s", "overflow", lambda: _fast_pair(1e100), 2e-101, 2e-100, 10.0,
-        _refuses(lambda: Simulator(*_fast_pair(1e200)), "ball 0: velocity must be finite, speed within"), speed=1e100)
-    add("no border dt=1e140", "overflow", lambda: _fast_pair(1.0), 1e140, 1e140, 1.0,
+        q=True,
+        ratio=1e300,
+    )
+    add(
+        "speed 1e100 m/s",
+        "overflow",
+        lambda: _fast_pair(1e100),
+        2e-101,
+        2e-100,
+        10.0,
+        _refuses(lambda: Simulator(*_fast_pair(1e200)), "ball 0: velocity must be finite, speed within"),
+        speed=1e100,
+    )
+    add(
+        "no border dt=1e140",
+        "overflow",
+        lambda: _fast_pair(1.0),
+        1e140,
+        1e140,
+        1.0,
         _refuses(lambda: Simulator(*_fast_pair(1e10)).step(1e145), "dt: a step of 1e+145 s would take ball"),
-        q=True, cap=100)
-    add("radius 1e-10 m", "overflow", lambda: _tiny_radius(1e-10), 0.01, 2.0, 10.0,
-        _refuses(lambda: Simulator(*_tiny_radius(1e-12)), "ball 0: radius 1e-12 m is too small"), radius=1e-10)
+        q=True,
+        cap=100,
+    )
+    add(
+        "radius 1e-10 m",
+        "overflow",
+        lambda: _tiny_radius(1e-10),
+        0.01,
+        2.0,
+        10.0,
+        _refuses(lambda: Simulator(*_tiny_radius(1e-12)), "ball 0: radius 1e-12 m is too small"),
+        radius=1e-10,
+    )
     for e in (1.0, 0.5, 0.0):
-        add(f"no room 2r=H vy>0 e={e:g}", "touching", lambda e=e: _wedged(e, 1e-3), 0.01, 2.0, 2e3,
+        add(
+            f"no room 2r=H vy>0 e={e:g}",
+            "touching",
+            lambda e=e: _wedged(e, 1e-3),
+            0.01,
+            2.0,
+            2e3,
             _refuses(lambda e=e: Simulator(*_wedged(e, 0.0)), "ball 0: radius 1 m leaves no room to move"),
-            q=e == 1.0, e=e)
+            q=e == 1.0,
+            e=e,
+        )
 
 
 # --------------------------------------------------------------------------- running a cell
@@ -556,8 +809,16 @@ def run_cell(cell: Cell, mode: str, substeps: int, budget: float) -> dict:
     case = cell.build()
     reasons: list[str] = []
     details: list[str] = []
-    sim = Simulator(case.scene, case.positions, case.velocities, case.masses, case.radii, mode=mode,
-                    substeps=substeps, max_events=cell.max_events)
+    sim = Simulator(
+        case.scene,
+        case.positions,
+        case.velocities,
+        case.masses,
+        case.radii,
+        mode=mode,
+        substeps=substeps,
+        max_events=cell.max_events,
+    )
     radii = case.radii
     scene = case.scene
     check_pairs = scene.ball_collisions and len(radii) > 1 and len(radii) <= 64
@@ -624,10 +885,19 @@ def run_cell(cell: Cell, mode: str, substeps: int, budget: float) -> dict:
             details.append(msg)
     ke = sim.kinetic_energy()
     return {
-        "cell": cell.name, "group": cell.group, "mode": mode if substeps == 1 else f"{mode} k={substeps}",
-        "status": "pass" if not reasons else ", ".join(reasons), "detail": "; ".join(details),
-        "dt": cell.dt, "duration": cell.duration, "steps": done, "impacts": count, "max_events": cell.max_events,
-        "wall_s": wall, "engine_s": engine_time, "worst_step_s": worst_step,
+        "cell": cell.name,
+        "group": cell.group,
+        "mode": mode if substeps == 1 else f"{mode} k={substeps}",
+        "status": "pass" if not reasons else ", ".join(reasons),
+        "detail": "; ".join(details),
+        "dt": cell.dt,
+        "duration": cell.duration,
+        "steps": done,
+        "impacts": count,
+        "max_events": cell.max_events,
+        "wall_s": wall,
+        "engine_s": engine_time,
+        "worst_step_s": worst_step,
         "energy_change": (ke / ke0 - 1) if ke0 > 0 else 0.0,
     }
 
@@ -636,19 +906,21 @@ def repro(cell: Cell) -> str:
     """A minimal, self-contained Python snippet that replays ``cell`` in exact mode."""
     c = cell.build()
     steps = cell.steps
-    return "\n".join([
-        "import numpy as np",
-        "from collision_env.engine import Scene, Simulator",
-        f"scene = {c.scene!r}",
-        f"pos = np.array({c.positions.tolist()!r})",
-        f"vel = np.array({c.velocities.tolist()!r})",
-        f"mass = np.array({c.masses.tolist()!r})",
-        f"radii = np.array({c.radii.tolist()!r})",
-        f"sim = Simulator(scene, pos, vel, mass, radii, mode='exact', max_events={cell.max_events})",
-        f"for k in range({steps}):",
-        f"    sim.step({cell.dt!r})",
-        "print(sim.positions, sim.velocities, sim.cap_reached, sim.kinetic_energy())",
-    ])
+    return "\n".join(
+        [
+            "import numpy as np",
+            "from collision_env.engine import Scene, Simulator",
+            f"scene = {c.scene!r}",
+            f"pos = np.array({c.positions.tolist()!r})",
+            f"vel = np.array({c.velocities.tolist()!r})",
+            f"mass = np.array({c.masses.tolist()!r})",
+            f"radii = np.array({c.radii.tolist()!r})",
+            f"sim = Simulator(scene, pos, vel, mass, radii, mode='exact', max_events={cell.max_events})",
+            f"for k in range({steps}):",
+            f"    sim.step({cell.dt!r})",
+            "print(sim.positions, sim.velocities, sim.cap_reached, sim.kinetic_energy())",
+        ]
+    )
 
 
 def run_extremes(quick: bool, budget: float | None = None, modes=MODES, log=print) -> list[dict]:
@@ -659,14 +931,29 @@ def run_extremes(quick: bool, budget: float | None = None, modes=MODES, log=prin
         t0 = time.perf_counter()
         for mode, k in modes:
             rows.append(run_cell(cell, mode, k, budget))
-        status = {r["mode"]: r["status"] for r in rows[-len(modes):]}
-        log(f"  {cell.name:34s} {time.perf_counter() - t0:6.2f} s  " +
-            "  ".join(f"{m}: {s}" for m, s in status.items()))
+        status = {r["mode"]: r["status"] for r in rows[-len(modes) :]}
+        log(
+            f"  {cell.name:34s} {time.perf_counter() - t0:6.2f} s  " + "  ".join(f"{m}: {s}" for m, s in status.items())
+        )
     return rows
 
 
-EXTREME_FIELDS = ("cell", "group", "mode", "status", "detail", "dt", "duration", "steps", "impacts", "max_events",
-                  "wall_s", "engine_s", "worst_step_s", "energy_change")
+EXTREME_FIELDS = (
+    "cell",
+    "group",
+    "mode",
+    "status",
+    "detail",
+    "dt",
+    "duration",
+    "steps",
+    "impacts",
+    "max_events",
+    "wall_s",
+    "engine_s",
+    "worst_step_s",
+    "energy_change",
+)
 
 
 def extremes_markdown(rows: list[dict], quick: bool, budget: float) -> str:
@@ -692,8 +979,11 @@ def extremes_markdown(rows: list[dict], quick: bool, budget: float) -> str:
         counts = {reason: sum(reason in r["status"].split(", ") for r in rs) for reason in REASONS}
         fails = ", ".join(f"{k}: {v}" for k, v in counts.items() if v) or "none"
         lines.append(f"| {m} | {passed} / {len(rs)} | {fails} |")
-    lines += ["", "| group | cell | dt (s) | duration (s) | " + " | ".join(modes) + " |",
-              "|---|---|---:|---:|" + "---|" * len(modes)]
+    lines += [
+        "",
+        "| group | cell | dt (s) | duration (s) | " + " | ".join(modes) + " |",
+        "|---|---|---:|---:|" + "---|" * len(modes),
+    ]
     for (group, name), per in by_cell.items():
         any_row = next(iter(per.values()))
         cells_ = []
@@ -710,8 +1000,11 @@ def extremes_markdown(rows: list[dict], quick: bool, budget: float) -> str:
     lines += [""]
     if exact_fail:
         lines += ["**Exact mode fails cells** (an engine problem to fix, not a trade):", ""]
-        lines += [f"- {r['cell']}: {r['status']} ({r['detail']}); replay it with "
-                  f"`python -m collision_env.bench.extremes --repro '{r['cell']}'`" for r in exact_fail]
+        lines += [
+            f"- {r['cell']}: {r['status']} ({r['detail']}); replay it with "
+            f"`python -m collision_env.bench.extremes --repro '{r['cell']}'`"
+            for r in exact_fail
+        ]
     else:
         lines.append("Exact mode passes every cell.")
     lines.append("")

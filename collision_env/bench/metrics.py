@@ -24,8 +24,16 @@ import numpy as np
 
 from collision_env.engine import WALL_NAMES
 
-IMPACTS = np.dtype([("time", np.float64), ("ball", np.int64), ("other", np.int64), ("wall", np.int64),
-                    ("x", np.float64), ("y", np.float64)])
+IMPACTS = np.dtype(
+    [
+        ("time", np.float64),
+        ("ball", np.int64),
+        ("other", np.int64),
+        ("wall", np.int64),
+        ("x", np.float64),
+        ("y", np.float64),
+    ]
+)
 
 
 def as_impacts(impacts) -> np.ndarray:
@@ -177,8 +185,15 @@ def match_impacts(run, ref, window: float, neighbours: int = 4) -> Match:
     point_error = np.hypot(run["x"][pr] - ref["x"][pf], run["y"][pr] - ref["y"][pf])
     run_pairs = {k for k in run_keys if k[2] < 0}
     tunnelled = sorted({k for k in ref_keys if k[2] < 0} - run_pairs)
-    return Match(pr, pf, np.flatnonzero(~ref_used), np.flatnonzero(~run_used), time_error, point_error,
-                 [(a, b) for a, b, _ in tunnelled])
+    return Match(
+        pr,
+        pf,
+        np.flatnonzero(~ref_used),
+        np.flatnonzero(~run_used),
+        time_error,
+        point_error,
+        [(a, b) for a, b, _ in tunnelled],
+    )
 
 
 # --------------------------------------------------------------------------- conservation, validity
@@ -266,7 +281,7 @@ def max_overlap(positions, radii, chunk=256) -> float:
     iu = np.triu_indices(n, 1)
     worst = 0.0
     for start in range(0, p.shape[0], chunk):
-        q = p[start:start + chunk]
+        q = p[start : start + chunk]
         d = np.sqrt(((q[:, :, None, :] - q[:, None, :, :]) ** 2).sum(-1))
         rel = (sigma - d) / sigma
         worst = max(worst, float(np.max(rel[:, iu[0], iu[1]])))

@@ -134,9 +134,14 @@ def results_markdown(rows, missing, env_rows, quick, meta) -> str:
         "| matched / missed / spurious | tunnelled pairs | escapes | energy drift |",
         "|---|---:|---|---:|---:|---:|---:|---|---:|---:|---:|",
     ]
-    for r in sorted((r for r in ok if r["dt"] == mid_dt),
-                    key=lambda r: (list(dict.fromkeys(x["scene"] for x in rows)).index(r["scene"]), r["n"],
-                                   fams.index(r["family"]))):
+    for r in sorted(
+        (r for r in ok if r["dt"] == mid_dt),
+        key=lambda r: (
+            list(dict.fromkeys(x["scene"] for x in rows)).index(r["scene"]),
+            r["n"],
+            fams.index(r["family"]),
+        ),
+    ):
         lines.append(
             f"| {r['scene']} | {r['n']} | {r['family']} | {_fmt(r['us_per_step'], 3)} | {_fmt(r['wall_per_sim_s'])} "
             f"| {_fmt(r['pos_err'])} | {_fmt(r['t_err_max'])} | {r['matched']} / {r['missed']} / {r['spurious']} "
@@ -144,9 +149,13 @@ def results_markdown(rows, missing, env_rows, quick, meta) -> str:
         )
     # error by dt, for each scene at its largest ball count
     dts = sorted({r["dt"] for r in ok})
-    lines += ["", "### Final-state error (radii) against the control step, at each scene's largest ball count", "",
-              "| scene | n | engine / mode | " + " | ".join(f"dt={d:g}" for d in dts) + " |",
-              "|---|---:|---|" + "---:|" * len(dts)]
+    lines += [
+        "",
+        "### Final-state error (radii) against the control step, at each scene's largest ball count",
+        "",
+        "| scene | n | engine / mode | " + " | ".join(f"dt={d:g}" for d in dts) + " |",
+        "|---|---:|---|" + "---:|" * len(dts),
+    ]
     largest = {}
     for r in ok:
         largest[r["scene"]] = max(largest.get(r["scene"], 0), r["n"])
@@ -161,8 +170,9 @@ def results_markdown(rows, missing, env_rows, quick, meta) -> str:
             if have:
                 lines.append(f"| {scene} | {n} | {f} | " + " | ".join(cells) + " |")
     # what could not run
-    notes = sorted({(r["family"], r["scene"], r.get("note", "")) for r in rows
-                    if r.get("status") not in ("ok", "timed")})
+    notes = sorted(
+        {(r["family"], r["scene"], r.get("note", "")) for r in rows if r.get("status") not in ("ok", "timed")}
+    )
     if notes or missing:
         lines += ["", "### What could not run", ""]
         for name, why in missing.items():
@@ -181,12 +191,17 @@ def results_markdown(rows, missing, env_rows, quick, meta) -> str:
 def env_markdown(env_rows) -> str:
     if isinstance(env_rows, str):
         return f"### Environment steps per second\n\n{env_rows}\n"
-    lines = ["### Environment steps per second (random actions, same run)", "",
-             "| env id | matching scene | mode | single env steps/s | vector env (64) steps/s |",
-             "|---|---|---|---:|---:|"]
+    lines = [
+        "### Environment steps per second (random actions, same run)",
+        "",
+        "| env id | matching scene | mode | single env steps/s | vector env (64) steps/s |",
+        "|---|---|---|---:|---:|",
+    ]
     for r in env_rows:
-        lines.append(f"| {r['env']} | {r['scene']} | {r['mode']} | {_fmt(r['single_steps_per_s'])} "
-                     f"| {_fmt(r['vector_steps_per_s'])} |")
+        lines.append(
+            f"| {r['env']} | {r['scene']} | {r['mode']} | {_fmt(r['single_steps_per_s'])} "
+            f"| {_fmt(r['vector_steps_per_s'])} |"
+        )
     lines.append("")
     return "\n".join(lines)
 
@@ -243,7 +258,7 @@ def plot_all(rows, out: Path) -> list[str]:
         ax.set_xlabel("wall s per simulated s", fontsize=8)
         ax.set_ylabel("final-state error (radii)", fontsize=8)
         ax.tick_params(labelsize=7)
-    for ax in list(axes.flat)[len(scenes):]:
+    for ax in list(axes.flat)[len(scenes) :]:
         ax.axis("off")
     handles, labels = [], []
     for ax in axes.flat:
@@ -290,10 +305,24 @@ def plot_all(rows, out: Path) -> list[str]:
         if not fr:
             continue
         x = [r["tunnel_scale"] for r in fr]
-        axes[0].scatter(x, [max(_err(r), PLOT_FLOOR) for r in fr], s=12, label=f, color=style[f]["color"],
-                        marker=style[f]["marker"], alpha=0.7)
-        axes[1].scatter(x, [r["missed"] / max(r["ref_impacts"], 1) for r in fr], s=12, label=f,
-                        color=style[f]["color"], marker=style[f]["marker"], alpha=0.7)
+        axes[0].scatter(
+            x,
+            [max(_err(r), PLOT_FLOOR) for r in fr],
+            s=12,
+            label=f,
+            color=style[f]["color"],
+            marker=style[f]["marker"],
+            alpha=0.7,
+        )
+        axes[1].scatter(
+            x,
+            [r["missed"] / max(r["ref_impacts"], 1) for r in fr],
+            s=12,
+            label=f,
+            color=style[f]["color"],
+            marker=style[f]["marker"],
+            alpha=0.7,
+        )
     axes[0].set_yscale("log")
     axes[0].set_ylabel("final-state error (radii)")
     axes[1].set_ylabel("fraction of reference impacts missed")
@@ -411,14 +440,19 @@ def _unmatched_cells(exact) -> tuple[list, bool]:
 def _exact_unmatched(exact) -> str:
     """Where exact mode's impacts did not pair one to one with its reference's, and why that can be."""
     cells, collapse = _unmatched_cells(exact)
-    where = "; ".join(f"{r['scene']} n={r['n']} dt={r['dt']:g}: {r['missed']} missed, {r['spurious']} spurious, "
-                      f"final-state error {_fmt(_err(r))} radii" for r in cells)
+    where = "; ".join(
+        f"{r['scene']} n={r['n']} dt={r['dt']:g}: {r['missed']} missed, {r['spurious']} spurious, "
+        f"final-state error {_fmt(_err(r))} radii"
+        for r in cells
+    )
     text = f", all in these runs ({where})"
     if collapse:
-        text += (". In an inelastic collapse, balls pressed together sit at the contact tolerance of a contact group "
-                 "(1e-9 of the length scale): round-off decides whether a barely touching ball joins a group, which "
-                 "can split one cascade's resolution over two instants and move its impacts' bookkeeping to a later "
-                 "cascade, while the motion agrees to the final-state error given")
+        text += (
+            ". In an inelastic collapse, balls pressed together sit at the contact tolerance of a contact group "
+            "(1e-9 of the length scale): round-off decides whether a barely touching ball joins a group, which "
+            "can split one cascade's resolution over two instants and move its impacts' bookkeeping to a later "
+            "cascade, while the motion agrees to the final-state error given"
+        )
     return text + "."
 
 
@@ -439,8 +473,10 @@ def summary_markdown(rows, extreme_rows, stat_rows, quick, meta) -> str:
     exact = [r for r in ok if r["family"] == "exact"]
     if exact:
         worst = max(exact, key=_err)
-        t_worst = max((r["t_err_max"] for r in exact if isinstance(r["t_err_max"], float)
-                       and not math.isnan(r["t_err_max"])), default=math.nan)
+        t_worst = max(
+            (r["t_err_max"] for r in exact if isinstance(r["t_err_max"], float) and not math.isnan(r["t_err_max"])),
+            default=math.nan,
+        )
         missed = sum(r["missed"] + r["spurious"] for r in exact)
         lines += [
             f"- **exact** matches its reference to round-off (amplified by the gas's chaos over ≤ 5 collisions per "
@@ -468,8 +504,11 @@ def summary_markdown(rows, extreme_rows, stat_rows, quick, meta) -> str:
                 else:
                     parts.append(f"within {level:g} when s < {y:.2g} ({below}/{total} runs)")
             y_miss, total = miss_threshold(ok, f, where=where)
-            miss = ("never misses or invents an impact" if math.isinf(y_miss)
-                    else f"first misses or invents an impact at s = {y_miss:.2g}")
+            miss = (
+                "never misses or invents an impact"
+                if math.isinf(y_miss)
+                else f"first misses or invents an impact at s = {y_miss:.2g}"
+            )
             lines.append(f"- **{f}**: " + "; ".join(parts) + f"; {miss}.")
     # typical errors by tunnelling scale
     edges = (0.0, 0.01, 0.1, 1.0, math.inf)
@@ -478,8 +517,13 @@ def summary_markdown(rows, extreme_rows, stat_rows, quick, meta) -> str:
         fr_all = [r for r in ok if where(r)]
         if not fr_all:
             continue
-        lines += ["", f"Median (worst) final-state error in radii on {title}, by s:", "",
-                  "| engine / mode | " + " | ".join(names) + " |", "|---|" + "---:|" * len(names)]
+        lines += [
+            "",
+            f"Median (worst) final-state error in radii on {title}, by s:",
+            "",
+            "| engine / mode | " + " | ".join(names) + " |",
+            "|---|" + "---:|" * len(names),
+        ]
         for f in fams:
             cells = []
             for lo, hi in zip(edges[:-1], edges[1:], strict=True):
@@ -492,17 +536,25 @@ def summary_markdown(rows, extreme_rows, stat_rows, quick, meta) -> str:
     lines += ["", "Cost, measured in the same run (per control step, same scene, ball count and dt):", ""]
     if k:
         lines.append(f"- exact ÷ naive at 1–4 balls: median {med:.2f}×, worst {mx:.2f}× over {k} runs.")
-    for num, den, counts in (("exact", "posteriori k=1", (1, 2, 4)), ("exact", "naive", (16, 64)),
-                             ("exact", "posteriori k=8", (1, 2, 4, 16, 64)),
-                             ("exact", "pymunk it=10", (1, 2, 4, 16, 64)),
-                             ("exact", "billiards", (1, 2, 4, 16, 64))):
+    for num, den, counts in (
+        ("exact", "posteriori k=1", (1, 2, 4)),
+        ("exact", "naive", (16, 64)),
+        ("exact", "posteriori k=8", (1, 2, 4, 16, 64)),
+        ("exact", "pymunk it=10", (1, 2, 4, 16, 64)),
+        ("exact", "billiards", (1, 2, 4, 16, 64)),
+    ):
         med, mx, k = cost_ratios(ok, num, den, counts)
         if k:
-            lines.append(f"- {num} ÷ {den} at {counts[0]}–{counts[-1]} balls: median {med:.2f}×, worst {mx:.2f}× "
-                         f"over {k} runs.")
+            lines.append(
+                f"- {num} ÷ {den} at {counts[0]}–{counts[-1]} balls: median {med:.2f}×, worst {mx:.2f}× over {k} runs."
+            )
     dominated, ties = pareto_check(ok)
-    lines += ["", "Pareto front: is any run both faster than exact's fastest run and more accurate than it, "
-              "beyond exact's own spread on that scene?", ""]
+    lines += [
+        "",
+        "Pareto front: is any run both faster than exact's fastest run and more accurate than it, "
+        "beyond exact's own spread on that scene?",
+        "",
+    ]
     if dominated:
         lines += [f"- **exact is dominated** on {s}, n={n} by {f} at dt={d:g}" for s, n, f, d in dominated]
     else:
@@ -512,8 +564,11 @@ def summary_markdown(rows, extreme_rows, stat_rows, quick, meta) -> str:
         by = defaultdict(list)
         for s, n, f, d, ratio in ties:
             by[(s, n)].append(f"{f} dt={d:g} ({ratio:.2f}× the cost)")
-        lines.append("- runs that tie with exact (error within its spread) at lower cost: " +
-                     "; ".join(f"{s} n={n}: " + ", ".join(v) for (s, n), v in by.items()) + ".")
+        lines.append(
+            "- runs that tie with exact (error within its spread) at lower cost: "
+            + "; ".join(f"{s} n={n}: " + ", ".join(v) for (s, n), v in by.items())
+            + "."
+        )
     # peers
     peer_lines = []
     for f in fams:
@@ -522,11 +577,14 @@ def summary_markdown(rows, extreme_rows, stat_rows, quick, meta) -> str:
         fr = [r for r in ok if r["family"] == f]
         esc = sum(r["escapes"] > 0 for r in fr)
         unsup = sorted({r["scene"] for r in rows if r["family"] == f and r.get("status") == "unsupported"})
-        drifts = [r["energy_drift"] for r in fr
-                  if isinstance(r["energy_drift"], float) and not math.isnan(r["energy_drift"])]
-        txt = (f"- {f}: median error {_fmt(_median([_err(r) for r in fr]))} radii, energy drift on elastic scenes "
-               f"median {_fmt(_median(drifts))} / worst {_fmt(max(drifts, default=math.nan))}, balls escaped the "
-               f"border in {esc} of {len(fr)} runs")
+        drifts = [
+            r["energy_drift"] for r in fr if isinstance(r["energy_drift"], float) and not math.isnan(r["energy_drift"])
+        ]
+        txt = (
+            f"- {f}: median error {_fmt(_median([_err(r) for r in fr]))} radii, energy drift on elastic scenes "
+            f"median {_fmt(_median(drifts))} / worst {_fmt(max(drifts, default=math.nan))}, balls escaped the "
+            f"border in {esc} of {len(fr)} runs"
+        )
         if unsup:
             txt += f"; cannot run {', '.join(unsup)}"
         peer_lines.append(txt + ".")
@@ -546,15 +604,21 @@ def summary_markdown(rows, extreme_rows, stat_rows, quick, meta) -> str:
             lines.append(f"- {mode}: {len(rs) - len(fails)} / {len(rs)} ({txt})")
         bad = [r for r in extreme_rows if r["mode"] == "exact" and r["status"] != "pass"]
         if bad:
-            lines.append("- **exact fails**: " + "; ".join(f"{r['cell']} ({r['status']})" for r in bad) +
-                         " — an engine problem, see extremes.md")
+            lines.append(
+                "- **exact fails**: "
+                + "; ".join(f"{r['cell']} ({r['status']})" for r in bad)
+                + " — an engine problem, see extremes.md"
+            )
     if stat_rows:
         good = [r for r in stat_rows if r.get("ks") not in (None, "")]
         lines += ["", "Long runs (64-ball gases; Maxwell-Boltzmann KS test and Enskog rate ratio):", ""]
         for f in dict.fromkeys(r["family"] for r in good):
             fr = [r for r in good if r["family"] == f]
-            txt = ", ".join(f"{r['gas'].split('_')[0]} dt={r['dt']:g}: KS {'pass' if r['ks_pass'] else 'fail'}, "
-                            f"rate ×{r['rate_ratio']:.2f}" for r in fr)
+            txt = ", ".join(
+                f"{r['gas'].split('_')[0]} dt={r['dt']:g}: KS {'pass' if r['ks_pass'] else 'fail'}, "
+                f"rate ×{r['rate_ratio']:.2f}"
+                for r in fr
+            )
             lines.append(f"- {f}: {txt}")
     # the rule of thumb, assembled from the numbers above
     lines += ["", "## Rule of thumb (from the numbers above)", ""]
@@ -563,11 +627,17 @@ def summary_markdown(rows, extreme_rows, stat_rows, quick, meta) -> str:
     if exact:
         worst = max(_err(r) for r in exact)
         cells, collapse = _unmatched_cells(exact)
-        impacts = ("no impact missed; " if not cells else
-                   "no impact missed outside the bookkeeping of inelastic collapse cascades (above); " if collapse
-                   else "impacts unmatched in some runs (above); ")
-        rule.append(f"- **exact**: error ≤ {_fmt(worst)} radii at every dt, speed and scene measured, {impacts}"
-                    + "the mode to use whenever impact times and points matter or no error bound below holds.")
+        impacts = (
+            "no impact missed; "
+            if not cells
+            else "no impact missed outside the bookkeeping of inelastic collapse cascades (above); "
+            if collapse
+            else "impacts unmatched in some runs (above); "
+        )
+        rule.append(
+            f"- **exact**: error ≤ {_fmt(worst)} radii at every dt, speed and scene measured, {impacts}"
+            + "the mode to use whenever impact times and points matter or no error bound below holds."
+        )
     for f in post + [f for f in fams if f.startswith("naive")]:
         for title, where in (ELASTIC, INELASTIC):
             y, below, total = thresholds(ok, f, 1e-3, where=where, floor=floor)
@@ -586,12 +656,16 @@ def summary_markdown(rows, extreme_rows, stat_rows, quick, meta) -> str:
     med, mx, k = cost_ratios(ok, "exact", "naive")
     if k:
         verdict = "within" if mx <= 2.0 else "above"
-        rule.append(f"- Cost: at 1–4 balls exact costs {med:.2f}× naive per step (median; worst {mx:.2f}×, "
-                    f"{verdict} the 2× bar).")
+        rule.append(
+            f"- Cost: at 1–4 balls exact costs {med:.2f}× naive per step (median; worst {mx:.2f}×, "
+            f"{verdict} the 2× bar)."
+        )
         med2, mx2, k2 = cost_ratios(ok, "exact", "naive", (16, 64))
         if k2:
-            rule.append(f"  At 16–64 balls it costs {med2:.2f}× naive (worst {mx2:.2f}×): the regime where a cheap "
-                        "mode saves time, if its error above is acceptable.")
+            rule.append(
+                f"  At 16–64 balls it costs {med2:.2f}× naive (worst {mx2:.2f}×): the regime where a cheap "
+                "mode saves time, if its error above is acceptable."
+            )
     lines += rule + [""]
     return "\n".join(lines)
 

@@ -99,27 +99,45 @@ def bench_size(n: int, log=print) -> dict:
     tracemalloc.stop()
     after = sim.stats
     events = after["events"] - before["events"]
-    per_event = {key: (after[key] - before[key]) / events for key in ("pair_tests", "cell_crossings",
-                                                                      "stale_events")}
+    per_event = {key: (after[key] - before[key]) / events for key in ("pair_tests", "cell_crossings", "stale_events")}
     # validity
     p = sim.positions[0]
     r = sim.radii[0]
     i, j = first_overlap(p, r, 1e-9)
     xmin, ymin, xmax, ymax = scene.bounds
     slack = 1e-12 * (xmax - xmin)
-    outside = int(np.count_nonzero((p[:, 0] - r < xmin - slack) | (p[:, 0] + r > xmax + slack)
-                                   | (p[:, 1] - r < ymin - slack) | (p[:, 1] + r > ymax + slack)))
+    outside = int(
+        np.count_nonzero(
+            (p[:, 0] - r < xmin - slack)
+            | (p[:, 0] + r > xmax + slack)
+            | (p[:, 1] - r < ymin - slack)
+            | (p[:, 1] + r > ymax + slack)
+        )
+    )
     e1 = _energy(sim)
     rate = 2.0 * pairs / (n * timed_frames * FRAME)
     nu_end = enskog_rate(n / area, 2 * RADIUS, PACKING, e1 / n, 1.0)
     row = {
-        "n": n, "build_s": build_s, "peak_bytes_per_disk": peak / n, "frames": timed_frames, "events": events,
-        "seconds": wall, "events_per_s": events / wall, "us_per_event": 1e6 * wall / events, **per_event,
-        "overlaps": int(i >= 0), "outside": outside, "energy_rel_change": abs(e1 - e0) / e0,
-        "rate_per_disk": rate, "rate_enskog": nu_end, "rate_ratio": rate / nu_end,
+        "n": n,
+        "build_s": build_s,
+        "peak_bytes_per_disk": peak / n,
+        "frames": timed_frames,
+        "events": events,
+        "seconds": wall,
+        "events_per_s": events / wall,
+        "us_per_event": 1e6 * wall / events,
+        **per_event,
+        "overlaps": int(i >= 0),
+        "outside": outside,
+        "energy_rel_change": abs(e1 - e0) / e0,
+        "rate_per_disk": rate,
+        "rate_enskog": nu_end,
+        "rate_ratio": rate / nu_end,
     }
-    log(f"  N = {n:>7,}: {row['events_per_s']:.3g} events/s ({row['us_per_event']:.2f} us/event), "
-        f"build {build_s:.3f} s, {row['peak_bytes_per_disk']:.0f} B/disk, rate/Enskog {row['rate_ratio']:.3f}")
+    log(
+        f"  N = {n:>7,}: {row['events_per_s']:.3g} events/s ({row['us_per_event']:.2f} us/event), "
+        f"build {build_s:.3f} s, {row['peak_bytes_per_disk']:.0f} B/disk, rate/Enskog {row['rate_ratio']:.3f}"
+    )
     return row
 
 
@@ -136,8 +154,9 @@ def bench_frames(n: int = 50, horizon: float = 20.0, repeats: int = 5) -> dict:
     def run(frames: bool) -> float:
         best = math.inf
         for _ in range(repeats):
-            sim = BatchSimulator(scene, pos[None], vel[None], np.ones(n), radii=np.full(n, GAS_RADIUS),
-                                 max_events=10**7)
+            sim = BatchSimulator(
+                scene, pos[None], vel[None], np.ones(n), radii=np.full(n, GAS_RADIUS), max_events=10**7
+            )
             t0 = time.perf_counter()
             if frames:
                 for _ in range(n_frames):
@@ -149,8 +168,14 @@ def bench_frames(n: int = 50, horizon: float = 20.0, repeats: int = 5) -> dict:
 
     run(False)
     one_step, in_frames = run(False), run(True)
-    return {"n": n, "horizon_s": horizon, "frames": n_frames, "one_step_events_per_s": one_step,
-            "frames_events_per_s": in_frames, "frames_over_one_step": in_frames / one_step}
+    return {
+        "n": n,
+        "horizon_s": horizon,
+        "frames": n_frames,
+        "one_step_events_per_s": one_step,
+        "frames_events_per_s": in_frames,
+        "frames_over_one_step": in_frames / one_step,
+    }
 
 
 def run(quick: bool = False, log=print) -> dict:
@@ -161,8 +186,16 @@ def run(quick: bool = False, log=print) -> dict:
     rows = [bench_size(n, log) for n in (QUICK_SIZES if quick else SIZES)]
     frames = bench_frames(repeats=3 if quick else 7)
     log(f"  50-disk gas: frames keep {100 * frames['frames_over_one_step']:.0f} % of the one-step event rate")
-    return {"machine": machine(), "cpus": cpus(), "timestamp": timestamp(), "versions": versions(["numpy", "numba"]),
-            "first_call_s": first_call_s, "sizes": rows, "frames": frames, "seconds": time.perf_counter() - t0}
+    return {
+        "machine": machine(),
+        "cpus": cpus(),
+        "timestamp": timestamp(),
+        "versions": versions(["numpy", "numba"]),
+        "first_call_s": first_call_s,
+        "sizes": rows,
+        "frames": frames,
+        "seconds": time.perf_counter() - t0,
+    }
 
 
 def render_markdown(results: dict) -> str:

@@ -76,8 +76,13 @@ def intro(n: int = 2) -> Case:
     """PhET Intro: two balls head-on on a line, reflecting border off, e = 1."""
     _check_n("intro", n, (2,))
     m = np.array([0.5, 1.5])
-    return _case(Scene(bounds=None, elasticity=1.0, dimension=1), [[-1.0, 0.0], [1.0, 0.0]],
-                 [[1.0, 0.0], [-0.5, 0.0]], m, radius_from_mass(m))
+    return _case(
+        Scene(bounds=None, elasticity=1.0, dimension=1),
+        [[-1.0, 0.0], [1.0, 0.0]],
+        [[1.0, 0.0], [-0.5, 0.0]],
+        m,
+        radius_from_mass(m),
+    )
 
 
 def explore_1d(n: int = 2) -> Case:
@@ -85,8 +90,13 @@ def explore_1d(n: int = 2) -> Case:
     _check_n("explore_1d", n, (1, 2, 3, 4, 5))
     rows = _EXPLORE_1D[:n]
     m = np.array([r[2] for r in rows])
-    return _case(Scene(bounds=PLAY_AREA_1D, elasticity=1.0, dimension=1), [[r[0], 0.0] for r in rows],
-                 [[r[1], 0.0] for r in rows], m, radius_from_mass(m))
+    return _case(
+        Scene(bounds=PLAY_AREA_1D, elasticity=1.0, dimension=1),
+        [[r[0], 0.0] for r in rows],
+        [[r[1], 0.0] for r in rows],
+        m,
+        radius_from_mass(m),
+    )
 
 
 def explore_2d(n: int = 2) -> Case:
@@ -94,8 +104,9 @@ def explore_2d(n: int = 2) -> Case:
     _check_n("explore_2d", n, (1, 2, 3, 4))
     rows = _EXPLORE_2D[:n]
     m = np.array([r[2] for r in rows])
-    return _case(Scene(bounds=PLAY_AREA_2D, elasticity=1.0), [r[0] for r in rows], [r[1] for r in rows], m,
-                 radius_from_mass(m))
+    return _case(
+        Scene(bounds=PLAY_AREA_2D, elasticity=1.0), [r[0] for r in rows], [r[1] for r in rows], m, radius_from_mass(m)
+    )
 
 
 def inelastic(n: int = 2, flavour: str = "stick") -> Case:
@@ -103,8 +114,13 @@ def inelastic(n: int = 2, flavour: str = "stick") -> Case:
     _check_n("inelastic", n, (2,))
     rows = _EXPLORE_2D[:2]
     m = np.array([r[2] for r in rows])
-    return _case(Scene(bounds=PLAY_AREA_2D, elasticity=0.0, inelastic=flavour), [r[0] for r in rows],
-                 [r[1] for r in rows], m, radius_from_mass(m))
+    return _case(
+        Scene(bounds=PLAY_AREA_2D, elasticity=0.0, inelastic=flavour),
+        [r[0] for r in rows],
+        [r[1] for r in rows],
+        m,
+        radius_from_mass(m),
+    )
 
 
 # --------------------------------------------------------------------------- gases
@@ -145,14 +161,16 @@ def _directions(n, speed, rng):
     return speed * np.stack([np.cos(angle), np.sin(angle)], axis=1)
 
 
-def gas(n: int, radius: float = 0.05, packing: float = 0.05, speed: float = 1.0, seed: int = 0,
-        elasticity: float = 1.0) -> Case:
+def gas(
+    n: int, radius: float = 0.05, packing: float = 0.05, speed: float = 1.0, seed: int = 0, elasticity: float = 1.0
+) -> Case:
     """``n`` equal 1 kg disks at ``packing`` fraction in a 2:1 box scaled with ``n``, equal speeds, any direction."""
     rng = np.random.default_rng(seed)
     bounds = gas_box(n, radius, packing)
     pos = _lattice(n, bounds, radius, rng, jitter=radius)
-    return _case(Scene(bounds=bounds, elasticity=elasticity), pos, _directions(n, speed, rng), np.ones(n),
-                 np.full(n, radius))
+    return _case(
+        Scene(bounds=bounds, elasticity=elasticity), pos, _directions(n, speed, rng), np.ones(n), np.full(n, radius)
+    )
 
 
 def dilute_gas(n: int = 16) -> Case:
@@ -210,8 +228,13 @@ def pi_billiard(n: int = 2, digits: int = 2) -> Case:
     _check_n("pi_billiard", n, (2,))
     m = np.array([1.0, 100.0**digits])
     r = np.array([0.1, 0.1])
-    return _case(Scene(bounds=(-2.0, -0.55, 1.0e4, 0.55), elasticity=1.0, dimension=1),
-                 [[-1.0, 0.0], [0.0, 0.0]], [[0.0, 0.0], [-1.0, 0.0]], m, r)
+    return _case(
+        Scene(bounds=(-2.0, -0.55, 1.0e4, 0.55), elasticity=1.0, dimension=1),
+        [[-1.0, 0.0], [0.0, 0.0]],
+        [[0.0, 0.0], [-1.0, 0.0]],
+        m,
+        r,
+    )
 
 
 def pi_collisions(digits: int) -> int:
@@ -231,8 +254,7 @@ def inelastic_pileup(n: int = 4, elasticity: float = 0.05) -> Case:
     x0 = -2.0 + r + 0.5
     pos = [[x0 + 2.5 * r * k, 0.0] for k in range(n)]
     vel = [[-rng.uniform(0.5, 1.5), 0.0] for _ in range(n)]
-    return _case(Scene(bounds=PLAY_AREA_1D, elasticity=elasticity, dimension=1), pos, vel, np.ones(n),
-                 np.full(n, r))
+    return _case(Scene(bounds=PLAY_AREA_1D, elasticity=elasticity, dimension=1), pos, vel, np.ones(n), np.full(n, r))
 
 
 # --------------------------------------------------------------------------- registry
@@ -263,16 +285,33 @@ SCENES: dict[str, SceneSpec] = {
         SceneSpec("explore_1d", explore_1d, (1, 2, 4), 6.0, False, "PhET Explore 1D defaults", (2, 4)),
         SceneSpec("explore_2d", explore_2d, (1, 2, 4), 6.0, True, "PhET Explore 2D defaults", (2, 4)),
         SceneSpec("inelastic", inelastic, (2,), 4.0, False, "PhET Inelastic (e = 0, stick)"),
-        SceneSpec("dilute_gas", dilute_gas, (1, 2, 4, 16, 64), 6.0, True, "gas, packing 0.05", (1, 4, 16, 64),
-                  cost_counts=(256, 1024, 4096, 10_000)),
+        SceneSpec(
+            "dilute_gas",
+            dilute_gas,
+            (1, 2, 4, 16, 64),
+            6.0,
+            True,
+            "gas, packing 0.05",
+            (1, 4, 16, 64),
+            cost_counts=(256, 1024, 4096, 10_000),
+        ),
         SceneSpec("dense_gas", dense_gas, (16, 64), 2.0, True, "gas, packing 0.5", (16,)),
         SceneSpec("corner_shot", corner_shot, (1, 4, 16), 1.0, True, "10 m/s ball near a corner", (1, 4)),
-        SceneSpec("newtons_cradle", newtons_cradle, (2, 4, 16, 64), 2.0, False, "Newton's cradle (touching row)",
-                  (4, 16)),
-        SceneSpec("pi_billiard", pi_billiard, (2,), 8.0, False, "Galperin pi billiard, mass ratio 1e4",
-                  kwargs={"digits": 2}),
-        SceneSpec("inelastic_pileup", inelastic_pileup, (2, 4, 16, 64), 3.0, False,
-                  "1D pile-up into a wall at e = 0.05", (4, 16)),
+        SceneSpec(
+            "newtons_cradle", newtons_cradle, (2, 4, 16, 64), 2.0, False, "Newton's cradle (touching row)", (4, 16)
+        ),
+        SceneSpec(
+            "pi_billiard", pi_billiard, (2,), 8.0, False, "Galperin pi billiard, mass ratio 1e4", kwargs={"digits": 2}
+        ),
+        SceneSpec(
+            "inelastic_pileup",
+            inelastic_pileup,
+            (2, 4, 16, 64),
+            3.0,
+            False,
+            "1D pile-up into a wall at e = 0.05",
+            (4, 16),
+        ),
     )
 }
 

@@ -28,8 +28,26 @@ from .scenes import SCENES
 from .sweep import record_run
 
 SNAPSHOT_COLLISIONS = 3.0  # mean collision times between speed snapshots (decorrelation)
-STAT_FIELDS = ("gas", "n", "packing", "family", "dt", "tunnel_scale", "horizon", "snapshots", "samples", "ks",
-               "ks_critical", "ks_pass", "rate", "rate_enskog", "rate_ratio", "energy_drift", "wall_s", "note")
+STAT_FIELDS = (
+    "gas",
+    "n",
+    "packing",
+    "family",
+    "dt",
+    "tunnel_scale",
+    "horizon",
+    "snapshots",
+    "samples",
+    "ks",
+    "ks_critical",
+    "ks_pass",
+    "rate",
+    "rate_enskog",
+    "rate_ratio",
+    "energy_drift",
+    "wall_s",
+    "note",
+)
 
 
 def _runners():
@@ -61,8 +79,15 @@ def gas_statistics(quick: bool, log=print) -> list[dict]:
             total = len(steps) * dt
             every = max(1, int(round(SNAPSHOT_COLLISIONS / nu0 / dt)))
             for runner in _runners():
-                base = {"gas": name, "n": n, "packing": packing, "family": runner.family, "dt": dt,
-                        "tunnel_scale": speed * dt / runner.substeps / r, "horizon": total}
+                base = {
+                    "gas": name,
+                    "n": n,
+                    "packing": packing,
+                    "family": runner.family,
+                    "dt": dt,
+                    "tunnel_scale": speed * dt / runner.substeps / r,
+                    "horizon": total,
+                }
                 t0 = time.perf_counter()
                 try:
                     rec = record_run(runner, case, steps)
@@ -83,12 +108,22 @@ def gas_statistics(quick: bool, log=print) -> list[dict]:
                 ke = M.kinetic_energy(rec.velocities[k_eq:], case.masses)
                 kT = float(np.mean(ke)) / n
                 predicted = M.enskog_rate(n / area, 2 * r, packing, kT, m)
-                rows.append({
-                    **base, "snapshots": len(snaps), "samples": int(speeds.size), "ks": ks, "ks_critical": crit,
-                    "ks_pass": bool(ks < crit), "rate": rate, "rate_enskog": predicted, "rate_ratio": rate / predicted,
-                    "energy_drift": M.drift(M.kinetic_energy(rec.velocities, case.masses)), "wall_s": wall,
-                    "note": "impacts are begin-contact events" if runner.engine == "pymunk" else "",
-                })
+                rows.append(
+                    {
+                        **base,
+                        "snapshots": len(snaps),
+                        "samples": int(speeds.size),
+                        "ks": ks,
+                        "ks_critical": crit,
+                        "ks_pass": bool(ks < crit),
+                        "rate": rate,
+                        "rate_enskog": predicted,
+                        "rate_ratio": rate / predicted,
+                        "energy_drift": M.drift(M.kinetic_energy(rec.velocities, case.masses)),
+                        "wall_s": wall,
+                        "note": "impacts are begin-contact events" if runner.engine == "pymunk" else "",
+                    }
+                )
             log(f"  statistics {name} dt={dt:g}: {time.perf_counter() - t0:5.1f} s (last runner)")
     return rows
 
@@ -108,8 +143,9 @@ def stats_markdown(rows: list[dict]) -> str:
     ]
     for r in rows:
         if "ks" not in r or r.get("ks") in (None, ""):
-            lines.append(f"| {r['gas']} | {r['packing']} | {r['dt']:g} | {r['family']} | | | | | | | "
-                         f"| {r.get('note', '')} |")
+            lines.append(
+                f"| {r['gas']} | {r['packing']} | {r['dt']:g} | {r['family']} | | | | | | | | {r.get('note', '')} |"
+            )
             continue
         lines.append(
             f"| {r['gas']} | {r['packing']:g} | {r['dt']:g} | {r['family']} | {r['tunnel_scale']:.2g} | {r['samples']} "

@@ -33,9 +33,11 @@ from .sweep import run_sweep
 def _meta_text(meta):
     v = meta["versions"]
     peers = ", ".join(f"{k} {v[k]}" for k in ("pymunk", "billiards") if v.get(k))
-    return (f"{meta['date']}, {meta['machine']}, {meta['cpus']} CPUs, Python {v['python']}, numpy {v['numpy']}, "
-            f"numba {v['numba']} (backend {v['backend']}){', ' + peers if peers else ''}; "
-            f"{meta['duration_s']:.0f} s")
+    return (
+        f"{meta['date']}, {meta['machine']}, {meta['cpus']} CPUs, Python {v['python']}, numpy {v['numpy']}, "
+        f"numba {v['numba']} (backend {v['backend']}){', ' + peers if peers else ''}; "
+        f"{meta['duration_s']:.0f} s"
+    )
 
 
 def _stderr(msg):
@@ -91,9 +93,17 @@ def main(argv=None):
                 report.write_csv(out / "envs.csv", env_rows, ENV_FIELDS)
         else:
             envs_note = env_rows = "left out (--skip envs)"
-        meta = {"quick": quick, "date": timestamp(), "machine": machine(), "cpus": cpus(),
-                "versions": versions(["numba", "pymunk", "billiards", "gymnasium", "matplotlib"]), "missing": missing,
-                "envs_note": envs_note, "budget": budget, "duration_s": time.perf_counter() - t0}
+        meta = {
+            "quick": quick,
+            "date": timestamp(),
+            "machine": machine(),
+            "cpus": cpus(),
+            "versions": versions(["numba", "pymunk", "billiards", "gymnasium", "matplotlib"]),
+            "missing": missing,
+            "envs_note": envs_note,
+            "budget": budget,
+            "duration_s": time.perf_counter() - t0,
+        }
         (out / "meta.json").write_text(json.dumps(meta, indent=1))
 
     meta_text = _meta_text(meta)

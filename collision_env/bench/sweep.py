@@ -41,12 +41,47 @@ REFERENCE_STEPS = 400
 COLLISIONS_PER_BALL = 5.0
 
 FIELDS = (
-    "scene", "n", "elasticity", "engine", "family", "mode", "substeps", "iterations", "dt", "h", "horizon", "steps",
+    "scene",
+    "n",
+    "elasticity",
+    "engine",
+    "family",
+    "mode",
+    "substeps",
+    "iterations",
+    "dt",
+    "h",
+    "horizon",
+    "steps",
     "status",
-    "wall_s", "wall_per_sim_s", "us_per_step", "ref_impacts", "impacts", "matched", "missed", "spurious",
-    "tunnelled_pairs", "t_err_median", "t_err_max", "p_err_median", "p_err_max", "escapes", "wall_penetration",
-    "ball_overlap", "energy_drift", "energy_err", "momentum_drift", "momentum_err", "pos_err", "vel_err",
-    "v_peak", "r_min", "tunnel_scale", "speed_dt_over_r", "cap_reached", "note",
+    "wall_s",
+    "wall_per_sim_s",
+    "us_per_step",
+    "ref_impacts",
+    "impacts",
+    "matched",
+    "missed",
+    "spurious",
+    "tunnelled_pairs",
+    "t_err_median",
+    "t_err_max",
+    "p_err_median",
+    "p_err_max",
+    "escapes",
+    "wall_penetration",
+    "ball_overlap",
+    "energy_drift",
+    "energy_err",
+    "momentum_drift",
+    "momentum_err",
+    "pos_err",
+    "vel_err",
+    "v_peak",
+    "r_min",
+    "tunnel_scale",
+    "speed_dt_over_r",
+    "cap_reached",
+    "note",
 )
 
 
@@ -146,8 +181,9 @@ def evaluate(ref: Reference, rec: Record, dt: float, substeps: int) -> dict:
     ref_ke = float(M.kinetic_energy(ref.record.velocities[-1], masses))
     ref_p = M.momentum(ref.record.velocities[-1], masses)
     v_scale = float(np.hypot(*case.velocities.T).max())
-    pos_err, vel_err = M.final_state_error(rec.positions[-1], rec.velocities[-1], ref.record.positions[-1],
-                                           ref.record.velocities[-1], case.radii, v_scale)
+    pos_err, vel_err = M.final_state_error(
+        rec.positions[-1], rec.velocities[-1], ref.record.positions[-1], ref.record.velocities[-1], case.radii, v_scale
+    )
     finite = bool(np.isfinite(rec.positions).all() and np.isfinite(rec.velocities).all())
     out.update(
         escapes=int(M.escapes(rec.positions, scene.bounds, scene.dimension).sum()),
@@ -184,12 +220,21 @@ def sweep_case(spec: SceneSpec, n: int, runners, dts, *, min_time: float, max_re
         steps = schedule(ref.horizon, dt)
         for runner in runners:
             base = {
-                "scene": spec.name, "n": n, "elasticity": case.scene.elasticity, "engine": runner.engine,
+                "scene": spec.name,
+                "n": n,
+                "elasticity": case.scene.elasticity,
+                "engine": runner.engine,
                 "family": runner.family,
-                "mode": getattr(runner, "mode", None) or "", "substeps": runner.substeps,
-                "iterations": runner.iterations if runner.iterations is not None else "", "dt": dt,
-                "h": dt / runner.substeps, "horizon": ref.horizon, "steps": len(steps), "v_peak": ref.v_peak,
-                "r_min": r_min, "tunnel_scale": ref.v_peak * dt / runner.substeps / r_min,
+                "mode": getattr(runner, "mode", None) or "",
+                "substeps": runner.substeps,
+                "iterations": runner.iterations if runner.iterations is not None else "",
+                "dt": dt,
+                "h": dt / runner.substeps,
+                "horizon": ref.horizon,
+                "steps": len(steps),
+                "v_peak": ref.v_peak,
+                "r_min": r_min,
+                "tunnel_scale": ref.v_peak * dt / runner.substeps / r_min,
                 "speed_dt_over_r": ref.v_peak * dt / r_min,
             }
             why = runner.unsupported(case)
@@ -203,8 +248,14 @@ def sweep_case(spec: SceneSpec, n: int, runners, dts, *, min_time: float, max_re
                 rows.append({**base, "status": "error", "note": f"{type(exc).__name__}: {exc}"})
                 log(traceback.format_exc())
                 continue
-            row = {**base, "status": "ok", "wall_s": wall, "wall_per_sim_s": wall / ref.horizon,
-                   "us_per_step": wall / len(steps) * 1e6, "note": _note(spec, rec)}
+            row = {
+                **base,
+                "status": "ok",
+                "wall_s": wall,
+                "wall_per_sim_s": wall / ref.horizon,
+                "us_per_step": wall / len(steps) * 1e6,
+                "note": _note(spec, rec),
+            }
             row.update(evaluate(ref, rec, dt, runner.substeps))
             rows.append(row)
     return rows
@@ -223,10 +274,20 @@ def cost_case(spec: SceneSpec, n: int, runners, *, min_time: float, max_repeats:
     steps = schedule(COST_HORIZON, COST_DT)
     rows = []
     for runner in runners:
-        base = {"scene": spec.name, "n": n, "elasticity": case.scene.elasticity, "engine": runner.engine,
-                "family": runner.family, "mode": getattr(runner, "mode", None) or "", "substeps": runner.substeps,
-                "iterations": runner.iterations if runner.iterations is not None else "", "dt": COST_DT,
-                "h": COST_DT / runner.substeps, "horizon": COST_HORIZON, "steps": len(steps)}
+        base = {
+            "scene": spec.name,
+            "n": n,
+            "elasticity": case.scene.elasticity,
+            "engine": runner.engine,
+            "family": runner.family,
+            "mode": getattr(runner, "mode", None) or "",
+            "substeps": runner.substeps,
+            "iterations": runner.iterations if runner.iterations is not None else "",
+            "dt": COST_DT,
+            "h": COST_DT / runner.substeps,
+            "horizon": COST_HORIZON,
+            "steps": len(steps),
+        }
         why = runner.unsupported(case)
         if why is None and runner.engine == "billiards" and n > ALL_PAIRS_PEER_MAX_BALLS:
             why = f"predicts all pairs at every event: minutes per run past {ALL_PAIRS_PEER_MAX_BALLS} balls"
@@ -234,8 +295,16 @@ def cost_case(spec: SceneSpec, n: int, runners, *, min_time: float, max_repeats:
             rows.append({**base, "status": "unsupported", "note": why})
             continue
         wall = timed_run(runner, case, steps, min_time, max_repeats)
-        rows.append({**base, "status": "timed", "wall_s": wall, "wall_per_sim_s": wall / COST_HORIZON,
-                     "us_per_step": wall / len(steps) * 1e6, "note": "cost only"})
+        rows.append(
+            {
+                **base,
+                "status": "timed",
+                "wall_s": wall,
+                "wall_per_sim_s": wall / COST_HORIZON,
+                "us_per_step": wall / len(steps) * 1e6,
+                "note": "cost only",
+            }
+        )
     return rows
 
 

@@ -49,8 +49,11 @@ def kernel_sources(package_dir: Path = PACKAGE_DIR) -> list[Path]:
     """The files the compiled kernels are made of: every module of the engine subpackage (kernels
     and the constants they freeze) and every other module of the package that defines a kernel."""
     engine = package_dir / "engine"
-    return sorted(path for path in package_dir.rglob("*.py")
-                  if path.is_relative_to(engine) or "njit" in path.read_text(encoding="utf-8"))
+    return sorted(
+        path
+        for path in package_dir.rglob("*.py")
+        if path.is_relative_to(engine) or "njit" in path.read_text(encoding="utf-8")
+    )
 
 
 def source_hash(package_dir: Path = PACKAGE_DIR) -> str:
@@ -192,7 +195,10 @@ def njit(func=None, **options):
         return func
     if not _in_package(func):
         return _numba.njit(cache=True, nogil=True, **options)(func)
-    dispatcher = _KernelDispatcher(py_func=func, locals=options.pop("locals", {}),
-                                   targetoptions={"nopython": True, "nogil": True, "boundscheck": None, **options})
+    dispatcher = _KernelDispatcher(
+        py_func=func,
+        locals=options.pop("locals", {}),
+        targetoptions={"nopython": True, "nogil": True, "boundscheck": None, **options},
+    )
     dispatcher.enable_caching()
     return dispatcher

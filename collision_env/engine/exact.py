@@ -104,9 +104,18 @@ _MAX_SWEEPS = 1000
 def scene_params(fparams, iparams):
     """The scene's parameters (``layout.SCENE_F`` and ``layout.SCENE_I``). Returns bounds, e, ratio,
     floor, sign, has_walls, pairs, dim, sticky, max_events."""
-    return (fparams[S_XMIN:S_YMAX + 1], fparams[S_ELASTICITY], fparams[S_COLLAPSE_RATIO],
-            fparams[S_COLLAPSE_FLOOR], fparams[S_SIGN], iparams[S_HAS_WALLS] != 0, iparams[S_PAIRS] != 0,
-            iparams[S_DIM], iparams[S_STICKY] != 0, iparams[S_MAX_EVENTS])
+    return (
+        fparams[S_XMIN : S_YMAX + 1],
+        fparams[S_ELASTICITY],
+        fparams[S_COLLAPSE_RATIO],
+        fparams[S_COLLAPSE_FLOOR],
+        fparams[S_SIGN],
+        iparams[S_HAS_WALLS] != 0,
+        iparams[S_PAIRS] != 0,
+        iparams[S_DIM],
+        iparams[S_STICKY] != 0,
+        iparams[S_MAX_EVENTS],
+    )
 
 
 @njit(inline="always")
@@ -173,8 +182,13 @@ def _predict_pair(i, k, now, horizon, pos, vel, mass, radius, body, omega, rot, 
             kj[q] = c[q]
         return now + ca_pair(ki, kj, radius[i] + radius[k], horizon)
     counters[PAIR_TESTS] += 1
-    return now + toi_pair(pos[k, 0] - pos[i, 0], pos[k, 1] - pos[i, 1], vel[k, 0] - vel[i, 0],
-                          vel[k, 1] - vel[i, 1], radius[i] + radius[k])
+    return now + toi_pair(
+        pos[k, 0] - pos[i, 0],
+        pos[k, 1] - pos[i, 1],
+        vel[k, 0] - vel[i, 0],
+        vel[k, 1] - vel[i, 1],
+        radius[i] + radius[k],
+    )
 
 
 @njit(inline="always")
@@ -219,8 +233,29 @@ def wall_contact(i, wall, pos, radius, bounds):
 
 @njit
 def _resolve_contact_group(
-    sc, t_abs, i0, j0, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, ratio, floor, imp, n_imp,
-    counters, group, in_group, c_a, c_b, c_hit,
+    sc,
+    t_abs,
+    i0,
+    j0,
+    pos,
+    vel,
+    inv_mass,
+    radius,
+    bounds,
+    has_walls,
+    pairs,
+    dim,
+    e,
+    ratio,
+    floor,
+    imp,
+    n_imp,
+    counters,
+    group,
+    in_group,
+    c_a,
+    c_b,
+    c_hit,
 ):
     """Resolve, at one instant, every contact of the group of touching balls an impact started.
 
@@ -297,8 +332,23 @@ def _resolve_contact_group(
             break
     if changed:
         _settle_contact_group(
-            sc, t_abs, pos, vel, inv_mass, radius, bounds, u_min, imp, n_imp, counters, group, size,
-            c_a, c_b, c_hit, n_contacts,
+            sc,
+            t_abs,
+            pos,
+            vel,
+            inv_mass,
+            radius,
+            bounds,
+            u_min,
+            imp,
+            n_imp,
+            counters,
+            group,
+            size,
+            c_a,
+            c_b,
+            c_hit,
+            n_contacts,
         )
     return size
 
@@ -341,7 +391,22 @@ def _record_contact(sc, t_abs, c, c_a, c_b, c_hit, pos, radius, bounds, speed, i
 
 @njit
 def _settle_contact_group(
-    sc, t_abs, pos, vel, inv_mass, radius, bounds, u_min, imp, n_imp, counters, group, size, c_a, c_b, c_hit,
+    sc,
+    t_abs,
+    pos,
+    vel,
+    inv_mass,
+    radius,
+    bounds,
+    u_min,
+    imp,
+    n_imp,
+    counters,
+    group,
+    size,
+    c_a,
+    c_b,
+    c_hit,
     n_contacts,
 ):
     """End a contact cascade that sequential impulses would need unboundedly many sweeps for.
@@ -517,8 +582,31 @@ def _wall_time(i, pos, vel, radius, bounds, dim, cf):
 
 # ---------------------------------------------------------------------------- predict
 @njit(inline="always")
-def _predict(i, now, horizon, rebuild, pos, vel, mass, radius, body, omega, rot, sticky, bounds, has_walls, pairs,
-             dim, geo, cf, ci, hp, ki, kj, counters):
+def _predict(
+    i,
+    now,
+    horizon,
+    rebuild,
+    pos,
+    vel,
+    mass,
+    radius,
+    body,
+    omega,
+    rot,
+    sticky,
+    bounds,
+    has_walls,
+    pairs,
+    dim,
+    geo,
+    cf,
+    ci,
+    hp,
+    ki,
+    kj,
+    counters,
+):
     """Find ball ``i``'s next event and schedule it.
 
     Looks at its wall, its partners in the 3 x 3 cells around it and its next cell crossing, from
@@ -539,8 +627,9 @@ def _predict(i, now, horizon, rebuild, pos, vel, mass, radius, body, omega, rot,
         best_stamp = 0
     if has_walls:
         if rot:  # (stick scenes keep every ball at ``now``)
-            t_wall, wall = _predict_wall(i, now, horizon, pos, vel, mass, radius, body, omega, rot, bounds, dim, ki,
-                                         counters)
+            t_wall, wall = _predict_wall(
+                i, now, horizon, pos, vel, mass, radius, body, omega, rot, bounds, dim, ki, counters
+            )
         else:
             counters[WALL_TESTS] += 1
             t_wall, wall = _wall_time(i, pos, vel, radius, bounds, dim, cf)
@@ -557,8 +646,9 @@ def _predict(i, now, horizon, rebuild, pos, vel, mass, radius, body, omega, rot,
                 while 0 <= k < n:
                     if k != i and (k > i or not rebuild):
                         if rot:
-                            t = _predict_pair(i, k, now, horizon, pos, vel, mass, radius, body, omega, rot, ki, kj,
-                                              counters)
+                            t = _predict_pair(
+                                i, k, now, horizon, pos, vel, mass, radius, body, omega, rot, ki, kj, counters
+                            )
                         elif body[i] == body[k]:
                             t = INF
                         else:
@@ -572,8 +662,9 @@ def _predict(i, now, horizon, rebuild, pos, vel, mass, radius, body, omega, rot,
                             cal.offer_pair(k, t, i, n, not rebuild, cf, ci, hp)
                     k = k + 1 if one_cell else ci[k, C_CELL_NEXT]
         if nx * ny > 1:
-            tau, direction = grid.crossing(pos[i, 0], pos[i, 1], vel[i, 0], vel[i, 1], ci[i, C_CELL], x0, y0,
-                                           hx, hy, nx, ny)
+            tau, direction = grid.crossing(
+                pos[i, 0], pos[i, 1], vel[i, 0], vel[i, 1], ci[i, C_CELL], x0, y0, hx, hy, nx, ny
+            )
             tau += cf[i, C_REF_TIME]
             if direction >= 0 and cal.earlier(tau, cal.EV_CROSS - direction, best_t, best_code, i):
                 best_t = tau
@@ -600,8 +691,12 @@ def _begin_whole_scene(pos, cf, ci, geo, pending):
 
 @njit(inline="always")
 def _changed_since_last_step(i, pos, vel, cf):
-    return (pos[i, 0] != cf[i, C_SEEN_X] or pos[i, 1] != cf[i, C_SEEN_Y] or vel[i, 0] != cf[i, C_SEEN_VX]
-            or vel[i, 1] != cf[i, C_SEEN_VY])
+    return (
+        pos[i, 0] != cf[i, C_SEEN_X]
+        or pos[i, 1] != cf[i, C_SEEN_Y]
+        or vel[i, 0] != cf[i, C_SEEN_VX]
+        or vel[i, 1] != cf[i, C_SEEN_VY]
+    )
 
 
 @njit(inline="always")
@@ -656,8 +751,35 @@ def _finish(t_end, pos, vel, mass, body, omega, rot, sticky, cf, ci, hp):
 
 # ---------------------------------------------------------------------------- resolve
 @njit(inline="always")
-def _resolve_wall(sc, t_abs, bi, wall, pos, vel, inv_mass, radius, body, omega, bounds, has_walls, pairs, dim, e,
-                  ratio, floor, sticky, cascades, imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit):
+def _resolve_wall(
+    sc,
+    t_abs,
+    bi,
+    wall,
+    pos,
+    vel,
+    inv_mass,
+    radius,
+    body,
+    omega,
+    bounds,
+    has_walls,
+    pairs,
+    dim,
+    e,
+    ratio,
+    floor,
+    sticky,
+    cascades,
+    imp,
+    n_imp,
+    counters,
+    involved,
+    in_group,
+    c_a,
+    c_b,
+    c_hit,
+):
     """Ball ``bi`` meets ``wall``. Returns how many balls' motion it changed (listed in ``involved``)."""
     n = pos.shape[0]
     n_inv = 0
@@ -689,15 +811,64 @@ def _resolve_wall(sc, t_abs, bi, wall, pos, vel, inv_mass, radius, body, omega, 
     n_inv = 1
     if cascades and speed > 0.0:
         n_inv = _resolve_contact_group(
-            sc, t_abs, bi, -1 - wall, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, ratio, floor,
-            imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit,
+            sc,
+            t_abs,
+            bi,
+            -1 - wall,
+            pos,
+            vel,
+            inv_mass,
+            radius,
+            bounds,
+            has_walls,
+            pairs,
+            dim,
+            e,
+            ratio,
+            floor,
+            imp,
+            n_imp,
+            counters,
+            involved,
+            in_group,
+            c_a,
+            c_b,
+            c_hit,
         )
     return n_inv
 
 
 @njit(inline="always")
-def _resolve_pair(sc, t_abs, bi, bj, pos, vel, mass, inv_mass, radius, body, omega, bounds, has_walls, pairs, dim, e,
-                  ratio, floor, sticky, cascades, imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit):
+def _resolve_pair(
+    sc,
+    t_abs,
+    bi,
+    bj,
+    pos,
+    vel,
+    mass,
+    inv_mass,
+    radius,
+    body,
+    omega,
+    bounds,
+    has_walls,
+    pairs,
+    dim,
+    e,
+    ratio,
+    floor,
+    sticky,
+    cascades,
+    imp,
+    n_imp,
+    counters,
+    involved,
+    in_group,
+    c_a,
+    c_b,
+    c_hit,
+):
     """Balls ``bi`` and ``bj`` meet. Returns how many balls' motion it changed (in ``involved``)."""
     n = pos.shape[0]
     n_inv = 0
@@ -731,16 +902,56 @@ def _resolve_pair(sc, t_abs, bi, bj, pos, vel, mass, inv_mass, radius, body, ome
     n_inv = 2
     if cascades and speed > 0.0:
         n_inv = _resolve_contact_group(
-            sc, t_abs, bi, bj, pos, vel, inv_mass, radius, bounds, has_walls, pairs, dim, e, ratio, floor,
-            imp, n_imp, counters, involved, in_group, c_a, c_b, c_hit,
+            sc,
+            t_abs,
+            bi,
+            bj,
+            pos,
+            vel,
+            inv_mass,
+            radius,
+            bounds,
+            has_walls,
+            pairs,
+            dim,
+            e,
+            ratio,
+            floor,
+            imp,
+            n_imp,
+            counters,
+            involved,
+            in_group,
+            c_a,
+            c_b,
+            c_hit,
         )
     return n_inv
 
 
 # ---------------------------------------------------------------------------- the scheduler
 @njit
-def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, counters, work_f, work_i, cal_f, cal_i,
-               cal_heap, scratch_f, scratch_i, scratch_b, dt_abs, fresh):
+def step_exact(
+    balls,
+    body_all,
+    time,
+    capped,
+    fparams,
+    iparams,
+    imp,
+    n_imp,
+    counters,
+    work_f,
+    work_i,
+    cal_f,
+    cal_i,
+    cal_heap,
+    scratch_f,
+    scratch_i,
+    scratch_b,
+    dt_abs,
+    fresh,
+):
     """Advance every active scene of the batch by its remaining time (see module doc).
 
     ``balls`` is the (B, N, 8) per-ball state (``layout.BALL``), ``body_all`` the (B, N) cluster
@@ -766,10 +977,10 @@ def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, coun
     ki = scratch_f[0:7]
     kj = scratch_f[7:14]
     pending = scratch_i[0:n]  # balls to predict
-    c_a = scratch_i[n:n + nc]
-    c_b = scratch_i[n + nc:n + 2 * nc]
+    c_a = scratch_i[n : n + nc]
+    c_b = scratch_i[n + nc : n + 2 * nc]
     in_group = scratch_b[0:n]
-    c_hit = scratch_b[n:n + nc]
+    c_hit = scratch_b[n : n + nc]
     bounds, e, ratio, floor, sign, has_walls, pairs, dim, sticky, max_events = scene_params(fparams, iparams)
     cascades = e < 1.0  # forward inelastic: resolve touching groups at one instant
     room = impacts_per_event(n, cascades)
@@ -795,8 +1006,14 @@ def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, coun
         cf = cal_f[sc]
         ci = cal_i[sc]
         hp = cal_heap[sc]
-        geo = (work_f[sc, W_GRID_X0], work_f[sc, W_GRID_Y0], work_f[sc, W_GRID_HX], work_f[sc, W_GRID_HY],
-               work_i[sc, W_GRID_NX], work_i[sc, W_GRID_NY])
+        geo = (
+            work_f[sc, W_GRID_X0],
+            work_f[sc, W_GRID_Y0],
+            work_f[sc, W_GRID_HX],
+            work_f[sc, W_GRID_HY],
+            work_i[sc, W_GRID_NX],
+            work_i[sc, W_GRID_NY],
+        )
         nx = geo[4]
         horizon_end = work_f[sc, W_REMAINING]
         t0 = time[sc]
@@ -816,8 +1033,31 @@ def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, coun
         while True:
             # predict (the one place where predictions are made: what begin or the last event listed)
             for q in range(n_pending):
-                _predict(pending[q], now, horizon_end - now, whole, pos, vel, mass, radius, body, omega, rot, sticky,
-                         bounds, has_walls, pairs, dim, geo, cf, ci, hp, ki, kj, counters)
+                _predict(
+                    pending[q],
+                    now,
+                    horizon_end - now,
+                    whole,
+                    pos,
+                    vel,
+                    mass,
+                    radius,
+                    body,
+                    omega,
+                    rot,
+                    sticky,
+                    bounds,
+                    has_walls,
+                    pairs,
+                    dim,
+                    geo,
+                    cf,
+                    ci,
+                    hp,
+                    ki,
+                    kj,
+                    counters,
+                )
             if whole:
                 cal.reset_heap(n, cf, ci, hp)
                 work_i[sc, W_CALENDAR_VALID] = True
@@ -879,13 +1119,66 @@ def step_exact(balls, body_all, time, capped, fparams, iparams, imp, n_imp, coun
             t_abs = t0 + sign * now
             # resolve: the balls whose motion changed are listed in ``pending``
             if bj < 0:
-                n_pending = _resolve_wall(sc, t_abs, bi, cal.EV_WALL - code, pos, vel, inv_mass, radius, body, omega,
-                                          bounds, has_walls, pairs, dim, e, ratio, floor, sticky, cascades, imp,
-                                          n_imp, counters, pending, in_group, c_a, c_b, c_hit)
+                n_pending = _resolve_wall(
+                    sc,
+                    t_abs,
+                    bi,
+                    cal.EV_WALL - code,
+                    pos,
+                    vel,
+                    inv_mass,
+                    radius,
+                    body,
+                    omega,
+                    bounds,
+                    has_walls,
+                    pairs,
+                    dim,
+                    e,
+                    ratio,
+                    floor,
+                    sticky,
+                    cascades,
+                    imp,
+                    n_imp,
+                    counters,
+                    pending,
+                    in_group,
+                    c_a,
+                    c_b,
+                    c_hit,
+                )
             else:
-                n_pending = _resolve_pair(sc, t_abs, bi, bj, pos, vel, mass, inv_mass, radius, body, omega, bounds,
-                                          has_walls, pairs, dim, e, ratio, floor, sticky, cascades, imp, n_imp,
-                                          counters, pending, in_group, c_a, c_b, c_hit)
+                n_pending = _resolve_pair(
+                    sc,
+                    t_abs,
+                    bi,
+                    bj,
+                    pos,
+                    vel,
+                    mass,
+                    inv_mass,
+                    radius,
+                    body,
+                    omega,
+                    bounds,
+                    has_walls,
+                    pairs,
+                    dim,
+                    e,
+                    ratio,
+                    floor,
+                    sticky,
+                    cascades,
+                    imp,
+                    n_imp,
+                    counters,
+                    pending,
+                    in_group,
+                    c_a,
+                    c_b,
+                    c_hit,
+                )
             if sticky:
                 rot = has_rotation(body, omega)
             # invalidate: events that other balls hold with these become stale through the change

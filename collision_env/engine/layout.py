@@ -72,5 +72,13 @@ WORK_I = ("events", "active", "stalled", "substeps_done", "calendar_valid", "gri
 W_EVENTS, W_ACTIVE, W_STALLED, W_SUBSTEPS_DONE, W_CALENDAR_VALID, W_GRID_NX, W_GRID_NY = range(7)
 
 #: Every packed layout, by name (for documentation and the layout test).
-LAYOUTS = {"BALL": BALL, "CAL_F": CAL_F, "CAL_I": CAL_I, "HEAP": HEAP, "SCENE_F": SCENE_F, "SCENE_I": SCENE_I,
-           "WORK_F": WORK_F, "WORK_I": WORK_I}
+LAYOUTS = {
+    "BALL": BALL,
+    "CAL_F": CAL_F,
+    "CAL_I": CAL_I,
+    "HEAP": HEAP,
+    "SCENE_F": SCENE_F,
+    "SCENE_I": SCENE_I,
+    "WORK_F": WORK_F,
+    "WORK_I": WORK_I,
+}

@@ -28,8 +28,14 @@ BALL_FIELDS = len(BALL)
 @njit(inline="always")
 def ball_views(balls):
     """The per-ball state as views: pos, vel (B, N, 2), mass, inv_mass, radius, omega (B, N)."""
-    return (balls[:, :, B_X:B_X + 2], balls[:, :, B_VX:B_VX + 2], balls[:, :, B_MASS], balls[:, :, B_INV_MASS],
-            balls[:, :, B_RADIUS], balls[:, :, B_OMEGA])
+    return (
+        balls[:, :, B_X : B_X + 2],
+        balls[:, :, B_VX : B_VX + 2],
+        balls[:, :, B_MASS],
+        balls[:, :, B_INV_MASS],
+        balls[:, :, B_RADIUS],
+        balls[:, :, B_OMEGA],
+    )
 
 
 @njit

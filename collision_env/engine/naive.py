@@ -78,8 +78,28 @@ def contain(sc, t_abs, pos, vel, radius, body, omega, bounds, dim, e, u_min, sti
 
 
 @njit(inline="always")
-def resolve_naive(sc, t_abs, pos, vel, mass, inv_mass, radius, body, omega, bounds, dim, e, u_min,
-                  has_walls, pairs, sticky, imp, n_imp, counters, cells):
+def resolve_naive(
+    sc,
+    t_abs,
+    pos,
+    vel,
+    mass,
+    inv_mass,
+    radius,
+    body,
+    omega,
+    bounds,
+    dim,
+    e,
+    u_min,
+    has_walls,
+    pairs,
+    sticky,
+    imp,
+    n_imp,
+    counters,
+    cells,
+):
     """Resolve the overlaps at the end of a sub-step; ``cells`` is the sub-step's broad phase
     (``substep.cell_lists``): pairs come from it in index order."""
     n = pos.shape[0]

@@ -70,8 +70,30 @@ def overlap_time_border(x, y, vx, vy, r, bounds, dim):
 
 
 @njit(inline="always")
-def resolve_posteriori(sc, t_end, sign, h, pos, vel, mass, inv_mass, radius, body, omega, bounds, dim, e, u_min,
-                       has_walls, pairs, sticky, imp, n_imp, counters, cells):
+def resolve_posteriori(
+    sc,
+    t_end,
+    sign,
+    h,
+    pos,
+    vel,
+    mass,
+    inv_mass,
+    radius,
+    body,
+    omega,
+    bounds,
+    dim,
+    e,
+    u_min,
+    has_walls,
+    pairs,
+    sticky,
+    imp,
+    n_imp,
+    counters,
+    cells,
+):
     """Reconstruct and resolve the collisions of a sub-step; ``cells`` is the sub-step's broad
     phase (``substep.cell_lists``): pairs come from it in index order."""
     n = pos.shape[0]

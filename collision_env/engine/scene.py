@@ -77,8 +77,11 @@ class Scene:
     ball_collisions: bool = True
 
     def __post_init__(self) -> None:
-        if isinstance(self.dimension, (bool, np.bool_)) or not isinstance(self.dimension, numbers.Integral) \
-                or self.dimension not in (1, 2):
+        if (
+            isinstance(self.dimension, (bool, np.bool_))
+            or not isinstance(self.dimension, numbers.Integral)
+            or self.dimension not in (1, 2)
+        ):
             raise ValueError(f"scene dimension: must be 1 or 2 (an integer, not a boolean), got {self.dimension!r}")
         object.__setattr__(self, "dimension", int(self.dimension))
         if self.bounds is not None:

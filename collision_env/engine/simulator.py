@@ -136,8 +136,9 @@ def _real_number(value, field):
     if isinstance(value, np.ndarray) and value.ndim == 0:
         value = value[()]
     if not _is_real(value):
-        raise ValueError(f"{field}: expected a number (real, not a boolean or a string), got {value!r} "
-                         f"({type(value).__name__})")
+        raise ValueError(
+            f"{field}: expected a number (real, not a boolean or a string), got {value!r} ({type(value).__name__})"
+        )
     return float(value)
 
 
@@ -150,13 +151,16 @@ def _real_array(value, shapes, field, where):
         try:
             obj = np.array(value, dtype=object)
         except ValueError:
-            raise ValueError(f"{field}: expected real numbers of shape {' or '.join(map(str, shapes))}, "
-                             f"got a ragged sequence") from None
+            raise ValueError(
+                f"{field}: expected real numbers of shape {' or '.join(map(str, shapes))}, got a ragged sequence"
+            ) from None
         if obj.shape in shapes:
             for index, x in np.ndenumerate(obj):
                 if not _is_real(x):
-                    raise ValueError(f"{where(index)}{field} must be real numbers (not booleans, strings or complex), "
-                                     f"got {x!r} ({type(x).__name__})")
+                    raise ValueError(
+                        f"{where(index)}{field} must be real numbers (not booleans, strings or complex), "
+                        f"got {x!r} ({type(x).__name__})"
+                    )
         arr = obj.astype(np.float64) if obj.shape in shapes else obj
     if arr.shape not in shapes:
         raise ValueError(f"{field}: expected shape {' or '.join(map(str, shapes))}, got {arr.shape}")
@@ -221,9 +225,20 @@ class BatchSimulator:
     naming the field and the ball, and changes nothing.
     """
 
-    def __init__(self, scene: Scene, positions: ArrayLike, velocities: ArrayLike, masses: ArrayLike,
-                 radii: ArrayLike | str | None = None, *, mode: str = "exact", substeps: int = 1,
-                 max_events: int = 10_000, collapse_ratio: float = 1e-9, collapse_floor: float = 0.0) -> None:
+    def __init__(
+        self,
+        scene: Scene,
+        positions: ArrayLike,
+        velocities: ArrayLike,
+        masses: ArrayLike,
+        radii: ArrayLike | str | None = None,
+        *,
+        mode: str = "exact",
+        substeps: int = 1,
+        max_events: int = 10_000,
+        collapse_ratio: float = 1e-9,
+        collapse_floor: float = 0.0,
+    ) -> None:
         if not isinstance(scene, Scene):
             raise ValueError(f"scene: expected a collision_env.engine.Scene, got {type(scene).__name__}")
         if not (isinstance(mode, str) and mode in MODES):
@@ -274,10 +289,20 @@ class BatchSimulator:
         self._counters = np.zeros(len(COUNTERS), dtype=np.int64)
 
         bounds = scene.bounds if scene.bounds is not None else (0.0, 0.0, 0.0, 0.0)
-        scene_f = dict(zip(("xmin", "ymin", "xmax", "ymax"), bounds, strict=True), elasticity=scene.elasticity,
-                       collapse_ratio=self.collapse_ratio, sign=1.0, collapse_floor=self.collapse_floor)
-        scene_i = dict(has_walls=scene.bounds is not None, pairs=scene.ball_collisions and n > 1,
-                       dim=scene.dimension, sticky=scene.sticky, max_events=self.max_events)
+        scene_f = dict(
+            zip(("xmin", "ymin", "xmax", "ymax"), bounds, strict=True),
+            elasticity=scene.elasticity,
+            collapse_ratio=self.collapse_ratio,
+            sign=1.0,
+            collapse_floor=self.collapse_floor,
+        )
+        scene_i = dict(
+            has_walls=scene.bounds is not None,
+            pairs=scene.ball_collisions and n > 1,
+            dim=scene.dimension,
+            sticky=scene.sticky,
+            max_events=self.max_events,
+        )
         self._fparams = np.array([scene_f[name] for name in SCENE_F])
         self._iparams = np.array([scene_i[name] for name in SCENE_I], dtype=np.int64)
         self._work_f = np.zeros((n_scenes, len(WORK_F)))
@@ -324,42 +349,65 @@ class BatchSimulator:
         big = _MAX_MAGNITUDE
         with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
             speed = np.hypot(vel[..., 0], vel[..., 1])
-            fail(~(np.abs(pos) <= big).all(-1),
-                 lambda s, i: f"position must be finite, within {big:g} m, got {tuple(pos[s, i])}")
-            fail(~(np.abs(vel) <= big).all(-1) | ~(speed <= big),
-                 lambda s, i: f"velocity must be finite, speed within {big:g} m/s, got {tuple(vel[s, i])}")
-            fail(~(np.isfinite(m) & (m > 0) & np.isfinite(1.0 / m)),
-                 lambda s, i: f"mass must be positive and finite, with a finite inverse, got {m[s, i]}")
-            fail(~np.isfinite(0.5 * m * speed * speed),
-                 lambda s, i: f"velocity {tuple(vel[s, i])} gives mass {m[s, i]} a kinetic energy beyond float64")
-        fail(~(np.isfinite(r) & (r > 0) & (r <= big)),
-             lambda s, i: f"radius must be positive and finite, got {r[s, i]}")
+            fail(
+                ~(np.abs(pos) <= big).all(-1),
+                lambda s, i: f"position must be finite, within {big:g} m, got {tuple(pos[s, i])}",
+            )
+            fail(
+                ~(np.abs(vel) <= big).all(-1) | ~(speed <= big),
+                lambda s, i: f"velocity must be finite, speed within {big:g} m/s, got {tuple(vel[s, i])}",
+            )
+            fail(
+                ~(np.isfinite(m) & (m > 0) & np.isfinite(1.0 / m)),
+                lambda s, i: f"mass must be positive and finite, with a finite inverse, got {m[s, i]}",
+            )
+            fail(
+                ~np.isfinite(0.5 * m * speed * speed),
+                lambda s, i: f"velocity {tuple(vel[s, i])} gives mass {m[s, i]} a kinetic energy beyond float64",
+            )
+        fail(
+            ~(np.isfinite(r) & (r > 0) & (r <= big)), lambda s, i: f"radius must be positive and finite, got {r[s, i]}"
+        )
         scene = self.scene
         # the coordinates' magnitude in each scene: the border, or the balls' own extent
         extent = np.max(np.abs(pos) + r[..., None], axis=(1, 2))
         if scene.bounds is not None:
             extent = np.maximum(extent, max(abs(v) for v in scene.bounds))
         smallest = _MIN_RADIUS_ULPS * EPS * extent
-        fail(r < smallest[:, None], lambda s, i: f"radius {r[s, i]:.6g} m is too small for float64 to resolve its "
-                                                 f"contacts at coordinates of {extent[s]:.6g} m "
-                                                 f"(at least {smallest[s]:.3g} m)")
+        fail(
+            r < smallest[:, None],
+            lambda s, i: (
+                f"radius {r[s, i]:.6g} m is too small for float64 to resolve its "
+                f"contacts at coordinates of {extent[s]:.6g} m "
+                f"(at least {smallest[s]:.3g} m)"
+            ),
+        )
         if scene.dimension == 1:
             fail(pos[..., 1] != 0.0, lambda s, i: f"position y must be 0 in a 1D scene, got {pos[s, i, 1]}")
             fail(vel[..., 1] != 0.0, lambda s, i: f"velocity y must be 0 in a 1D scene, got {vel[s, i, 1]}")
         if scene.bounds is not None:
             xmin, ymin, xmax, ymax = scene.bounds
             # a ball needs room to move across the box: more than the contact tolerance of the walls
-            for lo, hi, name in ((xmin, xmax, "width"), (ymin, ymax, "height"))[:scene.dimension]:
+            for lo, hi, name in ((xmin, xmax, "width"), (ymin, ymax, "height"))[: scene.dimension]:
                 room = (hi - lo) - 2.0 * r
-                fail(room <= CONTACT_RTOL * 2.0 * r + roundoff(extent[:, None]),
-                     lambda s, i, size=hi - lo, name=name: f"radius {r[s, i]:.6g} m leaves no room to move: its "
-                                                            f"diameter is the box {name} {size:.6g} m or more")
+                fail(
+                    room <= CONTACT_RTOL * 2.0 * r + roundoff(extent[:, None]),
+                    lambda s, i, size=hi - lo, name=name: (
+                        f"radius {r[s, i]:.6g} m leaves no room to move: its "
+                        f"diameter is the box {name} {size:.6g} m or more"
+                    ),
+                )
             tol = _CONTACT_RTOL * r + roundoff(np.abs(pos).max(-1))
             out = (pos[..., 0] - r < xmin - tol) | (pos[..., 0] + r > xmax + tol)
             if scene.dimension == 2:
                 out |= (pos[..., 1] - r < ymin - tol) | (pos[..., 1] + r > ymax + tol)
-            fail(out, lambda s, i: f"position must keep the ball inside the reflecting border {scene.bounds}, "
-                                   f"got {tuple(pos[s, i])} with radius {r[s, i]:.6g}")
+            fail(
+                out,
+                lambda s, i: (
+                    f"position must keep the ball inside the reflecting border {scene.bounds}, "
+                    f"got {tuple(pos[s, i])} with radius {r[s, i]:.6g}"
+                ),
+            )
         if scene.ball_collisions and n > 1:
             for s_ in range(k):
                 i, j = first_overlap(pos[s_], r[s_], _CONTACT_RTOL)
@@ -374,8 +422,8 @@ class BatchSimulator:
     # ------------------------------------------------------------------ stepping
     def _bind_views(self):
         b = self._balls
-        self._pos = b[..., B_X:B_X + 2]
-        self._vel = b[..., B_VX:B_VX + 2]
+        self._pos = b[..., B_X : B_X + 2]
+        self._vel = b[..., B_VX : B_VX + 2]
         self._mass = b[..., B_MASS]
         self._inv_mass = b[..., B_INV_MASS]
         self._radius = b[..., B_RADIUS]
@@ -385,10 +433,11 @@ class BatchSimulator:
         """Drop the calendar's predictions for ``scenes`` (they are made afresh at the next step)
         and lay out their grid for the balls they now hold."""
         reach = 1.0 if self.mode == "exact" else 2.0
-        origin_and_cells, counts = grid_geometry(self.scene.bounds, self._pos[scenes], self._radius[scenes],
-                                                 self._uses_grid(), reach)
-        self._work_f[scenes, W_GRID_X0:W_GRID_X0 + 4] = origin_and_cells
-        self._work_i[scenes, W_GRID_NX:W_GRID_NX + 2] = counts
+        origin_and_cells, counts = grid_geometry(
+            self.scene.bounds, self._pos[scenes], self._radius[scenes], self._uses_grid(), reach
+        )
+        self._work_f[scenes, W_GRID_X0 : W_GRID_X0 + 4] = origin_and_cells
+        self._work_i[scenes, W_GRID_NX : W_GRID_NX + 2] = counts
         self._work_i[scenes, W_CALENDAR_VALID] = 0
 
     def _uses_grid(self):
@@ -405,8 +454,19 @@ class BatchSimulator:
         self._imp = np.empty(rows, dtype=IMPACT_DTYPE)
         self._n_imp = np.zeros(2, dtype=np.int64)  # rows filled, scenes that reached the cap
         # the mode's kernel and its arguments, bound once (the arrays are only ever updated in place)
-        state = (self._balls, self._body, self._time, self._capped, self._fparams, self._iparams, self._imp,
-                 self._n_imp, self._counters, self._work_f, self._work_i)
+        state = (
+            self._balls,
+            self._body,
+            self._time,
+            self._capped,
+            self._fparams,
+            self._iparams,
+            self._imp,
+            self._n_imp,
+            self._counters,
+            self._work_f,
+            self._work_i,
+        )
         if self.mode == "exact":
             nf, ni, nb = scratch_sizes(self._n)
             self._kernel = step_exact
@@ -414,11 +474,15 @@ class BatchSimulator:
             self._kernel_args = state + (self._cal_f, self._cal_i, self._cal_heap) + scratch
         else:
             self._kernel = step_substeps
-            self._kernel_args = ((NAIVE if self.mode == "naive" else POSTERIORI, self.substeps) + state
-                                 + (np.empty(substep_scratch_size(self._n), dtype=np.int64),))
+            self._kernel_args = (
+                (NAIVE if self.mode == "naive" else POSTERIORI, self.substeps)
+                + state
+                + (np.empty(substep_scratch_size(self._n), dtype=np.int64),)
+            )
         self._sign = float(self._fparams[S_SIGN])  # the direction _fparams are set for (see step)
-        self._live = LiveArrays(self._balls, self._pos, self._vel, self._mass, self._radius, self._time, self._body,
-                                self._capped)
+        self._live = LiveArrays(
+            self._balls, self._pos, self._vel, self._mass, self._radius, self._time, self._body, self._capped
+        )
 
     def step(self, dt: float) -> np.ndarray:
         """Advance every scene by ``dt`` seconds (``dt < 0`` runs time backwards).
@@ -438,8 +502,9 @@ class BatchSimulator:
             self._check_reach(dt)
         e = self.scene.elasticity
         if dt < 0.0 and e == 0.0:
-            raise ValueError("dt: cannot step backwards with elasticity 0 "
-                             "(a perfectly inelastic collision has no inverse)")
+            raise ValueError(
+                "dt: cannot step backwards with elasticity 0 (a perfectly inelastic collision has no inverse)"
+            )
         if dt == 0.0:
             self._capped[:] = False
             return np.zeros(0, dtype=IMPACT_DTYPE)
@@ -473,8 +538,10 @@ class BatchSimulator:
         reach = np.abs(self._pos).max(-1) + np.hypot(self._vel[..., 0], self._vel[..., 1]) * abs(dt)
         if not (reach <= _MAX_MAGNITUDE).all():
             s, i = np.argwhere(~(reach <= _MAX_MAGNITUDE))[0]
-            raise ValueError(f"dt: a step of {dt:g} s would take {self._label(s, i).rstrip(': ')} beyond "
-                             f"{_MAX_MAGNITUDE:g} m (no border), where positions are no longer representable")
+            raise ValueError(
+                f"dt: a step of {dt:g} s would take {self._label(s, i).rstrip(': ')} beyond "
+                f"{_MAX_MAGNITUDE:g} m (no border), where positions are no longer representable"
+            )
 
     def _run(self, dt_abs):
         chunks = []
@@ -600,8 +667,9 @@ class BatchSimulator:
             # one cheap test on the common path; find the culprit only when there is one
             if not (np.abs(dv) <= _MAX_MAGNITUDE).all():
                 s, i = np.argwhere(~(np.abs(dv) <= _MAX_MAGNITUDE).all(-1))[0]
-                raise ValueError(f"{self._label(s, i)}nudge must be finite, within {_MAX_MAGNITUDE:g} m/s, "
-                                 f"got {tuple(dv[s, i])}")
+                raise ValueError(
+                    f"{self._label(s, i)}nudge must be finite, within {_MAX_MAGNITUDE:g} m/s, got {tuple(dv[s, i])}"
+                )
             if self.scene.dimension == 1 and dv[..., 1].any():
                 s, i = np.argwhere(dv[..., 1] != 0.0)[0]
                 raise ValueError(f"{self._label(s, i)}nudge y must be 0 in a 1D scene, got {dv[s, i, 1]}")
@@ -620,11 +688,20 @@ class BatchSimulator:
             bad = ~(limit <= _MAX_MAGNITUDE / 2) | ~np.isfinite(self._mass * limit * limit)
         if bad.any():
             s, i = np.argwhere(bad)[0]
-            raise ValueError(f"{self._label(s, i)}nudge {tuple(dv[s, i])} would give a speed beyond the representable "
-                             f"range (speeds up to {_MAX_MAGNITUDE:g} m/s, finite kinetic energy)")
+            raise ValueError(
+                f"{self._label(s, i)}nudge {tuple(dv[s, i])} would give a speed beyond the representable "
+                f"range (speeds up to {_MAX_MAGNITUDE:g} m/s, finite kinetic energy)"
+            )
 
-    def set_scenes(self, index: ArrayLike, positions: ArrayLike, velocities: ArrayLike, masses: ArrayLike | None = None,
-                   radii: ArrayLike | str | None = None, time: ArrayLike = 0.0) -> None:
+    def set_scenes(
+        self,
+        index: ArrayLike,
+        positions: ArrayLike,
+        velocities: ArrayLike,
+        masses: ArrayLike | None = None,
+        radii: ArrayLike | str | None = None,
+        time: ArrayLike = 0.0,
+    ) -> None:
         """Start the scenes picked by ``index`` (indices or a ``(B,)`` bool mask) afresh.
 
         ``positions``/``velocities`` are ``(K, N, 2)`` for the K scenes picked; ``masses`` and
@@ -668,9 +745,16 @@ class BatchSimulator:
     def set_state(self, state: Mapping[str, ArrayLike]) -> None:
         """Restore a state from :meth:`get_state` (shapes, number types and finiteness are checked;
         the physics of the values is trusted)."""
-        shapes = {"positions": self._pos.shape, "velocities": self._vel.shape, "masses": self._mass.shape,
-                  "radii": self._radius.shape, "clusters": self._body.shape, "omega": self._omega.shape,
-                  "time": self._time.shape, "time_compensation": self._time.shape}
+        shapes = {
+            "positions": self._pos.shape,
+            "velocities": self._vel.shape,
+            "masses": self._mass.shape,
+            "radii": self._radius.shape,
+            "clusters": self._body.shape,
+            "omega": self._omega.shape,
+            "time": self._time.shape,
+            "time_compensation": self._time.shape,
+        }
         arrays = {}
         for key, shape in shapes.items():
             if key not in state:
@@ -680,8 +764,9 @@ class BatchSimulator:
                 raise ValueError(f"state {key}: expected shape {shape}, got {a.shape}")
             kinds = "iu" if key == "clusters" else "iuf"
             if a.dtype.kind not in kinds:
-                raise ValueError(f"state {key}: expected {'integers' if key == 'clusters' else 'real numbers'}, "
-                                f"got dtype {a.dtype}")
+                raise ValueError(
+                    f"state {key}: expected {'integers' if key == 'clusters' else 'real numbers'}, got dtype {a.dtype}"
+                )
             if not np.isfinite(a).all():
                 raise ValueError(f"state {key}: values must be finite")
             arrays[key] = a
@@ -703,8 +788,20 @@ class BatchSimulator:
 
     def __getstate__(self):
         state = self.__dict__.copy()
-        for key in ("_imp", "_n_imp", "_kernel", "_kernel_args", "_sign", "_live",
-                    "_pos", "_vel", "_mass", "_inv_mass", "_radius", "_omega"):
+        for key in (
+            "_imp",
+            "_n_imp",
+            "_kernel",
+            "_kernel_args",
+            "_sign",
+            "_live",
+            "_pos",
+            "_vel",
+            "_mass",
+            "_inv_mass",
+            "_radius",
+            "_omega",
+        ):
             state.pop(key)
         return state
 
@@ -730,8 +827,17 @@ class Simulator:
     batch of one over :class:`BatchSimulator`; keyword arguments pass through to it.
     """
 
-    def __init__(self, scene: Scene, positions: ArrayLike, velocities: ArrayLike, masses: ArrayLike,
-                 radii: ArrayLike | str | None = None, mode: str = "exact", substeps: int = 1, **options: Any) -> None:
+    def __init__(
+        self,
+        scene: Scene,
+        positions: ArrayLike,
+        velocities: ArrayLike,
+        masses: ArrayLike,
+        radii: ArrayLike | str | None = None,
+        mode: str = "exact",
+        substeps: int = 1,
+        **options: Any,
+    ) -> None:
         try:
             shape = np.shape(positions)
         except ValueError:  # numpy refuses ragged nesting
@@ -739,8 +845,9 @@ class Simulator:
         if shape is None or len(shape) != 2:
             got = "a ragged sequence" if shape is None else shape
             raise ValueError(f"positions: expected shape (N, 2), got {got}")
-        self._batch = BatchSimulator(scene, [positions], [velocities], masses, radii, mode=mode, substeps=substeps,
-                                     **options)
+        self._batch = BatchSimulator(
+            scene, [positions], [velocities], masses, radii, mode=mode, substeps=substeps, **options
+        )
 
     @property
     def batch(self) -> BatchSimulator:
@@ -794,8 +901,12 @@ class Simulator:
         """Replace positions and/or velocities (validated; on error nothing changes). Time is kept."""
         b = self._batch
         clock = b._clock[0].copy()
-        b.set_scenes([0], b._pos if positions is None else [positions], b._vel if velocities is None else [velocities],
-                     time=b._time[0])
+        b.set_scenes(
+            [0],
+            b._pos if positions is None else [positions],
+            b._vel if velocities is None else [velocities],
+            time=b._time[0],
+        )
         b._clock[0] = clock
 
     def get_state(self) -> dict[str, np.ndarray]:
@@ -822,8 +933,12 @@ def warm_up() -> None:
     compiles a kernel's whole call graph at once). Without numba it only runs those scenes.
     """
     pos, vel = [[-0.5, 0.0], [0.5, 0.0]], [[1.0, 0.0], [-1.0, 0.0]]
-    scenes = (Scene(), Scene(bounds=None), Scene(dimension=1, bounds=(-2.0, -0.55, 2.0, 0.55)),
-              Scene(elasticity=0.0, inelastic="stick"))
+    scenes = (
+        Scene(),
+        Scene(bounds=None),
+        Scene(dimension=1, bounds=(-2.0, -0.55, 2.0, 0.55)),
+        Scene(elasticity=0.0, inelastic="stick"),
+    )
     for scene in scenes:
         for mode, substeps in (("naive", 1), ("posteriori", 2), ("exact", 1)):
             sim = Simulator(scene, pos, vel, [1.0, 2.0], mode=mode, substeps=substeps)

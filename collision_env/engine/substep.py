@@ -43,9 +43,9 @@ def _cell_lists(n, p, v, h, scratch, geo):
     ``(head, nxt, cell, near, nx, ny)`` for the resolvers."""
     x0, y0, hx, hy, nx, ny = geo
     head = scratch[0:n]
-    nxt = scratch[n:2 * n]
-    cell = scratch[2 * n:3 * n]
-    near = scratch[3 * n:4 * n]
+    nxt = scratch[n : 2 * n]
+    cell = scratch[2 * n : 3 * n]
+    near = scratch[3 * n : 4 * n]
     if nx * ny > 1:
         for c in range(nx * ny):
             head[c] = -1
@@ -78,8 +78,24 @@ def _grid_worst_case(n, cells):
 
 
 @njit
-def step_substeps(mode, k_total, balls, body, time, capped, fparams, iparams, imp, n_imp, counters, work_f, work_i,
-                  scratch, dt_abs, fresh):
+def step_substeps(
+    mode,
+    k_total,
+    balls,
+    body,
+    time,
+    capped,
+    fparams,
+    iparams,
+    imp,
+    n_imp,
+    counters,
+    work_f,
+    work_i,
+    scratch,
+    dt_abs,
+    fresh,
+):
     """Run the remaining sub-steps of every active scene.
 
     Parameters as :func:`exact.step_exact` (``fresh`` starts a step for every scene; ``capped``
@@ -113,8 +129,14 @@ def step_substeps(mode, k_total, balls, body, time, capped, fparams, iparams, im
         m = mass[sc]
         b = body[sc]
         w = omega[sc]
-        geo = (work_f[sc, W_GRID_X0], work_f[sc, W_GRID_Y0], work_f[sc, W_GRID_HX], work_f[sc, W_GRID_HY],
-               work_i[sc, W_GRID_NX], work_i[sc, W_GRID_NY])
+        geo = (
+            work_f[sc, W_GRID_X0],
+            work_f[sc, W_GRID_Y0],
+            work_f[sc, W_GRID_HX],
+            work_f[sc, W_GRID_HY],
+            work_i[sc, W_GRID_NX],
+            work_i[sc, W_GRID_NY],
+        )
         u_min = elastic_threshold(v, ratio, floor)
         while done[sc] < k_total:
             cells = _cell_lists(n, p, v, h, scratch, geo)
@@ -125,11 +147,53 @@ def step_substeps(mode, k_total, balls, body, time, capped, fparams, iparams, im
             t_end = t_start[sc] + sign * (dt_abs if k == k_total else h * k)
             advance_all(h, p, v, m, b, w, sticky and has_rotation(b, w))
             if mode == NAIVE:
-                resolve_naive(sc, t_end, p, v, m, inv_mass[sc], radius[sc], b, w, bounds, dim, e, u_min,
-                              has_walls, pairs, sticky, imp, n_imp, counters, cells)
+                resolve_naive(
+                    sc,
+                    t_end,
+                    p,
+                    v,
+                    m,
+                    inv_mass[sc],
+                    radius[sc],
+                    b,
+                    w,
+                    bounds,
+                    dim,
+                    e,
+                    u_min,
+                    has_walls,
+                    pairs,
+                    sticky,
+                    imp,
+                    n_imp,
+                    counters,
+                    cells,
+                )
             else:
-                resolve_posteriori(sc, t_end, sign, h, p, v, m, inv_mass[sc], radius[sc], b, w, bounds, dim, e, u_min,
-                                   has_walls, pairs, sticky, imp, n_imp, counters, cells)
+                resolve_posteriori(
+                    sc,
+                    t_end,
+                    sign,
+                    h,
+                    p,
+                    v,
+                    m,
+                    inv_mass[sc],
+                    radius[sc],
+                    b,
+                    w,
+                    bounds,
+                    dim,
+                    e,
+                    u_min,
+                    has_walls,
+                    pairs,
+                    sticky,
+                    imp,
+                    n_imp,
+                    counters,
+                    cells,
+                )
             done[sc] = k
             time[sc] = t_end
         n_stalled += stalled[sc]

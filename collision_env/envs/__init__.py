@@ -21,8 +21,12 @@ from collision_env.envs.vector import CollisionTargetVectorEnv
 
 #: The generic env: any preset by name, any TaskConfig field by keyword.
 GENERIC_ID = "CollisionEnv/Target-v0"
-register_env(GENERIC_ID, CollisionTargetEnv, CollisionTargetVectorEnv,
-             bench_scene=f"generic ({CollisionTargetEnv.preset} preset)")
+register_env(
+    GENERIC_ID,
+    CollisionTargetEnv,
+    CollisionTargetVectorEnv,
+    bench_scene=f"generic ({CollisionTargetEnv.preset} preset)",
+)
 
 __all__ = [
     "GENERIC_ID",

@@ -188,16 +188,18 @@ class TaskConfig:
         s("target_width", _number("target_width", self.target_width, low=0.0, strict_low=True))
         shortest = min((b[3] - b[1]) if w in ("left", "right") else (b[2] - b[0]) for w in walls)
         if self.dimension == 2 and self.target_width > shortest:
-            raise ValueError(f"target_width: {self.target_width} m is longer than the shortest target wall "
-                             f"({shortest} m)")
+            raise ValueError(
+                f"target_width: {self.target_width} m is longer than the shortest target wall ({shortest} m)"
+            )
         if self.scorers not in SCORERS:
             raise ValueError(f"scorers: expected one of {SCORERS}, got {self.scorers!r}")
         if self.scorers == "others" and len(ctrl) == self.n_balls:
             raise ValueError("scorers: 'others' needs at least one ball that is not controlled")
         sticky = self.inelastic == "stick" and self.elasticity == 0.0 and self.ball_collisions
         if self.scorers == "cluster" and not sticky:
-            raise ValueError("scorers: 'cluster' needs a stick scene "
-                             "(inelastic='stick', elasticity=0, ball_collisions=True)")
+            raise ValueError(
+                "scorers: 'cluster' needs a stick scene (inelastic='stick', elasticity=0, ball_collisions=True)"
+            )
         if self.scorers == "cluster" and self.n_balls < 2:
             raise ValueError("scorers: 'cluster' needs at least 2 balls")
         for name in ("hit_reward", "success_bonus", "miss_penalty", "action_cost", "shaping"):
@@ -226,8 +228,9 @@ class TaskConfig:
         else:
             room = 0.3 * (b[2] - b[0]) * (b[3] - b[1]) * (0.5 if self.layout == "rack" else 1.0)
             if self.n_balls * math.pi * r_big**2 > room:
-                raise ValueError(f"n_balls: {self.n_balls} balls of radius up to {r_big:.4g} m are too many "
-                                 f"for bounds {b}")
+                raise ValueError(
+                    f"n_balls: {self.n_balls} balls of radius up to {r_big:.4g} m are too many for bounds {b}"
+                )
 
     # ----------------------------------------------------------------------------------------- #
     def radius_of(self, masses: np.ndarray) -> np.ndarray:

@@ -81,12 +81,17 @@ class Impacts:
         out = []
         for r in self.records.tolist():
             rec = dict(zip(self.records.dtype.names, r, strict=True))
-            out.append({
-                "time": rec["time"], "ball": rec["ball"],
-                "other": None if rec["other"] < 0 else rec["other"],
-                "wall": None if rec["wall"] < 0 else WALL_NAMES[rec["wall"]],
-                "point": (rec["x"], rec["y"]), "speed": rec["speed"], "scene": rec["scene"],
-            })
+            out.append(
+                {
+                    "time": rec["time"],
+                    "ball": rec["ball"],
+                    "other": None if rec["other"] < 0 else rec["other"],
+                    "wall": None if rec["wall"] < 0 else WALL_NAMES[rec["wall"]],
+                    "point": (rec["x"], rec["y"]),
+                    "speed": rec["speed"],
+                    "scene": rec["scene"],
+                }
+            )
         return out
 
     def __repr__(self) -> str:
@@ -148,12 +153,30 @@ class EpisodeSampler:
         self.walls = np.array([WALL_NAMES.index(w) for w in cfg.target_walls], dtype=np.int64)
         xmin, ymin, xmax, ymax = cfg.bounds
         (speed_low, speed_high), (others_low, others_high) = cfg.speed_range, cfg.others_speed_range
-        self.E = packed(EPISODE_FLOATS, np.float64, xmin=xmin, ymin=ymin, xmax=xmax, ymax=ymax, speed_low=speed_low,
-                        speed_high=speed_high, others_low=others_low, others_high=others_high,
-                        half_width=0.5 * cfg.target_width, window=-1.0 if cfg.window is None else cfg.window,
-                        time_limit=cfg.time_limit)
-        self.F = packed(EPISODE_INTS, np.int64, dimension=cfg.dimension, n_balls=n, n_targets=k,
-                        rack=int(cfg.layout == "rack"), tries=PLACEMENT_TRIES)
+        self.E = packed(
+            EPISODE_FLOATS,
+            np.float64,
+            xmin=xmin,
+            ymin=ymin,
+            xmax=xmax,
+            ymax=ymax,
+            speed_low=speed_low,
+            speed_high=speed_high,
+            others_low=others_low,
+            others_high=others_high,
+            half_width=0.5 * cfg.target_width,
+            window=-1.0 if cfg.window is None else cfg.window,
+            time_limit=cfg.time_limit,
+        )
+        self.F = packed(
+            EPISODE_INTS,
+            np.int64,
+            dimension=cfg.dimension,
+            n_balls=n,
+            n_targets=k,
+            rack=int(cfg.layout == "rack"),
+            tries=PLACEMENT_TRIES,
+        )
 
     def _build(self, U: np.ndarray) -> tuple:
         cfg = self.cfg
@@ -182,8 +205,10 @@ class EpisodeSampler:
                         getattr(eps, name)[row] = getattr(one, name)[0]
                     break
             else:
-                raise RuntimeError(f"could not place {self.cfg.n_balls} balls without overlap in {self.cfg.bounds} "
-                                   f"after {MAX_ATTEMPTS} attempts; use fewer or smaller balls")
+                raise RuntimeError(
+                    f"could not place {self.cfg.n_balls} balls without overlap in {self.cfg.bounds} "
+                    f"after {MAX_ATTEMPTS} attempts; use fewer or smaller balls"
+                )
         return eps
 
 
@@ -210,16 +235,42 @@ class TaskCore:
         self.cfg = cfg
         B, N, Kt = int(num_scenes), cfg.n_balls, cfg.n_targets
         self.num_scenes = B
-        self.scene = Scene(bounds=cfg.bounds, elasticity=cfg.elasticity, dimension=cfg.dimension,
-                           inelastic=cfg.inelastic, ball_collisions=cfg.ball_collisions)
+        self.scene = Scene(
+            bounds=cfg.bounds,
+            elasticity=cfg.elasticity,
+            dimension=cfg.dimension,
+            inelastic=cfg.inelastic,
+            ball_collisions=cfg.ball_collisions,
+        )
         xmin, ymin, xmax, ymax = cfg.bounds
-        self.P = packed(PARAMS, np.float64, xmin=xmin, ymin=ymin, xmax=xmax, ymax=ymax, hit_reward=cfg.hit_reward,
-                        miss_penalty=cfg.miss_penalty, success_bonus=cfg.success_bonus, shaping=cfg.shaping,
-                        vscale=2.0 * cfg.max_speed, mscale=MASS_SCALE, time_limit=cfg.time_limit,
-                        max_dv=cfg.max_dv, max_speed=cfg.max_speed, action_cost=cfg.action_cost)
+        self.P = packed(
+            PARAMS,
+            np.float64,
+            xmin=xmin,
+            ymin=ymin,
+            xmax=xmax,
+            ymax=ymax,
+            hit_reward=cfg.hit_reward,
+            miss_penalty=cfg.miss_penalty,
+            success_bonus=cfg.success_bonus,
+            shaping=cfg.shaping,
+            vscale=2.0 * cfg.max_speed,
+            mscale=MASS_SCALE,
+            time_limit=cfg.time_limit,
+            max_dv=cfg.max_dv,
+            max_speed=cfg.max_speed,
+            action_cost=cfg.action_cost,
+        )
         self._cluster_scoring = cfg.scorers == "cluster"
-        self.Q = packed(SWITCHES, np.int64, sequential=int(cfg.sequential), cluster=int(self._cluster_scoring),
-                        dimension=cfg.dimension, n_steps=cfg.n_steps, sticky=int(self.scene.sticky))
+        self.Q = packed(
+            SWITCHES,
+            np.int64,
+            sequential=int(cfg.sequential),
+            cluster=int(self._cluster_scoring),
+            dimension=cfg.dimension,
+            n_steps=cfg.n_steps,
+            sticky=int(self.scene.sticky),
+        )
         self.ctrl = np.array(cfg.controlled, dtype=np.int64)
         self.qual = cfg.scoring_mask
         self.obs_dim = cfg.obs_dim
@@ -238,16 +289,25 @@ class TaskCore:
         self.sampler = EpisodeSampler(cfg)
         ep = self.sampler.sample([np.random.default_rng(0)])
         rep = lambda a: np.repeat(a, B, 0)  # noqa: E731
-        self.batch = BatchSimulator(self.scene, rep(ep.positions), rep(ep.velocities), rep(ep.masses),
-                                    radii=rep(ep.radii), mode=cfg.mode, substeps=cfg.substeps,
-                                    max_events=cfg.max_events)
+        self.batch = BatchSimulator(
+            self.scene,
+            rep(ep.positions),
+            rep(ep.velocities),
+            rep(ep.masses),
+            radii=rep(ep.radii),
+            mode=cfg.mode,
+            substeps=cfg.substeps,
+            max_events=cfg.max_events,
+        )
         self._write_episode(np.arange(B), Episodes(*(rep(getattr(ep, f)) for f in Episodes.__slots__)))
         self.impact_dtype = IMPACT_DTYPE
 
     # views into the packed state (writable: they share memory with it)
     t_wall = property(lambda self: self.T[..., TARGET_INTS.wall], doc="(B, K) target walls (engine wall codes).")
-    t_status = property(lambda self: self.T[..., TARGET_INTS.status],
-                        doc="(B, K) 0 pending, 1 hit, 2 failed (``_layout.TARGET_PENDING`` ...).")
+    t_status = property(
+        lambda self: self.T[..., TARGET_INTS.status],
+        doc="(B, K) 0 pending, 1 hit, 2 failed (``_layout.TARGET_PENDING`` ...).",
+    )
     cur = property(lambda self: self.C[:, SCENE_INTS.current], doc="(B,) index of the current (sequential) target.")
     steps = property(lambda self: self.C[:, SCENE_INTS.steps], doc="(B,) control steps taken this episode.")
     # the engine's state: live views, to read (the renderer and the scripted policies do, per sub-env)
@@ -308,17 +368,36 @@ class TaskCore:
         then in ``S`` and ``C`` (see :meth:`outputs`).
         """
         live = self.batch.live_arrays()
-        K.task_kernel(flags, imp, live.balls, live.time,
-                      live.clusters if self._cluster_scoring else self.body, self.S,
-                      self.C, self.T, self.t_geo, self.body, self.qual, self.P, self.Q, obs)
+        K.task_kernel(
+            flags,
+            imp,
+            live.balls,
+            live.time,
+            live.clusters if self._cluster_scoring else self.body,
+            self.S,
+            self.C,
+            self.T,
+            self.t_geo,
+            self.body,
+            self.qual,
+            self.P,
+            self.Q,
+            obs,
+        )
         return obs
 
     def outputs(self) -> tuple:
         """Fresh ``(reward, terminated, truncated, success, targets_hit, energy, nudge)`` arrays (B,)."""
         S, C, sf, si = self.S, self.C, SCENE_FLOATS, SCENE_INTS
-        return (S[:, sf.reward].copy(), C[:, si.terminated].astype(bool), C[:, si.truncated].astype(bool),
-                C[:, si.success].astype(bool), C[:, si.targets_hit].copy(), S[:, sf.energy].copy(),
-                S[:, sf.nudge].copy())
+        return (
+            S[:, sf.reward].copy(),
+            C[:, si.terminated].astype(bool),
+            C[:, si.truncated].astype(bool),
+            C[:, si.success].astype(bool),
+            C[:, si.targets_hit].copy(),
+            S[:, sf.energy].copy(),
+            S[:, sf.nudge].copy(),
+        )
 
     def empty_impacts(self) -> np.ndarray:
         """A fresh zero-length impact record array (the engine's dtype)."""
@@ -340,8 +419,9 @@ class TaskCore:
         for name in self._TASK_FIELDS:  # check everything before changing anything
             arr = np.asarray(state[name])
             if arr.shape != getattr(self, name).shape:
-                raise ValueError(f"set_state: field {name!r} has shape {arr.shape}, "
-                                 f"expected {getattr(self, name).shape}")
+                raise ValueError(
+                    f"set_state: field {name!r} has shape {arr.shape}, expected {getattr(self, name).shape}"
+                )
             arrays[name] = arr
         self.batch.set_state(state["engine"])
         for name, arr in arrays.items():

@@ -194,9 +194,13 @@ def _score_impacts(flags, imp, C, T, t_geo, body, qual, seq, cluster):  # pragma
         hit = False
         k0, k1 = _visible_targets(C[b, SI.current], T.shape[1], seq)
         for k in range(k0, k1):
-            if (T[b, k, TI.status] == TARGET_PENDING and T[b, k, TI.wall] == w
-                    and abs(along - t_geo[b, k, TG.centre]) <= t_geo[b, k, TG.half_width]
-                    and t_geo[b, k, TG.opens] <= t and t <= t_geo[b, k, TG.closes]):
+            if (
+                T[b, k, TI.status] == TARGET_PENDING
+                and T[b, k, TI.wall] == w
+                and abs(along - t_geo[b, k, TG.centre]) <= t_geo[b, k, TG.half_width]
+                and t_geo[b, k, TG.opens] <= t
+                and t <= t_geo[b, k, TG.closes]
+            ):
                 T[b, k, TI.status] = TARGET_HIT
                 hit = True
                 if seq:
@@ -246,8 +250,9 @@ def _observed_point(wall, centre, xc, yc, xh, yh):  # pragma: no cover - numba
 
 
 @njit(inline="always")
-def _observe(flags, obs, S, pos, vel, masses, body, qual, C, T, t_geo, sim_time, seq, cluster, n_steps,
-             P):  # pragma: no cover - numba
+def _observe(
+    flags, obs, S, pos, vel, masses, body, qual, C, T, t_geo, sim_time, seq, cluster, n_steps, P
+):  # pragma: no cover - numba
     """Write the observation (ball blocks, target slots, globals) and the kinetic energy."""
     xc, yc, xh, yh = _centre_and_half_size(P)
     vscale = P[PARAMS.vscale]
@@ -372,8 +377,20 @@ def _settle(flags, S, C, T, t_geo, pos, vel, radii, body, qual, seq, cluster, n_
             for k in range(k0, k1):
                 if T[b, k, TI.status] != TARGET_PENDING:
                     continue
-                d = _distance_to_target(cx, cy, T[b, k, TI.wall], t_geo[b, k, TG.centre], t_geo[b, k, TG.half_width],
-                                        xmin, ymin, xmax, ymax) / diag
+                d = (
+                    _distance_to_target(
+                        cx,
+                        cy,
+                        T[b, k, TI.wall],
+                        t_geo[b, k, TG.centre],
+                        t_geo[b, k, TG.half_width],
+                        xmin,
+                        ymin,
+                        xmax,
+                        ymax,
+                    )
+                    / diag
+                )
                 if d < best:
                     best = d
         phi_new = -best
@@ -385,8 +402,11 @@ def _settle(flags, S, C, T, t_geo, pos, vel, radii, body, qual, seq, cluster, n_
                     failed = True
             done_ok = C[b, SI.targets_hit] == K
             hits = C[b, SI.hits]
-            rew = hits * P[PARAMS.hit_reward] - C[b, SI.misses] * P[PARAMS.miss_penalty] \
+            rew = (
+                hits * P[PARAMS.hit_reward]
+                - C[b, SI.misses] * P[PARAMS.miss_penalty]
                 - P[PARAMS.action_cost] * S[b, SF.nudge]
+            )
             if done_ok:
                 rew += P[PARAMS.success_bonus]
             if hits == 0:
@@ -405,8 +425,9 @@ def _settle(flags, S, C, T, t_geo, pos, vel, radii, body, qual, seq, cluster, n_
 
 
 @njit
-def task_kernel(flags, imp, balls, sim_time, clusters, S, C, T, t_geo, body, qual, P, Q,
-                obs):  # pragma: no cover - numba
+def task_kernel(
+    flags, imp, balls, sim_time, clusters, S, C, T, t_geo, body, qual, P, Q, obs
+):  # pragma: no cover - numba
     """Score a step's impacts, update target state, and write reward, flags and observation.
 
     ``imp`` is the engine's impact record array for the batch (sorted by scene then time);
@@ -469,7 +490,7 @@ def _place_on_line(U, off, radii, E, pos, ok):  # pragma: no cover - numba
         free = (xmax - xmin) - _GAP * (N + 1)
         for i in range(N):
             free -= 2.0 * radii[r, i]
-        us = np.sort(U[r, off:off + N] * free)
+        us = np.sort(U[r, off : off + N] * free)
         edge = xmin
         for i in range(N):
             edge += _GAP
@@ -558,7 +579,7 @@ def _draw_windows(U, off, E, t_geo):  # pragma: no cover - numba
                 t_geo[r, k, TG.opens] = -_NO_WINDOW
                 t_geo[r, k, TG.closes] = _NO_WINDOW
             continue
-        opens = np.sort(U[r, off:off + K])
+        opens = np.sort(U[r, off : off + K])
         for k in range(K):
             t_geo[r, k, TG.opens] = earliest + (latest - earliest) * opens[k]
             t_geo[r, k, TG.closes] = t_geo[r, k, TG.opens] + win

@@ -27,8 +27,16 @@ HIT = (70, 220, 120)
 FAILED = (110, 110, 118)
 ARROW = (235, 238, 245)
 CONTROLLED = (255, 214, 70)
-PALETTE = [(232, 74, 95), (80, 170, 255), (170, 120, 255), (90, 215, 200), (255, 130, 60), (150, 210, 90),
-           (240, 110, 200), (120, 140, 255)]
+PALETTE = [
+    (232, 74, 95),
+    (80, 170, 255),
+    (170, 120, 255),
+    (90, 215, 200),
+    (255, 130, 60),
+    (150, 210, 90),
+    (240, 110, 200),
+    (120, 140, 255),
+]
 FLASH_LIFE = 0.4  # s of simulated time
 
 
@@ -49,8 +57,9 @@ def _fade(colour, f):
 class Renderer:
     """Draws scene ``b`` of a :class:`~collision_env.envs._core.TaskCore`."""
 
-    def __init__(self, cfg, trails: bool = False, ppm: float = 150.0, margin: int = 26, bar: int = 26,
-                 trail_length: int = 40):
+    def __init__(
+        self, cfg, trails: bool = False, ppm: float = 150.0, margin: int = 26, bar: int = 26, trail_length: int = 40
+    ):
         self.pg = _pygame()
         self.cfg = cfg
         self.trails = trails

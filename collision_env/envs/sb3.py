@@ -26,7 +26,8 @@ except ModuleNotFoundError as err:  # an optional extra: say how to get it
     raise ModuleNotFoundError(
         f"collision_env.envs.sb3 needs stable-baselines3 ({err.name} is missing): "
         'pip install "collision_env[train]" (on a CPU-only machine install torch\'s CPU build first)',
-        name=err.name) from err
+        name=err.name,
+    ) from err
 
 from collision_env.envs.vector import CollisionTargetVectorEnv
 
@@ -40,20 +41,31 @@ class CollisionSB3VecEnv(VecEnv):
     statistics (``make_sb3_vec_env`` does).
     """
 
-    def __init__(self, env_id: str | None = None, n_envs: int = 1, venv: CollisionTargetVectorEnv | None = None,
-                 **env_kwargs: Any):
+    def __init__(
+        self,
+        env_id: str | None = None,
+        n_envs: int = 1,
+        venv: CollisionTargetVectorEnv | None = None,
+        **env_kwargs: Any,
+    ):
         if venv is None:
             if env_id is None:
                 raise ValueError("give env_id (a registered id) or venv (a native vector env)")
             import collision_env  # noqa: F401  (registers the ids)
 
-            venv = gym.make_vec(env_id, num_envs=n_envs, vectorization_mode="vector_entry_point",
-                                autoreset_mode=AutoresetMode.SAME_STEP, **env_kwargs)
+            venv = gym.make_vec(
+                env_id,
+                num_envs=n_envs,
+                vectorization_mode="vector_entry_point",
+                autoreset_mode=AutoresetMode.SAME_STEP,
+                **env_kwargs,
+            )
         if not isinstance(venv.unwrapped, CollisionTargetVectorEnv):
             raise ValueError(f"venv: expected a CollisionTargetVectorEnv, got {type(venv).__name__}")
         if venv.metadata.get("autoreset_mode") != AutoresetMode.SAME_STEP:
-            raise ValueError("venv: SB3 needs same-step autoreset; "
-                             "create it with autoreset_mode=AutoresetMode.SAME_STEP")
+            raise ValueError(
+                "venv: SB3 needs same-step autoreset; create it with autoreset_mode=AutoresetMode.SAME_STEP"
+            )
         self.venv = venv
         super().__init__(venv.num_envs, venv.single_observation_space, venv.single_action_space)
         self._actions = None
@@ -89,8 +101,10 @@ class CollisionSB3VecEnv(VecEnv):
             success = info["is_success"].tolist()
             hits = info["targets_hit"].tolist()
             nudge = info["nudge"].tolist()
-        infos = [{"is_success": success[i], "targets_hit": hits[i], "nudge": nudge[i], "TimeLimit.truncated": limit[i]}
-                 for i in range(n)]
+        infos = [
+            {"is_success": success[i], "targets_hit": hits[i], "nudge": nudge[i], "TimeLimit.truncated": limit[i]}
+            for i in range(n)
+        ]
         if dones.any():
             final_obs = info["final_obs"]
             for i in np.flatnonzero(dones):
@@ -131,8 +145,14 @@ class CollisionSB3VecEnv(VecEnv):
         return [False for _ in self._get_indices(indices)]
 
 
-def make_sb3_vec_env(env_id: str, n_envs: int = 8, seed: int | None = None, monitor: bool = True,
-                     monitor_file: str | None = None, **env_kwargs: Any) -> VecEnv:
+def make_sb3_vec_env(
+    env_id: str,
+    n_envs: int = 8,
+    seed: int | None = None,
+    monitor: bool = True,
+    monitor_file: str | None = None,
+    **env_kwargs: Any,
+) -> VecEnv:
     """A :class:`CollisionSB3VecEnv` for ``env_id`` (seeded with ``seed + i`` at the first reset),
     wrapped in ``VecMonitor(info_keywords=("is_success",))`` (writing ``monitor_file`` if given)
     unless ``monitor=False``."""

@@ -105,7 +105,7 @@ class AimingPolicy:
                         break
                 self.want[i] = want
             if want is not None:
-                action[2 * j:2 * j + 2] = np.clip((want - v) / cfg.max_dv, -1, 1)
+                action[2 * j : 2 * j + 2] = np.clip((want - v) / cfg.max_dv, -1, 1)
         return action
 
 
@@ -182,8 +182,11 @@ def cluster_plans(env) -> list:
     """Once stuck: push the cluster in one of 64 directions for 8, 20 or 40 steps."""
     if not stuck(env):
         return []
-    return [push((math.cos(a), math.sin(a)), steps)
-            for steps in (8, 20, 40) for a in np.linspace(0, 2 * math.pi, 64, endpoint=False)]
+    return [
+        push((math.cos(a), math.sin(a)), steps)
+        for steps in (8, 20, 40)
+        for a in np.linspace(0, 2 * math.pi, 64, endpoint=False)
+    ]
 
 
 def ram(env) -> np.ndarray:
@@ -246,10 +249,15 @@ def scripted_policy(env):
     """
     env = env.unwrapped
     cfg = env.config
-    if cfg.dimension == 2 and cfg.scorers in ("any", "controlled") and (cfg.n_balls == 1 or not cfg.ball_collisions) \
-            and len(cfg.controlled) == cfg.n_balls:
+    if (
+        cfg.dimension == 2
+        and cfg.scorers in ("any", "controlled")
+        and (cfg.n_balls == 1 or not cfg.ball_collisions)
+        and len(cfg.controlled) == cfg.n_balls
+    ):
         return AimingPolicy(env)
     if cfg.scorers == "cluster":
+
         def ram_first(e):
             return np.zeros(e.action_space.shape, np.float32) if stuck(e) else ram(e)
 

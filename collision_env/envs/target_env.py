@@ -106,14 +106,16 @@ class CollisionTargetEnv(gym.Env):
     metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 20}
     preset: str | None = "one_ball"
 
-    def __init__(self, preset: str | None = _CLASS_PRESET, render_mode: str | None = None, trails: bool = False,
-                 **overrides: Any):
+    def __init__(
+        self, preset: str | None = _CLASS_PRESET, render_mode: str | None = None, trails: bool = False, **overrides: Any
+    ):
         if preset is _CLASS_PRESET:
             preset = type(self).preset
         self.config: TaskConfig = make_config(preset, **overrides)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(f"render_mode: expected one of {self.metadata['render_modes']} or None, "
-                             f"got {render_mode!r}")
+            raise ValueError(
+                f"render_mode: expected one of {self.metadata['render_modes']} or None, got {render_mode!r}"
+            )
         self.render_mode = render_mode
         self.metadata = {**type(self).metadata, "render_fps": max(1, int(round(1.0 / self.config.dt)))}
         self._core = TaskCore(self.config, 1)
@@ -136,20 +138,35 @@ class CollisionTargetEnv(gym.Env):
         """This step's (reward, terminated, truncated, success, targets hit, energy, nudge) as Python values."""
         S, C = self._core.S[0].tolist(), self._core.C[0].tolist()
         sf, si = SCENE_FLOATS, SCENE_INTS
-        return (S[sf.reward], bool(C[si.terminated]), bool(C[si.truncated]), bool(C[si.success]), C[si.targets_hit],
-                S[sf.energy], S[sf.nudge])
+        return (
+            S[sf.reward],
+            bool(C[si.terminated]),
+            bool(C[si.truncated]),
+            bool(C[si.success]),
+            C[si.targets_hit],
+            S[sf.energy],
+            S[sf.nudge],
+        )
 
     # ------------------------------------------------------------------------------------- #
-    def reset(self, *, seed: int | None = None,
-              options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
         super().reset(seed=seed)
         core = self._core
         core.reset_scenes(np.zeros(1, dtype=np.int64), [self.np_random])
         imp = core.empty_impacts()
         obs = core.finish(self._reset_flag, imp, self._obs())
         _, _, _, _, n_hit, energy, _ = self._scalars()
-        info = {"impacts": Impacts(imp), "event_cap": False, "nudge": 0.0, "energy": energy,
-                "time": float(core.batch.live_arrays().time[0]), "targets_hit": n_hit, "is_success": False}
+        info = {
+            "impacts": Impacts(imp),
+            "event_cap": False,
+            "nudge": 0.0,
+            "energy": energy,
+            "time": float(core.batch.live_arrays().time[0]),
+            "targets_hit": n_hit,
+            "is_success": False,
+        }
         if self.render_mode is not None:
             self._get_renderer().start()  # trails and flashes are recorded from the episode start
         if self.render_mode == "human":
@@ -170,8 +187,15 @@ class CollisionTargetEnv(gym.Env):
         obs = core.finish(self._step_flag, imp, self._obs())
         reward, term, trunc, success, n_hit, energy, nudge = self._scalars()
         live = core.batch.live_arrays()
-        info = {"impacts": Impacts(imp), "event_cap": bool(live.capped[0]), "nudge": nudge, "energy": energy,
-                "time": float(live.time[0]), "targets_hit": n_hit, "is_success": success}
+        info = {
+            "impacts": Impacts(imp),
+            "event_cap": bool(live.capped[0]),
+            "nudge": nudge,
+            "energy": energy,
+            "time": float(live.time[0]),
+            "targets_hit": n_hit,
+            "is_success": success,
+        }
         if self._renderer is not None:
             self._renderer.record(core, 0, imp)
         if self.render_mode == "human":

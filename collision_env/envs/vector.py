@@ -48,13 +48,21 @@ class CollisionTargetVectorEnv(VectorEnv):
     # set before __init__ can fail: gymnasium < 1.3's VectorEnv.__del__ closes a half-made env
     _renderers: list | None = None
 
-    def __init__(self, num_envs: int = 1, max_episode_steps: int | None = None, render_mode: str | None = None,
-                 autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP, preset: str | None = _CLASS_PRESET,
-                 trails: bool = False, **overrides: Any):
+    def __init__(
+        self,
+        num_envs: int = 1,
+        max_episode_steps: int | None = None,
+        render_mode: str | None = None,
+        autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
+        preset: str | None = _CLASS_PRESET,
+        trails: bool = False,
+        **overrides: Any,
+    ):
         if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
             raise ValueError(f"num_envs: must be a positive integer, got {num_envs!r}")
-        if max_episode_steps is not None and (not isinstance(max_episode_steps, (int, np.integer))
-                                              or max_episode_steps < 1):
+        if max_episode_steps is not None and (
+            not isinstance(max_episode_steps, (int, np.integer)) or max_episode_steps < 1
+        ):
             raise ValueError(f"max_episode_steps: must be a positive integer or None, got {max_episode_steps!r}")
         try:
             autoreset_mode = AutoresetMode(autoreset_mode)
@@ -72,8 +80,11 @@ class CollisionTargetVectorEnv(VectorEnv):
         self.max_episode_steps = None if max_episode_steps is None else int(max_episode_steps)
         self.render_mode = render_mode
         self.autoreset_mode = autoreset_mode
-        self.metadata = {**type(self).metadata, "autoreset_mode": autoreset_mode,
-                         "render_fps": max(1, int(round(1.0 / cfg.dt)))}
+        self.metadata = {
+            **type(self).metadata,
+            "autoreset_mode": autoreset_mode,
+            "render_fps": max(1, int(round(1.0 / cfg.dt))),
+        }
         self.single_action_space = spaces.Box(-1.0, 1.0, (cfg.action_dim,), np.float32)
         self.single_observation_space = spaces.Box(-1.0, 1.0, (cfg.obs_dim,), np.float32)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
@@ -109,14 +120,21 @@ class CollisionTargetVectorEnv(VectorEnv):
     def _info(self, energy, event_cap, nudge, success, n_hit, imp) -> dict:
         n = self.num_envs
         info = {"impacts": Impacts(imp), "_impacts": np.ones(n, dtype=bool)}
-        for key, value in (("event_cap", event_cap), ("nudge", nudge), ("energy", energy),
-                           ("time", self._core.time), ("targets_hit", n_hit), ("is_success", success)):
+        for key, value in (
+            ("event_cap", event_cap),
+            ("nudge", nudge),
+            ("energy", energy),
+            ("time", self._core.time),
+            ("targets_hit", n_hit),
+            ("is_success", success),
+        ):
             info[key] = value
             info["_" + key] = np.ones(n, dtype=bool)
         return info
 
-    def reset(self, *, seed: int | list[int] | None = None,
-              options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
+    def reset(
+        self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
         options = dict(options) if options else {}
         mask = options.pop("reset_mask", None)
         if mask is None:
@@ -203,8 +221,14 @@ class CollisionTargetVectorEnv(VectorEnv):
             final_obs[i] = obs[i].copy()
         final_info = {"impacts": Impacts(imp[in_done]), "_impacts": done.copy()}
         time_now = core.time
-        for key, value in (("event_cap", event_cap), ("nudge", nudge), ("energy", energy), ("time", time_now),
-                           ("targets_hit", n_hit), ("is_success", success)):
+        for key, value in (
+            ("event_cap", event_cap),
+            ("nudge", nudge),
+            ("energy", energy),
+            ("time", time_now),
+            ("targets_hit", n_hit),
+            ("is_success", success),
+        ):
             v = np.zeros_like(value)
             v[done] = value[done]
             final_info[key] = v
@@ -257,8 +281,11 @@ class CollisionTargetVectorEnv(VectorEnv):
     # ------------------------------------------------------------------------------------- #
     def get_state(self) -> dict:
         """Engine, task arrays, autoreset flags and every sub-env's RNG state."""
-        return {"core": self._core.get_state(), "autoreset": self._autoreset.copy(),
-                "rngs": [None if g is None else copy.deepcopy(g.bit_generator.state) for g in self._rngs]}
+        return {
+            "core": self._core.get_state(),
+            "autoreset": self._autoreset.copy(),
+            "rngs": [None if g is None else copy.deepcopy(g.bit_generator.state) for g in self._rngs],
+        }
 
     def set_state(self, state: dict) -> None:
         self._core.set_state(state["core"])

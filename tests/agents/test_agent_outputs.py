@@ -20,8 +20,13 @@ TINY = ["--timesteps", "2048", "--n-envs", "4", "--eval-freq", "0", "--save-freq
 
 
 def test_training_through_a_pipe_prints_progress_lines_and_keeps_them_in_the_run(tmp_path):
-    run = subprocess.run([sys.executable, "-m", "agents.train_ppo", *TINY, "--output", str(tmp_path),
-                          "--run-name", "piped"], capture_output=True, text=True, cwd=ROOT, timeout=600)
+    run = subprocess.run(
+        [sys.executable, "-m", "agents.train_ppo", *TINY, "--output", str(tmp_path), "--run-name", "piped"],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=600,
+    )
     assert run.returncode == 0, run.stderr
     progress = [line for line in run.stdout.splitlines() if " steps (" in line]
     assert len(progress) >= 2 and progress[-1].startswith("2,048 / 2,048 steps (100 %)")

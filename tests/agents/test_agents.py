@@ -57,11 +57,16 @@ def test_rl_zoo_style_values_are_understood():
     pk = config.ppo_kwargs({"policy_kwargs": "dict(net_arch=[32], activation_fn=nn.ReLU)"})["policy_kwargs"]
     assert pk == {"net_arch": [32], "activation_fn": nn.ReLU}
     assert config.ppo_kwargs({"policy_kwargs": {"activation_fn": "tanh"}})["policy_kwargs"]["activation_fn"] is nn.Tanh
-    assert config.normalize_settings("{'norm_obs': True, 'norm_reward': False}") == {"norm_obs": True,
-                                                                                      "norm_reward": False}
+    assert config.normalize_settings("{'norm_obs': True, 'norm_reward': False}") == {
+        "norm_obs": True,
+        "norm_reward": False,
+    }
     assert config.normalize_settings(False) is None
-    assert config.parse_env_kwargs(["mode=naive", "dt=0.1", "substeps=4"]) == {"mode": "naive", "dt": 0.1,
-                                                                               "substeps": 4}
+    assert config.parse_env_kwargs(["mode=naive", "dt=0.1", "substeps=4"]) == {
+        "mode": "naive",
+        "dt": 0.1,
+        "substeps": 4,
+    }
     for bad in ({"learning_rate": "lin_x"}, {"policy_kwargs": "open('x')"}, {"policy_kwargs": {"activation_fn": "no"}}):
         with pytest.raises(config.UsageError):
             config.ppo_kwargs(bad)
@@ -91,8 +96,23 @@ def test_native_and_sb3_vector_envs_play_the_same_episodes_through_their_ends():
 
 # --------------------------------------------------------------------------- train, save, evaluate
 def test_train_save_reload_evaluate_and_record(tmp_path):
-    run = train_ppo.main(TINY + ["--output", str(tmp_path), "--run-name", "smoke", "--eval-freq", "1024",
-                                 "--save-freq", "1024", "--eval-episodes", "2", "--env-kwargs", "time_limit=2.0"])
+    run = train_ppo.main(
+        TINY
+        + [
+            "--output",
+            str(tmp_path),
+            "--run-name",
+            "smoke",
+            "--eval-freq",
+            "1024",
+            "--save-freq",
+            "1024",
+            "--eval-episodes",
+            "2",
+            "--env-kwargs",
+            "time_limit=2.0",
+        ]
+    )
     files = ("config.yml", "model.zip", "vecnormalize.pkl", "best_model.zip", "monitor.csv", "eval/evaluations.npz")
     for name in files:
         assert (run / name).is_file(), name
@@ -127,35 +147,69 @@ def test_observation_normalisation_uses_the_statistics_saved_with_each_model(tmp
     from stable_baselines3 import PPO
     from stable_baselines3.common.vec_env import VecNormalize
 
-    hp = dict(config.hyperparams_for("CollisionEnv/OneBallTarget-v0"),
-              normalize={"norm_obs": True, "norm_reward": True})
+    hp = dict(
+        config.hyperparams_for("CollisionEnv/OneBallTarget-v0"), normalize={"norm_obs": True, "norm_reward": True}
+    )
     hp_file = tmp_path / "hp.yml"
     config.write_yaml(hp_file, {"CollisionEnv/OneBallTarget-v0": hp})
-    args = TINY + ["--hyperparams", str(hp_file), "--output", str(tmp_path), "--run-name", "n", "--eval-freq", "1024",
-                   "--eval-episodes", "2", "--save-freq", "0"]
+    args = TINY + [
+        "--hyperparams",
+        str(hp_file),
+        "--output",
+        str(tmp_path),
+        "--run-name",
+        "n",
+        "--eval-freq",
+        "1024",
+        "--eval-episodes",
+        "2",
+        "--save-freq",
+        "0",
+    ]
     run = train_ppo.main(args)
     assert (run / "vecnormalize.pkl").is_file() and (run / "best_vecnormalize.pkl").is_file()
     env = evaluate.make_env("CollisionEnv/OneBallTarget-v0", {})
     obs, _ = env.reset(seed=3)
-    for which, model_file, stats_file in (("final", "model.zip", "vecnormalize.pkl"),
-                                          ("best", "best_model.zip", "best_vecnormalize.pkl")):
+    for which, model_file, stats_file in (
+        ("final", "model.zip", "vecnormalize.pkl"),
+        ("best", "best_model.zip", "best_vecnormalize.pkl"),
+    ):
         act = evaluate.trained_policy(run, which)(env.unwrapped, 0)
         venv = train_ppo.make_vec_env("CollisionEnv/OneBallTarget-v0", 1, 0, {})
         stats = VecNormalize.load(str(run / stats_file), venv)
         expect = PPO.load(run / model_file, device="cpu").predict(stats.normalize_obs(obs), deterministic=True)[0]
         assert np.allclose(act(obs), expect, atol=1e-6)
     # --overwrite replaces the whole folder: no statistics of the earlier run survive
-    train_ppo.main(TINY + ["--output", str(tmp_path), "--run-name", "n", "--overwrite", "--eval-freq", "0",
-                           "--save-freq", "0"])
+    train_ppo.main(
+        TINY + ["--output", str(tmp_path), "--run-name", "n", "--overwrite", "--eval-freq", "0", "--save-freq", "0"]
+    )
     assert not (run / "best_vecnormalize.pkl").exists() and not (run / "best_model.zip").exists()
     _finite(evaluate.evaluate(run, episodes=2, baselines=()))
 
 
 def test_a_run_config_repeats_its_run(tmp_path):
-    first = train_ppo.main(["--env", "CollisionEnv/Line1D-v0", "--seed", "3", "--vec-env", "dummy", "--eval-freq", "0",
-                            "--save-freq", "0", "--output", str(tmp_path), "--run-name", "a", *TINY])
-    again = train_ppo.main(["--hyperparams", str(first / "config.yml"), "--output", str(tmp_path), "--run-name", "b",
-                            "--no-progress"])
+    first = train_ppo.main(
+        [
+            "--env",
+            "CollisionEnv/Line1D-v0",
+            "--seed",
+            "3",
+            "--vec-env",
+            "dummy",
+            "--eval-freq",
+            "0",
+            "--save-freq",
+            "0",
+            "--output",
+            str(tmp_path),
+            "--run-name",
+            "a",
+            *TINY,
+        ]
+    )
+    again = train_ppo.main(
+        ["--hyperparams", str(first / "config.yml"), "--output", str(tmp_path), "--run-name", "b", "--no-progress"]
+    )
     a, b = config.read_run(first), config.read_run(again)
     for key in ("env_id", "seed", "vec_env", "n_envs", "n_timesteps", "env_kwargs", "callbacks", "episode_steps"):
         assert a[key] == b[key], key
@@ -171,15 +225,39 @@ def test_a_run_config_repeats_its_run(tmp_path):
 
 def test_record_mp4(tmp_path):
     pytest.importorskip("imageio_ffmpeg")
-    run = train_ppo.main(TINY + ["--output", str(tmp_path), "--run-name", "r", "--eval-freq", "0", "--save-freq", "0",
-                                 "--env-kwargs", "time_limit=1.0"])
+    run = train_ppo.main(
+        TINY
+        + [
+            "--output",
+            str(tmp_path),
+            "--run-name",
+            "r",
+            "--eval-freq",
+            "0",
+            "--save-freq",
+            "0",
+            "--env-kwargs",
+            "time_limit=1.0",
+        ]
+    )
     path = evaluate.record(run, tmp_path / "ep.mp4", episodes=2)
     assert path.stat().st_size > 1000
 
 
 def test_training_on_sb3_dummy_vec_env_and_other_mode(tmp_path):
-    run = train_ppo.train("CollisionEnv/Line1D-v0", timesteps=1024, n_envs=4, mode="naive", substeps=2,
-                          output=tmp_path, run_name="d", vec_env="dummy", eval_freq=0, save_freq=0, log=lambda *a: None)
+    run = train_ppo.train(
+        "CollisionEnv/Line1D-v0",
+        timesteps=1024,
+        n_envs=4,
+        mode="naive",
+        substeps=2,
+        output=tmp_path,
+        run_name="d",
+        vec_env="dummy",
+        eval_freq=0,
+        save_freq=0,
+        log=lambda *a: None,
+    )
     cfg = config.read_run(run)
     assert cfg["env_kwargs"] == {"mode": "naive", "substeps": 2} and cfg["vec_env"] == "dummy"
     _finite(evaluate.evaluate(run, episodes=2, mode="exact"))
@@ -197,10 +275,31 @@ def test_study_writes_tables_plot_and_readme_block(tmp_path):
     readme = tmp_path / "README.md"
     readme.write_text("x\n<!-- agents:study:start -->\nold\n<!-- agents:study:end -->\ny\n")
     docs = tmp_path / "docs"
-    data = study.main(["--envs", "CollisionEnv/OneBallTarget-v0", "--modes", "naive:1", "exact:1", "--seeds", "0", "1",
-                       "--presets", "CollisionEnv/Line1D-v0", "CollisionEnv/OneBallTarget-v0", "--timesteps", "1024",
-                       "--episodes", "2", "--output", str(tmp_path / "runs"), "--docs", str(docs),
-                       "--readme", str(readme)])
+    data = study.main(
+        [
+            "--envs",
+            "CollisionEnv/OneBallTarget-v0",
+            "--modes",
+            "naive:1",
+            "exact:1",
+            "--seeds",
+            "0",
+            "1",
+            "--presets",
+            "CollisionEnv/Line1D-v0",
+            "CollisionEnv/OneBallTarget-v0",
+            "--timesteps",
+            "1024",
+            "--episodes",
+            "2",
+            "--output",
+            str(tmp_path / "runs"),
+            "--docs",
+            str(docs),
+            "--readme",
+            str(readme),
+        ]
+    )
     modes = [r for r in data["rows"] if r["part"] == "modes"]
     assert {(r["mode"], r["seed"]) for r in modes} == {("naive", 0), ("naive", 1), ("exact", 0), ("exact", 1)}
     presets = [r["env_id"] for r in data["rows"] if r["part"] == "presets"]
@@ -219,12 +318,15 @@ def test_study_writes_tables_plot_and_readme_block(tmp_path):
 
 
 # --------------------------------------------------------------------------------------- bad input
-@pytest.mark.parametrize("module, args, message", [
-    ("agents.train_ppo", ["--env", "CollisionEnv/OneBalTarget-v0"], "unknown env id"),
-    ("agents.train_ppo", ["--env-kwargs", "elasticity=2"], "elasticity"),
-    ("agents.evaluate", ["/no/such/run"], "run folder not found"),
-    ("agents.main", ["--env", "Nope-v0"], "unknown env id"),
-])
+@pytest.mark.parametrize(
+    "module, args, message",
+    [
+        ("agents.train_ppo", ["--env", "CollisionEnv/OneBalTarget-v0"], "unknown env id"),
+        ("agents.train_ppo", ["--env-kwargs", "elasticity=2"], "elasticity"),
+        ("agents.evaluate", ["/no/such/run"], "run folder not found"),
+        ("agents.main", ["--env", "Nope-v0"], "unknown env id"),
+    ],
+)
 def test_bad_input_is_a_one_line_error_without_traceback(module, args, message):
     proc = subprocess.run([sys.executable, "-m", module, *args], capture_output=True, text=True, cwd=ROOT, timeout=120)
     assert proc.returncode == 2
@@ -232,25 +334,28 @@ def test_bad_input_is_a_one_line_error_without_traceback(module, args, message):
     assert len(lines) == 1 and message in lines[0] and "Traceback" not in proc.stderr
 
 
-@pytest.mark.parametrize("command, args, message", [
-    ("train", ["--hyperparams", "{bad_yaml}"], "not valid YAML"),
-    ("train", ["--hyperparams", "{typo_yaml}"], "unknown key(s) ['n_step']"),
-    ("train", ["--hyperparams", "{gamma_yaml}"], "gamma: expected a number"),
-    ("train", ["--hyperparams", "{kwargs_yaml}"], "expected a mapping of env keywords"),
-    ("train", ["--env-kwargs", "mass_range=[1"], "cannot read the value"),
-    ("train", ["--env-kwargs", "render_mode=human"], "render_mode cannot be set"),
-    ("train", ["--seed", "-1"], "seed: expected an integer >= 0"),
-    ("train", ["--threads", "0"], "threads: expected a positive integer"),
-    ("train", ["--eval-freq", "-5"], "eval_freq"),
-    ("train", ["--env", "CartPole-v1"], "unknown env id"),
-    ("evaluate", ["{run}", "--gif", "--record-episodes", "0"], "record episodes"),
-    ("evaluate", ["{run}", "--video", "x.avi"], "expected a .gif or .mp4"),
-    ("evaluate", ["{run}", "--episodes", "-3"], "episodes"),
-    ("study", ["--timesteps", "0"], "timesteps"),
-    ("study", ["--modes", "exact:2"], "substeps must be"),
-    ("study", ["--render", "--docs", "{corrupt_docs}"], "is not a study result"),
-    ("study", ["--readme", "{corrupt_docs}/none.md"], "block to write into"),
-])
+@pytest.mark.parametrize(
+    "command, args, message",
+    [
+        ("train", ["--hyperparams", "{bad_yaml}"], "not valid YAML"),
+        ("train", ["--hyperparams", "{typo_yaml}"], "unknown key(s) ['n_step']"),
+        ("train", ["--hyperparams", "{gamma_yaml}"], "gamma: expected a number"),
+        ("train", ["--hyperparams", "{kwargs_yaml}"], "expected a mapping of env keywords"),
+        ("train", ["--env-kwargs", "mass_range=[1"], "cannot read the value"),
+        ("train", ["--env-kwargs", "render_mode=human"], "render_mode cannot be set"),
+        ("train", ["--seed", "-1"], "seed: expected an integer >= 0"),
+        ("train", ["--threads", "0"], "threads: expected a positive integer"),
+        ("train", ["--eval-freq", "-5"], "eval_freq"),
+        ("train", ["--env", "CartPole-v1"], "unknown env id"),
+        ("evaluate", ["{run}", "--gif", "--record-episodes", "0"], "record episodes"),
+        ("evaluate", ["{run}", "--video", "x.avi"], "expected a .gif or .mp4"),
+        ("evaluate", ["{run}", "--episodes", "-3"], "episodes"),
+        ("study", ["--timesteps", "0"], "timesteps"),
+        ("study", ["--modes", "exact:2"], "substeps must be"),
+        ("study", ["--render", "--docs", "{corrupt_docs}"], "is not a study result"),
+        ("study", ["--readme", "{corrupt_docs}/none.md"], "block to write into"),
+    ],
+)
 def test_bad_input_in_process_is_one_line_and_exit_2(tmp_path, capsys, command, args, message):
     (tmp_path / "bad.yml").write_text("a: [1\n")
     config.write_yaml(tmp_path / "typo.yml", {"CollisionEnv/OneBallTarget-v0": {"n_step": 256}})
@@ -260,12 +365,18 @@ def test_bad_input_in_process_is_one_line_and_exit_2(tmp_path, capsys, command, 
     (tmp_path / "docs" / "study.json").write_text("{not json")
     run = tmp_path / "run"
     if command == "evaluate":
-        run = train_ppo.main(TINY + ["--output", str(tmp_path), "--run-name", "run", "--eval-freq", "0",
-                                     "--save-freq", "0"])
+        run = train_ppo.main(
+            TINY + ["--output", str(tmp_path), "--run-name", "run", "--eval-freq", "0", "--save-freq", "0"]
+        )
         capsys.readouterr()
-    fill = {"bad_yaml": tmp_path / "bad.yml", "typo_yaml": tmp_path / "typo.yml", "gamma_yaml": tmp_path / "gamma.yml",
-            "kwargs_yaml": tmp_path / "kwargs.yml", "run": run,
-            "corrupt_docs": tmp_path / "docs"}
+    fill = {
+        "bad_yaml": tmp_path / "bad.yml",
+        "typo_yaml": tmp_path / "typo.yml",
+        "gamma_yaml": tmp_path / "gamma.yml",
+        "kwargs_yaml": tmp_path / "kwargs.yml",
+        "run": run,
+        "corrupt_docs": tmp_path / "docs",
+    }
     argv = [a.format(**fill) for a in args] + (["--output", str(tmp_path / "out")] if command == "train" else [])
     main = {"train": train_ppo.main, "evaluate": evaluate.main, "study": study.main}[command]
     with pytest.raises(SystemExit) as exit_info:

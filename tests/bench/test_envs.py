@@ -9,8 +9,20 @@ def test_env_benchmark_writes_markdown_and_readme_block(tmp_path, capsys):
     readme = tmp_path / "README.md"
     readme.write_text(f"before\n{start}\nold\n{end}\nafter\n")
     md = tmp_path / "envs.md"
-    bench.main(["--seconds", "0.05", "--num-envs", "4", "--ids", "CollisionEnv/OneBallTarget-v0",
-                "--markdown", str(md), "--readme", str(readme)])
+    bench.main(
+        [
+            "--seconds",
+            "0.05",
+            "--num-envs",
+            "4",
+            "--ids",
+            "CollisionEnv/OneBallTarget-v0",
+            "--markdown",
+            str(md),
+            "--readme",
+            str(readme),
+        ]
+    )
     table = md.read_text()
     assert "| `CollisionEnv/OneBallTarget-v0` | exact |" in table and "| `CartPole-v1` |" in table
     text = readme.read_text()

@@ -15,18 +15,22 @@ def _imp(rows):
 
 # ------------------------------------------------------------------ impact matching
 def test_match_pairs_missed_and_spurious():
-    ref = _imp([
-        (1.00, 0, 1, None, 0.0, 0.0),  # matched (run reports the pair the other way round)
-        (2.00, 0, None, "left", -2.0, 0.1),  # matched
-        (3.00, 1, 2, None, 0.5, 0.5),  # missed: the run never sees pair (1, 2): tunnelled
-        (4.00, 0, None, "top", 0.3, 1.0),  # missed: the run's top impact is too late
-    ])
-    run = _imp([
-        (1.01, 1, 0, None, 0.0, 0.02),
-        (2.02, 0, None, "left", -2.0, 0.1),
-        (2.50, 0, 2, None, 1.0, 1.0),  # spurious: the reference has no (0, 2) impact
-        (4.50, 0, None, "top", 0.3, 1.0),  # spurious: outside the window of the reference's
-    ])
+    ref = _imp(
+        [
+            (1.00, 0, 1, None, 0.0, 0.0),  # matched (run reports the pair the other way round)
+            (2.00, 0, None, "left", -2.0, 0.1),  # matched
+            (3.00, 1, 2, None, 0.5, 0.5),  # missed: the run never sees pair (1, 2): tunnelled
+            (4.00, 0, None, "top", 0.3, 1.0),  # missed: the run's top impact is too late
+        ]
+    )
+    run = _imp(
+        [
+            (1.01, 1, 0, None, 0.0, 0.02),
+            (2.02, 0, None, "left", -2.0, 0.1),
+            (2.50, 0, 2, None, 1.0, 1.0),  # spurious: the reference has no (0, 2) impact
+            (4.50, 0, None, "top", 0.3, 1.0),  # spurious: outside the window of the reference's
+        ]
+    )
     m = M.match_impacts(run, ref, window=0.1)
     assert sorted(zip(m.run_index.tolist(), m.ref_index.tolist(), strict=False)) == [(0, 0), (1, 1)]
     assert m.missed.tolist() == [2, 3]
@@ -118,16 +122,18 @@ def test_energy_momentum_helpers():
 
 
 def test_final_state_error():
-    dx, dv = M.final_state_error([[0, 0], [1, 1]], [[1, 0], [0, 0]], [[0, 0.1], [1, 1]], [[1, 0], [0, 0.5]],
-                                 radii=[0.2, 0.1], speed_scale=2.0)
+    dx, dv = M.final_state_error(
+        [[0, 0], [1, 1]], [[1, 0], [0, 0]], [[0, 0.1], [1, 1]], [[1, 0], [0, 0.5]], radii=[0.2, 0.1], speed_scale=2.0
+    )
     assert dx == pytest.approx(0.5)
     assert dv == pytest.approx(0.25)
 
 
 def test_escapes_penetration_overlap():
     bounds = (-1.0, -1.0, 1.0, 1.0)
-    pos = np.array([[[0.0, 0.0], [0.95, 0.0], [0.0, 0.5]],
-                    [[0.0, 0.0], [1.05, 0.0], [0.0, 0.5]]])  # ball 1 crosses the right wall at t=1
+    pos = np.array(
+        [[[0.0, 0.0], [0.95, 0.0], [0.0, 0.5]], [[0.0, 0.0], [1.05, 0.0], [0.0, 0.5]]]
+    )  # ball 1 crosses the right wall at t=1
     r = np.array([0.1, 0.1, 0.3])
     assert M.escapes(pos, bounds).tolist() == [False, True, False]
     assert M.escapes(pos[0], bounds).tolist() == [False, False, False]

@@ -24,9 +24,15 @@ def test_a_gas_on_the_grid_stays_valid_and_collides_at_enskogs_rate():
 
 
 def test_the_report_renders_every_size():
-    results = {"machine": "m", "cpus": 2, "timestamp": "t", "versions": {"numpy": "1", "numba": "2"},
-               "first_call_s": 1.0, "seconds": 3.0,
-               "sizes": [scale.bench_size(n, log=lambda *_: None) for n in (100, 200)],
-               "frames": scale.bench_frames(n=20, horizon=1.0, repeats=1)}
+    results = {
+        "machine": "m",
+        "cpus": 2,
+        "timestamp": "t",
+        "versions": {"numpy": "1", "numba": "2"},
+        "first_call_s": 1.0,
+        "seconds": 3.0,
+        "sizes": [scale.bench_size(n, log=lambda *_: None) for n in (100, 200)],
+        "frames": scale.bench_frames(n=20, horizon=1.0, repeats=1),
+    }
     text = scale.render_markdown(results)
     assert "| 100 |" in text and "| 200 |" in text and "frames keep" in text

@@ -32,8 +32,15 @@ def test_every_scene_builds_valid_cases(name):
 
 
 def test_sweep_case_exact_is_its_own_reference_and_naive_is_not():
-    rows = sweep_case(SCENES["explore_2d"], 2, [EngineRunner("naive"), EngineRunner("exact")], (0.01,),
-                      min_time=0.0, max_repeats=1, log=lambda *_: None)
+    rows = sweep_case(
+        SCENES["explore_2d"],
+        2,
+        [EngineRunner("naive"), EngineRunner("exact")],
+        (0.01,),
+        min_time=0.0,
+        max_repeats=1,
+        log=lambda *_: None,
+    )
     by = {r["family"]: r for r in rows}
     exact, naive = by["exact"], by["naive"]
     assert exact["status"] == naive["status"] == "ok"
@@ -91,11 +98,24 @@ def test_extremes_cells_pass_and_fail_as_they_should():
 
 def test_summary_thresholds_on_synthetic_rows():
     def row(fam, s, err, missed=0, e=1.0):
-        return {"status": "ok", "family": fam, "speed_dt_over_r": s, "pos_err": err, "missed": missed,
-                "spurious": 0, "elasticity": e, "scene": "gas" if e == 1.0 else "pile", "n": 4}
+        return {
+            "status": "ok",
+            "family": fam,
+            "speed_dt_over_r": s,
+            "pos_err": err,
+            "missed": missed,
+            "spurious": 0,
+            "elasticity": e,
+            "scene": "gas" if e == 1.0 else "pile",
+            "n": 4,
+        }
 
-    rows = [row("posteriori k=1", 0.01, 1e-12), row("posteriori k=1", 0.1, 1e-4), row("posteriori k=1", 1.0, 0.5, 3),
-            row("posteriori k=1", 0.05, 1e-2, e=0.5)]
+    rows = [
+        row("posteriori k=1", 0.01, 1e-12),
+        row("posteriori k=1", 0.1, 1e-4),
+        row("posteriori k=1", 1.0, 0.5, 3),
+        row("posteriori k=1", 0.05, 1e-2, e=0.5),
+    ]
     elastic = report.ELASTIC[1]
     assert report.thresholds(rows, "posteriori k=1", 1e-6, where=elastic) == (0.1, 1, 3)
     assert report.thresholds(rows, "posteriori k=1", 1e-3, where=elastic) == (1.0, 2, 3)
@@ -109,8 +129,16 @@ def test_summary_thresholds_on_synthetic_rows():
 
 
 def test_csv_round_trip(tmp_path):
-    rows = [{"scene": "intro", "n": np.int64(2), "dt": np.float64(0.01), "cap_reached": np.bool_(False),
-             "note": "", "pos_err": float("nan")}]
+    rows = [
+        {
+            "scene": "intro",
+            "n": np.int64(2),
+            "dt": np.float64(0.01),
+            "cap_reached": np.bool_(False),
+            "note": "",
+            "pos_err": float("nan"),
+        }
+    ]
     path = tmp_path / "x.csv"
     report.write_csv(path, rows, ("scene", "n", "dt", "cap_reached", "note", "pos_err"))
     back = report.read_csv(path)[0]

@@ -44,10 +44,24 @@ def test_python_fallback_matches_compiled_kernels():
 
 def test_models_report_what_the_scene_needs():
     one = Simulator(Scene(bounds=None), [[0, 0]], [[1, 0]], [1.0])
-    assert one.models | {"backend": None} == {"mode": "exact", "substeps": 1, "dimension": 2, "walls": False,
-                                              "ball_pairs": False, "clusters": False, "backend": None}
-    stick = Simulator(Scene(elasticity=0, inelastic="stick", dimension=1, bounds=(-2, -0.5, 2, 0.5)),
-                      [[-1, 0], [1, 0]], [[1, 0], [0, 0]], [1, 1], mode="naive", substeps=3)
+    assert one.models | {"backend": None} == {
+        "mode": "exact",
+        "substeps": 1,
+        "dimension": 2,
+        "walls": False,
+        "ball_pairs": False,
+        "clusters": False,
+        "backend": None,
+    }
+    stick = Simulator(
+        Scene(elasticity=0, inelastic="stick", dimension=1, bounds=(-2, -0.5, 2, 0.5)),
+        [[-1, 0], [1, 0]],
+        [[1, 0], [0, 0]],
+        [1, 1],
+        mode="naive",
+        substeps=3,
+    )
     assert stick.models["clusters"] and stick.models["ball_pairs"] and stick.models["dimension"] == 1
-    assert not Simulator(Scene(elasticity=0, inelastic="stick", ball_collisions=False), [[-1, 0], [1, 0]],
-                         [[1, 0], [0, 0]], [1, 1]).models["clusters"]
+    assert not Simulator(
+        Scene(elasticity=0, inelastic="stick", ball_collisions=False), [[-1, 0], [1, 0]], [[1, 0], [0, 0]], [1, 1]
+    ).models["clusters"]

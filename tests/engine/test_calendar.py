@@ -29,8 +29,15 @@ def gas(n, phi=0.3, r=0.01, seed=0, speed=1.0):
 
 def fresh_copy(sim):
     """A simulator that has never predicted anything, in ``sim``'s state."""
-    new = Simulator(sim.scene, sim.positions, sim.velocities, sim.masses, radii=sim.radii, mode=sim.mode,
-                    max_events=sim.batch.max_events)
+    new = Simulator(
+        sim.scene,
+        sim.positions,
+        sim.velocities,
+        sim.masses,
+        radii=sim.radii,
+        mode=sim.mode,
+        max_events=sim.batch.max_events,
+    )
     new.set_state(sim.get_state())
     return new
 

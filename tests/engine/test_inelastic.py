@@ -42,9 +42,12 @@ def test_stick_glancing_cluster_rotates_rigidly_then_stops_at_wall():
     d1 = np.array([0.6, 0.12]) - com0
     L0 = 0.3 * (d1[0] * 0.0 - d1[1] * -1.0) - 1.8 * 0.0  # about the moving COM: r x m(v - v_cm)
     vcm = p0 / m.sum()
-    L0 = sum(mi * ((pi - com0)[0] * (vi - vcm)[1] - (pi - com0)[1] * (vi - vcm)[0])
-             for mi, pi, vi in zip(m, [np.array([-0.65, 0]), np.array([0.6, 0.12])],
-                                   [np.zeros(2), np.array([-1.0, 0])], strict=True))
+    L0 = sum(
+        mi * ((pi - com0)[0] * (vi - vcm)[1] - (pi - com0)[1] * (vi - vcm)[0])
+        for mi, pi, vi in zip(
+            m, [np.array([-0.65, 0]), np.array([0.6, 0.12])], [np.zeros(2), np.array([-1.0, 0])], strict=True
+        )
+    )
     assert angular_momentum(sim) == pytest.approx(L0, rel=1e-12)
     assert abs(L0) > 1e-3
     stopped = False
@@ -149,8 +152,7 @@ def test_three_ball_collapse_with_wall_is_bounded():
     # Zhou & Kadanoff: three particles in 1D collapse for e < 7 - 4 sqrt(3) ~ 0.072.
     r = 0.05
     scene = Scene(bounds=(-1.0, -0.5, 100.0, 0.5), elasticity=0.05, dimension=1)
-    sim = Simulator(scene, [[-1 + r, 0], [-0.5, 0], [0.0, 0]], [[0, 0], [0, 0], [-1.0, 0]], [1, 1, 1],
-                    radii=[r] * 3)
+    sim = Simulator(scene, [[-1 + r, 0], [-0.5, 0], [0.0, 0]], [[0, 0], [0, 0], [-1.0, 0]], [1, 1, 1], radii=[r] * 3)
     total = sum(len(sim.step(0.5)) for _ in range(10))
     assert 3 < total < 500 and not sim.cap_reached
     _valid(sim)
@@ -161,8 +163,9 @@ def test_light_ball_pressed_by_a_far_heavier_one_settles_at_once(ratio):
     # A light ball between a wall and a ball M/m times heavier: sequential impulses would need
     # about M/m sweeps at one instant; the cascade is replaced by its limit (the heavy ball stops).
     scene = Scene(bounds=(-2.0, -0.55, 1e4, 0.55), elasticity=0.05, dimension=1)
-    sim = Simulator(scene, [[-1.0, 0.0], [0.0, 0.0]], [[0.0, 0.0], [-1.0, 0.0]], [1.0, ratio], radii=[0.1, 0.1],
-                    max_events=10_000)
+    sim = Simulator(
+        scene, [[-1.0, 0.0], [0.0, 0.0]], [[0.0, 0.0], [-1.0, 0.0]], [1.0, ratio], radii=[0.1, 0.1], max_events=10_000
+    )
     energy = sim.kinetic_energy()
     start = time.perf_counter()
     for _ in range(200):
@@ -179,8 +182,9 @@ def test_corner_pile_with_a_heavy_ball_settles_at_once_2d():
     # Two light balls in a corner, a 1e10 times heavier ball driven diagonally into them.
     r = 0.1
     pos = [[-2 + r, -1 + r], [-2 + r, -1 + 3 * r], [-1.0, -0.5]]
-    sim = Simulator(Scene(elasticity=0.05), pos, [[0, 0], [0, 0], [-1.2, -0.6]], [1.0, 2.0, 1e10],
-                    radii=[r] * 3, max_events=10_000)
+    sim = Simulator(
+        Scene(elasticity=0.05), pos, [[0, 0], [0, 0], [-1.2, -0.6]], [1.0, 2.0, 1e10], radii=[r] * 3, max_events=10_000
+    )
     energy = sim.kinetic_energy()
     start = time.perf_counter()
     for _ in range(120):
@@ -194,8 +198,9 @@ def test_corner_pile_with_a_heavy_ball_settles_at_once_2d():
 
 def test_event_cap_is_reported_and_leaves_a_valid_state():
     scene = Scene(bounds=(0.0, -1.0, 1e9, 1.0), dimension=1)
-    sim = Simulator(scene, [[1.0, 0.0], [2.0, 0.0]], [[0.0, 0.0], [-1.0, 0.0]], [1.0, 1e6], radii=[0.1, 0.1],
-                    max_events=100)
+    sim = Simulator(
+        scene, [[1.0, 0.0], [2.0, 0.0]], [[0.0, 0.0], [-1.0, 0.0]], [1.0, 1e6], radii=[0.1, 0.1], max_events=100
+    )
     with pytest.warns(EventCapWarning, match="event cap of 100"):
         hits = sim.step(10.0)
     assert len(hits) == 100 and sim.cap_reached

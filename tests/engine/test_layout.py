@@ -12,8 +12,16 @@ from collision_env.engine import layout
 @pytest.mark.parametrize("name", sorted(layout.LAYOUTS))
 def test_each_field_has_the_constant_of_its_position(name):
     fields = layout.LAYOUTS[name]
-    prefix = {"BALL": "B_", "CAL_F": "C_", "CAL_I": "C_", "HEAP": "H_", "SCENE_F": "S_", "SCENE_I": "S_",
-              "WORK_F": "W_", "WORK_I": "W_"}[name]
+    prefix = {
+        "BALL": "B_",
+        "CAL_F": "C_",
+        "CAL_I": "C_",
+        "HEAP": "H_",
+        "SCENE_F": "S_",
+        "SCENE_I": "S_",
+        "WORK_F": "W_",
+        "WORK_I": "W_",
+    }[name]
     assert len(set(fields)) == len(fields)
     for position, field in enumerate(fields):
         constant = prefix + re.sub(r"\W", "_", field).upper()

@@ -107,8 +107,9 @@ def test_batched_impacts_come_by_scene_then_in_the_order_they_happened(mode, sub
     b, n = 3, 6
     pos = np.stack([np.column_stack([np.linspace(-1.6, 1.6, n), rng.uniform(-0.6, 0.6, n)]) for _ in range(b)])
     vel = rng.normal(size=(b, n, 2)) * 3.0
-    sim = BatchSimulator(Scene(elasticity=0.9), pos, vel, np.ones((b, n)), radii=np.full((b, n), 0.12), mode=mode,
-                         substeps=substeps)
+    sim = BatchSimulator(
+        Scene(elasticity=0.9), pos, vel, np.ones((b, n)), radii=np.full((b, n), 0.12), mode=mode, substeps=substeps
+    )
     seen = 0
     for dt in [0.2] * 10 + [-0.2] * 5:
         rows = sim.step(dt)
@@ -131,8 +132,7 @@ def test_a_step_too_big_for_the_impact_buffer_resumes_and_matches_single_scenes(
     grid = np.array([[x, y] for x in np.linspace(-1.6, 1.6, 4) for y in (-0.5, 0.5)])
     pos = np.stack([grid + rng.uniform(-0.05, 0.05, grid.shape) for _ in range(b)])
     vel = rng.normal(size=(b, n, 2)) * 2.0
-    batch = BatchSimulator(Scene(), pos, vel, np.ones((b, n)), radii=np.full((b, n), r), mode=mode,
-                           substeps=substeps)
+    batch = BatchSimulator(Scene(), pos, vel, np.ones((b, n)), radii=np.full((b, n), r), mode=mode, substeps=substeps)
     rows = batch.step(4.0)
     assert len(rows) > len(batch._imp)  # the step really stalled at least once
     assert np.all(np.diff(rows["scene"]) >= 0)
@@ -141,7 +141,8 @@ def test_a_step_too_big_for_the_impact_buffer_resumes_and_matches_single_scenes(
         hits = single.step(4.0)
         mine = rows[rows["scene"] == s]
         assert [(h.ball, h.other if h.other is not None else -1) for h in hits] == list(
-            zip(mine["ball"].tolist(), mine["other"].tolist(), strict=True))
+            zip(mine["ball"].tolist(), mine["other"].tolist(), strict=True)
+        )
         if mode != "exact":  # the fixed-step modes are bit for bit the same
             assert [h.time for h in hits] == mine["time"].tolist()
             np.testing.assert_array_equal(single.positions, batch.positions[s])

@@ -9,8 +9,9 @@ from collision_env.engine import PLAY_AREA_1D, Scene, Simulator, radius_from_mas
 
 
 def test_radius_rule_matches_phet():
-    np.testing.assert_allclose(radius_from_mass([0.1, 0.5, 1.0, 1.5, 3.0]),
-                               [0.08803, 0.150524, 0.18965, 0.217093, 0.27352], atol=5e-6)
+    np.testing.assert_allclose(
+        radius_from_mass([0.1, 0.5, 1.0, 1.5, 3.0]), [0.08803, 0.150524, 0.18965, 0.217093, 0.27352], atol=5e-6
+    )
 
 
 def test_phet_intro_head_on():
@@ -73,8 +74,14 @@ def test_energy_loss_and_momentum_per_collision(e, masses):
 def _galperin(k, max_events):
     """A wall at x = 0 (left border), a light ball at rest, a heavy one coming in: floor(pi 10^k)."""
     scene = Scene(bounds=(0.0, -1.0, 1e9, 1.0), dimension=1)
-    sim = Simulator(scene, [[1.0, 0.0], [2.0, 0.0]], [[0.0, 0.0], [-1.0, 0.0]], [1.0, 100.0**k],
-                    radii=[0.1, 0.1], max_events=max_events)
+    sim = Simulator(
+        scene,
+        [[1.0, 0.0], [2.0, 0.0]],
+        [[0.0, 0.0], [-1.0, 0.0]],
+        [1.0, 100.0**k],
+        radii=[0.1, 0.1],
+        max_events=max_events,
+    )
     count = 0
     for _ in range(100):
         count += len(sim.step(10.0))

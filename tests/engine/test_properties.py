@@ -39,8 +39,12 @@ def scenes(draw):
     cx = -2 + (cells % 6 + 0.5) * (4 / 6)
     cy = -1 + (cells // 6 + 0.5) * (2 / 3) if dim == 2 else np.zeros(n)
     slack = 4 / 12 - radius
-    pos = np.column_stack([cx + rng.uniform(-1, 1, n) * slack,
-                           cy + (rng.uniform(-1, 1, n) * np.minimum(slack, 1 / 3 - radius) if dim == 2 else 0)])
+    pos = np.column_stack(
+        [
+            cx + rng.uniform(-1, 1, n) * slack,
+            cy + (rng.uniform(-1, 1, n) * np.minimum(slack, 1 / 3 - radius) if dim == 2 else 0),
+        ]
+    )
     vel = rng.normal(size=(n, 2)) * speed
     if dim == 1:
         vel[:, 1] = 0.0
@@ -101,9 +105,15 @@ def test_batch_of_scenes_equals_scenes_one_by_one(case):
     sim, dt = case
     other = sim.copy()
     other.nudge(np.where(sim.scene.dimension == 1, [1.0, 0.0], [1.0, -0.5]) * 0.1 * np.ones((sim.batch.num_balls, 2)))
-    batch = BatchSimulator(sim.scene, [sim.positions, other.positions], [sim.velocities, other.velocities],
-                           [sim.masses, other.masses], [sim.radii, other.radii], mode=sim.mode,
-                           substeps=sim.batch.substeps)
+    batch = BatchSimulator(
+        sim.scene,
+        [sim.positions, other.positions],
+        [sim.velocities, other.velocities],
+        [sim.masses, other.masses],
+        [sim.radii, other.radii],
+        mode=sim.mode,
+        substeps=sim.batch.substeps,
+    )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", EventCapWarning)
         for _ in range(4):
@@ -112,7 +122,8 @@ def test_batch_of_scenes_equals_scenes_one_by_one(case):
             for k, impacts in enumerate(singles):
                 mine = rows[rows["scene"] == k]
                 assert len(mine) == len(impacts)
-                assert [(h.ball, h.time) for h in impacts] == list(zip(mine["ball"].tolist(), mine["time"].tolist(),
-                                                                     strict=True))
+                assert [(h.ball, h.time) for h in impacts] == list(
+                    zip(mine["ball"].tolist(), mine["time"].tolist(), strict=True)
+                )
     np.testing.assert_array_equal(batch.positions, [sim.positions, other.positions])
     np.testing.assert_array_equal(batch.velocities, [sim.velocities, other.velocities])

@@ -41,8 +41,13 @@ def _step_all(sim, dt, steps):
     e=st.sampled_from([0.0, 0.05, 0.5, 0.999]),
 )
 def test_an_oblique_collision_is_reported_once(b, v, log_mass, e):
-    sim = Simulator(Scene(bounds=None, elasticity=e), [[-0.5, 0.0], [0.5, b]], [[v, 0.0], [-0.5 * v, 0.0]],
-                    [1.0, 10.0**log_mass], [0.1, 0.1])
+    sim = Simulator(
+        Scene(bounds=None, elasticity=e),
+        [[-0.5, 0.0], [0.5, b]],
+        [[v, 0.0], [-0.5 * v, 0.0]],
+        [1.0, 10.0**log_mass],
+        [0.1, 0.1],
+    )
     hits = _step_all(sim, 2.0 / v, 1)
     assert len(hits) == 1, [(h.time, h.speed) for h in hits]
     assert hits[0].speed == pytest.approx(1.5 * v * math.sqrt(1 - (b / 0.2) ** 2), rel=1e-9)
@@ -66,10 +71,22 @@ def _squeeze(ratio, e, dim):
     """A ball ``ratio`` times heavier presses a light ball at rest against the left wall."""
     r = 0.1
     if dim == 1:
-        return Simulator(Scene(bounds=PLAY_AREA_1D, elasticity=e, dimension=1), [[-2 + r, 0.0], [-1.5, 0.0]],
-                         [[0.0, 0.0], [-1.0, 0.0]], [1.0, ratio], [r, r], max_events=2000)
-    return Simulator(Scene(bounds=PLAY_AREA_2D, elasticity=e), [[-2 + r, 0.1], [-1.5, 0.2]],
-                     [[0.0, 0.0], [-1.0, 0.2]], [1.0, ratio], [r, r], max_events=2000)
+        return Simulator(
+            Scene(bounds=PLAY_AREA_1D, elasticity=e, dimension=1),
+            [[-2 + r, 0.0], [-1.5, 0.0]],
+            [[0.0, 0.0], [-1.0, 0.0]],
+            [1.0, ratio],
+            [r, r],
+            max_events=2000,
+        )
+    return Simulator(
+        Scene(bounds=PLAY_AREA_2D, elasticity=e),
+        [[-2 + r, 0.1], [-1.5, 0.2]],
+        [[0.0, 0.0], [-1.0, 0.2]],
+        [1.0, ratio],
+        [r, r],
+        max_events=2000,
+    )
 
 
 @SLOW
@@ -114,8 +131,13 @@ def _sequence(sim, dt, steps):
 def test_a_near_contact_far_from_the_origin_is_not_a_contact(gap, e, offset):
     # ball 0 rests ``gap`` from the left wall; ball 1 hits it. Only then does ball 0 reach the wall.
     r = 0.1
-    case = (Scene(bounds=PLAY_AREA_1D, elasticity=e, dimension=1), [[-2 + r + gap, 0.0], [-1.0, 0.0]],
-            [[0.0, 0.0], [-1.0, 0.0]], [1.0, 1.0], [r, r])
+    case = (
+        Scene(bounds=PLAY_AREA_1D, elasticity=e, dimension=1),
+        [[-2 + r + gap, 0.0], [-1.0, 0.0]],
+        [[0.0, 0.0], [-1.0, 0.0]],
+        [1.0, 1.0],
+        [r, r],
+    )
     near, far = _shifted(case, 0.0), _shifted(case, offset)
     seq0, t0 = _sequence(near, 0.1, 12)
     seq1, t1 = _sequence(far, 0.1, 12)
@@ -187,8 +209,13 @@ def test_the_clock_compensation_is_part_of_the_state():
 def _slow_pair(e, slow, fast):
     """A slow head-on pair (closing at ``2 slow``) in the middle; ball 2 far away, at ``fast``."""
     r = 0.1
-    return Simulator(Scene(bounds=None, elasticity=e), [[-r - slow, 0.0], [r + slow, 0.0], [50.0, 50.0]],
-                     [[slow, 0.0], [-slow, 0.0], [fast, fast]], [1.0, 1.0, 1.0], [r, r, r])
+    return Simulator(
+        Scene(bounds=None, elasticity=e),
+        [[-r - slow, 0.0], [r + slow, 0.0], [50.0, 50.0]],
+        [[slow, 0.0], [-slow, 0.0], [fast, fast]],
+        [1.0, 1.0, 1.0],
+        [r, r, r],
+    )
 
 
 @SLOW
@@ -364,8 +391,9 @@ def test_dt_must_be_a_real_number(dt):
     assert sim.time == 0.0
 
 
-@pytest.mark.parametrize("kwargs", [dict(collapse_ratio=True), dict(collapse_floor="0"), dict(max_events=True),
-                                    dict(mode=1)])
+@pytest.mark.parametrize(
+    "kwargs", [dict(collapse_ratio=True), dict(collapse_floor="0"), dict(max_events=True), dict(mode=1)]
+)
 def test_settings_are_type_checked(kwargs):
     with pytest.raises(ValueError, match=next(iter(kwargs))):
         _make(**kwargs)
@@ -375,9 +403,16 @@ def test_settings_are_type_checked(kwargs):
 def test_numpy_scalar_types_are_accepted_wherever_numbers_are(real):
     scene = Scene(bounds=tuple(real(v) for v in (-2, -1, 2, 1)), elasticity=real(1), dimension=np.int64(2))
     pos = [[real(-1), real(0)], [real(1), real(0)]]
-    sim = Simulator(scene, pos, [[real(1), real(0)], [real(-1), real(0)]], [real(1), real(2)],
-                    [real(1) / 4, real(1) / 4], max_events=np.int64(100), collapse_ratio=np.float32(1e-9),
-                    collapse_floor=real(0))
+    sim = Simulator(
+        scene,
+        pos,
+        [[real(1), real(0)], [real(-1), real(0)]],
+        [real(1), real(2)],
+        [real(1) / 4, real(1) / 4],
+        max_events=np.int64(100),
+        collapse_ratio=np.float32(1e-9),
+        collapse_floor=real(0),
+    )
     sim.step(real(1))
     sim.batch.set_scenes([0], [pos], [[[real(0), real(0)], [real(0), real(0)]]], time=real(2))
     sim.nudge([[real(1), real(0)], [real(0), real(0)]])
@@ -388,8 +423,11 @@ def test_set_state_type_checks_its_fields():
     sim = _make()
     state = sim.get_state()
     before = sim.get_state()
-    for key, bad in (("positions", state["positions"].astype(complex)), ("time", np.array("0.0")),
-                     ("masses", np.array([1.0, math.nan]))):
+    for key, bad in (
+        ("positions", state["positions"].astype(complex)),
+        ("time", np.array("0.0")),
+        ("masses", np.array([1.0, math.nan])),
+    ):
         with pytest.raises(ValueError, match=f"state {key}"):
             sim.set_state({**state, key: bad})
     for key, value in sim.get_state().items():

@@ -31,10 +31,14 @@ def make(**changes):
         (dict(positions=[[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]]), "positions: expected shape"),
         (dict(velocities=[[1.0, 0.0]]), "velocities: expected shape"),
         (dict(masses=[1.0, 2.0, 3.0]), "masses: expected shape"),
-        (dict(scene=Scene(dimension=1, bounds=(-2, -0.55, 2, 0.55)), velocities=[[1, 0.5], [0, 0]]),
-         "ball 0: velocity y must be 0 in a 1D scene"),
-        (dict(scene=Scene(dimension=1, bounds=(-2, -0.55, 2, 0.55)), positions=[[-1, 0], [1, 0.1]]),
-         "ball 1: position y must be 0 in a 1D scene"),
+        (
+            dict(scene=Scene(dimension=1, bounds=(-2, -0.55, 2, 0.55)), velocities=[[1, 0.5], [0, 0]]),
+            "ball 0: velocity y must be 0 in a 1D scene",
+        ),
+        (
+            dict(scene=Scene(dimension=1, bounds=(-2, -0.55, 2, 0.55)), positions=[[-1, 0], [1, 0.1]]),
+            "ball 1: position y must be 0 in a 1D scene",
+        ),
         (dict(mode="fast"), "mode: must be one of"),
         (dict(substeps=0), "substeps: must be a positive integer"),
         (dict(substeps=4), "substeps: exact mode"),
@@ -69,8 +73,10 @@ def test_touching_balls_are_allowed():
     assert sim.step(0.1)  # they collide at once
 
 
-@pytest.mark.parametrize("dt, message", [(math.nan, "dt: must be finite"), (math.inf, "dt: must be finite"),
-                                         ("soon", "dt: expected a number")])
+@pytest.mark.parametrize(
+    "dt, message",
+    [(math.nan, "dt: must be finite"), (math.inf, "dt: must be finite"), ("soon", "dt: expected a number")],
+)
 def test_step_rejects_bad_dt_and_keeps_state(dt, message):
     sim = make()
     before = sim.get_state()

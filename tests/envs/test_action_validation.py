@@ -41,8 +41,9 @@ def test_a_non_real_vector_action_raises(action):
             envs.step(np.stack([action, action]))
 
 
-@pytest.mark.parametrize("action", [[0.5, 0.0], (np.float32(0.5), np.int64(0)), np.array([0.5, 0.0], np.float16),
-                                    np.array([1, 0])])
+@pytest.mark.parametrize(
+    "action", [[0.5, 0.0], (np.float32(0.5), np.int64(0)), np.array([0.5, 0.0], np.float16), np.array([1, 0])]
+)
 def test_real_actions_of_any_numeric_type_are_taken(action):
     env = gym.make("CollisionEnv/OneBallTarget-v0").unwrapped
     env.reset(seed=0)

@@ -129,13 +129,33 @@ def test_generic_env_reaches_every_preset():
     assert set(PRESETS) == set(PRESET_IDS)
 
 
-@pytest.mark.parametrize("kwargs", [
-    {"n_balls": -1}, {"n_balls": 0}, {"mode": "fast"}, {"elasticity": 1.5}, {"elasticity": -0.1},
-    {"dt": 0.0}, {"dt": float("nan")}, {"substeps": 0}, {"mode": "exact", "substeps": 3}, {"max_dv": -1.0},
-    {"controlled": (5,)}, {"target_walls": ("ceiling",)}, {"window": 100.0}, {"n_targets": 0},
-    {"scorers": "cluster"}, {"preset": "snooker"}, {"mass_range": (0.0, 1.0)}, {"radius": -0.1},
-    {"n_balls": 400}, {"target_width": 10.0}, {"render_mode": "ansi"}, {"max_events": 0},
-])
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {"n_balls": -1},
+        {"n_balls": 0},
+        {"mode": "fast"},
+        {"elasticity": 1.5},
+        {"elasticity": -0.1},
+        {"dt": 0.0},
+        {"dt": float("nan")},
+        {"substeps": 0},
+        {"mode": "exact", "substeps": 3},
+        {"max_dv": -1.0},
+        {"controlled": (5,)},
+        {"target_walls": ("ceiling",)},
+        {"window": 100.0},
+        {"n_targets": 0},
+        {"scorers": "cluster"},
+        {"preset": "snooker"},
+        {"mass_range": (0.0, 1.0)},
+        {"radius": -0.1},
+        {"n_balls": 400},
+        {"target_width": 10.0},
+        {"render_mode": "ansi"},
+        {"max_events": 0},
+    ],
+)
 @pytest.mark.filterwarnings("ignore:.*render_mode")
 def test_bad_kwargs_raise_value_error_at_make(kwargs):
     env_id = "CollisionEnv/Target-v0" if "preset" in kwargs else "CollisionEnv/OneBallTarget-v0"
@@ -179,8 +199,12 @@ def test_info_nudge_is_the_requested_velocity_change_and_its_cost_is_charged():
     _, info = env.reset(seed=2)
     assert info["nudge"] == 0.0
     cfg = env.config
-    for action, size in (([1.0, 0.0], cfg.max_dv), ([3.0, 0.0], cfg.max_dv), ([-1.0, 1.0], cfg.max_dv * 2**0.5),
-                         ([0.0, 0.0], 0.0)):
+    for action, size in (
+        ([1.0, 0.0], cfg.max_dv),
+        ([3.0, 0.0], cfg.max_dv),
+        ([-1.0, 1.0], cfg.max_dv * 2**0.5),
+        ([0.0, 0.0], 0.0),
+    ):
         _, reward, _, _, info = env.step(np.array(action, np.float32))
         assert type(info["nudge"]) is float and info["nudge"] == pytest.approx(size, rel=1e-6)
         assert reward == pytest.approx(-cfg.action_cost * size, rel=1e-6) and len(info["impacts"]) == 0

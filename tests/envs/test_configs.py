@@ -13,7 +13,9 @@ def configs(draw):
     n = draw(st.integers(1, 4 if dim == 1 else 5))
     stick = n >= 2 and dim == 2 and draw(st.booleans())
     cfg = dict(
-        preset=None, dimension=dim, n_balls=n,
+        preset=None,
+        dimension=dim,
+        n_balls=n,
         elasticity=0.0 if stick else draw(st.sampled_from([0.0, 0.5, 0.9, 1.0])),
         inelastic="stick" if stick else draw(st.sampled_from(["slip", "stick"])),
         ball_collisions=True if stick else draw(st.booleans()),
@@ -23,10 +25,14 @@ def configs(draw):
         speed_range=(0.0, draw(st.sampled_from([0.0, 0.5, 2.0]))),
         others_speed_range=(0.0, draw(st.sampled_from([0.0, 1.0]))),
         controlled=tuple(range(draw(st.integers(1, n)))),
-        n_targets=draw(st.integers(1, 3)), sequential=draw(st.booleans()),
-        window=draw(st.sampled_from([None, 1.5])), target_width=draw(st.sampled_from([0.3, 1.0])),
-        shaping=draw(st.sampled_from([0.0, 1.0])), miss_penalty=draw(st.sampled_from([0.0, 0.1])),
-        dt=draw(st.sampled_from([0.02, 0.05, 0.2])), time_limit=3.0,
+        n_targets=draw(st.integers(1, 3)),
+        sequential=draw(st.booleans()),
+        window=draw(st.sampled_from([None, 1.5])),
+        target_width=draw(st.sampled_from([0.3, 1.0])),
+        shaping=draw(st.sampled_from([0.0, 1.0])),
+        miss_penalty=draw(st.sampled_from([0.0, 0.1])),
+        dt=draw(st.sampled_from([0.02, 0.05, 0.2])),
+        time_limit=3.0,
     )
     scorers = ["any", "controlled"] + (["others"] if len(cfg["controlled"]) < n else [])
     scorers += ["cluster"] if stick else []

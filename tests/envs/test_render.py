@@ -33,7 +33,7 @@ def test_impact_flash_is_drawn_at_the_contact_point():
         _, _, term, trunc, info = env.step(np.zeros(2, np.float32))
         if len(info["impacts"]):
             break
-    (x, y), = info["impacts"].point
+    ((x, y),) = info["impacts"].point
     with_flash = env.render()
     env._renderer._flashes.clear()
     without = env.render()

@@ -23,8 +23,9 @@ from collision_env.envs.scripted import (
 )
 
 
-@pytest.mark.parametrize("env_id", ["CollisionEnv/OneBallTarget-v0", "CollisionEnv/Target-v0",
-                                    "CollisionEnv/MultiBall-v0"])
+@pytest.mark.parametrize(
+    "env_id", ["CollisionEnv/OneBallTarget-v0", "CollisionEnv/Target-v0", "CollisionEnv/MultiBall-v0"]
+)
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_aimer_hits_every_target(env_id, seed):
     env = gym.make(env_id).unwrapped
@@ -36,8 +37,12 @@ def test_aimer_hits_every_target(env_id, seed):
         obs, reward, term, trunc, info = env.step(aim())
         if info["targets_hit"] > hits:
             hits = info["targets_hit"]
-            assert any(on_target(env.core, 0, k, r["wall"], r["x"], r["y"], r["time"])
-                       for r in info["impacts"].records if r["wall"] >= 0 for k in pending)
+            assert any(
+                on_target(env.core, 0, k, r["wall"], r["x"], r["y"], r["time"])
+                for r in info["impacts"].records
+                if r["wall"] >= 0
+                for k in pending
+            )
             assert reward > 0.5
         if term or trunc:
             break
@@ -54,8 +59,12 @@ def replay_and_check(env, plan, hit_step, predicted, horizon):
     assert np.array_equal(info["impacts"].records, predicted)  # exactly the predicted impacts
     newly = np.flatnonzero((before == 0) & (env.core.t_status[0] == 1))
     assert len(newly) >= 1
-    assert any(on_target(env.core, 0, k, r["wall"], r["x"], r["y"], r["time"])
-               for k in newly for r in predicted if r["wall"] >= 0)
+    assert any(
+        on_target(env.core, 0, k, r["wall"], r["x"], r["y"], r["time"])
+        for k in newly
+        for r in predicted
+        if r["wall"] >= 0
+    )
     assert reward >= env.config.hit_reward - 0.1
 
 
@@ -93,8 +102,9 @@ def test_line_1d_hits_an_end_wall_inside_a_window(seed):
     replay_and_check(env, plan, t_hit, predicted, env.config.n_steps)
 
 
-@pytest.mark.parametrize("env_id", ["CollisionEnv/Billiards-v0", "CollisionEnv/InelasticCluster-v0",
-                                    "CollisionEnv/Line1D-v0"])
+@pytest.mark.parametrize(
+    "env_id", ["CollisionEnv/Billiards-v0", "CollisionEnv/InelasticCluster-v0", "CollisionEnv/Line1D-v0"]
+)
 def test_scripted_policy_scores_in_a_full_episode(env_id):
     env = gym.make(env_id).unwrapped
     env.reset(seed=0)

@@ -15,20 +15,25 @@ MODULE_ID = f"collision_env:{ENV_ID}"
 
 def fresh_python(code: str, **env) -> subprocess.CompletedProcess:
     """Run ``code`` in a new interpreter (nothing of this test process imported)."""
-    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300,
-                          env={**os.environ, **env})
+    return subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=300, env={**os.environ, **env}
+    )
 
 
-@pytest.mark.parametrize("code", [
-    # the bare id, after importing the package (the README's first example)
-    f"import gymnasium as gym, collision_env; env = gym.make({ENV_ID!r})",
-    # the module:id form imports the package itself (for tools that only take an id)
-    f"import gymnasium as gym; env = gym.make({MODULE_ID!r})",
-    f"import gymnasium as gym; env = gym.make_vec({MODULE_ID!r}, num_envs=2)",
-])
+@pytest.mark.parametrize(
+    "code",
+    [
+        # the bare id, after importing the package (the README's first example)
+        f"import gymnasium as gym, collision_env; env = gym.make({ENV_ID!r})",
+        # the module:id form imports the package itself (for tools that only take an id)
+        f"import gymnasium as gym; env = gym.make({MODULE_ID!r})",
+        f"import gymnasium as gym; env = gym.make_vec({MODULE_ID!r}, num_envs=2)",
+    ],
+)
 def test_each_documented_id_form_makes_and_steps_in_a_fresh_interpreter(code):
-    run = fresh_python(code + "\nenv.reset(seed=0); env.step(env.action_space.sample())"
-                              "\nprint(type(env.unwrapped).__name__)")
+    run = fresh_python(
+        code + "\nenv.reset(seed=0); env.step(env.action_space.sample())\nprint(type(env.unwrapped).__name__)"
+    )
     assert run.returncode == 0, run.stderr
     assert "OneBallTarget" in run.stdout
 
@@ -61,8 +66,9 @@ def test_sb3_subproc_vec_env_over_the_module_id():
     from stable_baselines3.common.env_util import make_vec_env
     from stable_baselines3.common.vec_env import SubprocVecEnv
 
-    venv = make_vec_env(MODULE_ID, n_envs=2, seed=0, vec_env_cls=SubprocVecEnv,
-                        vec_env_kwargs={"start_method": "spawn"})
+    venv = make_vec_env(
+        MODULE_ID, n_envs=2, seed=0, vec_env_cls=SubprocVecEnv, vec_env_kwargs={"start_method": "spawn"}
+    )
     try:
         obs = venv.reset()
         assert obs.shape == (2, *venv.observation_space.shape)
