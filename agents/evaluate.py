@@ -47,6 +47,7 @@ from agents.config import (
     read_run,
     run_cli,
 )
+from collision_env.engine import MODES
 
 EVAL_SEED = 1_000_000  # evaluation episodes start far from the training and EvalCallback seeds
 BASELINES = ("random", "scripted")
@@ -378,7 +379,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("run", help="a run folder written by agents.train_ppo or agents.train_rllib")
     p.add_argument("--episodes", type=int, default=100)
-    p.add_argument("--mode", choices=("exact", "posteriori", "naive"), help="engine mode (default: the run's)")
+    p.add_argument("--mode", choices=MODES, help="engine mode (default: the run's)")
     p.add_argument("--substeps", type=int, help="sub-steps for naive/posteriori (default 1 with --mode)")
     p.add_argument("--seed", type=int, default=EVAL_SEED, help="episode i starts from seed + i")
     p.add_argument("--model", choices=("final", "best"), default="final")

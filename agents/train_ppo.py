@@ -59,6 +59,7 @@ from agents.config import (
     write_yaml,
 )
 from collision_env.bench.machine import versions
+from collision_env.engine import MODES
 
 DEFAULT_ENV = "CollisionEnv/OneBallTarget-v0"
 VEC_ENVS = ("native", "dummy", "subproc")
@@ -386,7 +387,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--timesteps", type=float, help="total env steps (default: the entry's n_timesteps)")
     p.add_argument("--n-envs", type=int, help="parallel sub-envs (default: the entry's n_envs)")
     p.add_argument("--seed", type=int, help="default 0 (or the run's)")
-    p.add_argument("--mode", choices=("exact", "posteriori", "naive"), help="engine fidelity mode (default: exact)")
+    p.add_argument("--mode", choices=MODES, help="engine fidelity mode (default: exact)")
     p.add_argument("--substeps", type=int, help="sub-steps per control step for naive/posteriori")
     p.add_argument("--env-kwargs", nargs="*", metavar="KEY=VALUE", help="more env keywords, e.g. dt=0.1")
     p.add_argument("--output", default="runs", help="folder for run folders (default: %(default)s)")

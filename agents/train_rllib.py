@@ -45,6 +45,7 @@ from agents.config import (
     run_cli,
     write_yaml,
 )
+from collision_env.engine import MODES
 
 DEFAULT_ENV = "CollisionEnv/OneBallTarget-v0"
 HYPERPARAMS = Path(__file__).with_name("hyperparams") / "rllib_ppo.yml"
@@ -416,7 +417,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--target-success", type=float, help="stop at this evaluation success share (default: 0.9)")
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--mode", choices=("exact", "posteriori", "naive"), help="engine fidelity mode (default: exact)")
+    p.add_argument("--mode", choices=MODES, help="engine fidelity mode (default: exact)")
     p.add_argument("--substeps", type=int, help="sub-steps per control step for naive/posteriori")
     p.add_argument("--env-kwargs", nargs="*", metavar="KEY=VALUE", help="more env keywords, e.g. dt=0.1")
     p.add_argument("--output", default="runs", help="folder for run folders (default: %(default)s)")
