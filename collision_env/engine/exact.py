@@ -74,12 +74,6 @@ from .layout import (
     W_ACTIVE,
     W_CALENDAR_VALID,
     W_EVENTS,
-    W_GRID_HX,
-    W_GRID_HY,
-    W_GRID_NX,
-    W_GRID_NY,
-    W_GRID_X0,
-    W_GRID_Y0,
     W_REMAINING,
     W_STALLED,
 )
@@ -1006,14 +1000,7 @@ def step_exact(
         cf = cal_f[sc]
         ci = cal_i[sc]
         hp = cal_heap[sc]
-        geo = (
-            work_f[sc, W_GRID_X0],
-            work_f[sc, W_GRID_Y0],
-            work_f[sc, W_GRID_HX],
-            work_f[sc, W_GRID_HY],
-            work_i[sc, W_GRID_NX],
-            work_i[sc, W_GRID_NY],
-        )
+        geo = grid.scene_geometry(work_f, work_i, sc)
         nx = geo[4]
         horizon_end = work_f[sc, W_REMAINING]
         t0 = time[sc]

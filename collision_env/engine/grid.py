@@ -26,7 +26,18 @@ import math
 import numpy as np
 
 from ._jit import njit
-from .layout import C_CELL, C_CELL_HEAD, C_CELL_NEXT, C_CELL_PREV
+from .layout import (
+    C_CELL,
+    C_CELL_HEAD,
+    C_CELL_NEXT,
+    C_CELL_PREV,
+    W_GRID_HX,
+    W_GRID_HY,
+    W_GRID_NX,
+    W_GRID_NY,
+    W_GRID_X0,
+    W_GRID_Y0,
+)
 
 #: Scenes with fewer balls keep one cell (every ball is every other's neighbour): below this size
 #: the grid's bookkeeping costs more than the pairs it saves (measured by the engine benchmark).
@@ -69,6 +80,20 @@ def grid_geometry(bounds, positions, radii, use_grid, reach=1.0):
             counts[over, big[over]] -= 1
     cell = np.where(counts > 1, size / counts, np.inf)  # one cell along an axis: no boundary there
     return np.concatenate([lo, cell], axis=1), counts
+
+
+@njit(inline="always")
+def scene_geometry(work_f, work_i, sc):
+    """Scene ``sc``'s grid ``(x0, y0, hx, hy, nx, ny)``, as :func:`grid_geometry` laid it out in the
+    per-scene work arrays (``layout.WORK_F``/``WORK_I``)."""
+    return (
+        work_f[sc, W_GRID_X0],
+        work_f[sc, W_GRID_Y0],
+        work_f[sc, W_GRID_HX],
+        work_f[sc, W_GRID_HY],
+        work_i[sc, W_GRID_NX],
+        work_i[sc, W_GRID_NY],
+    )
 
 
 @njit(inline="always")
@@ -225,19 +250,6 @@ def first_overlap(pos, radius, rtol):
 
 
 # ---------------------------------------------------------------------------- cheap modes
-@njit(inline="always")
-def fill_cell_lists(n, pos, head, nxt, cell, x0, y0, hx, hy, nx, ny):
-    """A throw-away grid of the current positions (the cheap modes rebuild it every sub-step):
-    ``head`` (n_cells,), ``nxt`` and ``cell`` (N,); each cell's list runs in ascending index."""
-    for c in range(nx * ny):
-        head[c] = -1
-    for i in range(n - 1, -1, -1):
-        c = cell_of(pos[i, 0], pos[i, 1], x0, y0, hx, hy, nx, ny)
-        cell[i] = c
-        nxt[i] = head[c]
-        head[c] = i
-
-
 @njit(inline="always")
 def later_neighbours(i, n, head, nxt, cell, nx, ny, out):
     """The balls ``j > i`` in the 3 x 3 cells around ball ``i``, ascending, into ``out``; returns

@@ -4,15 +4,9 @@ from __future__ import annotations
 
 from ._jit import njit
 from .exact import scene_params
-from .grid import block, cell_of
+from .grid import block, cell_of, scene_geometry
 from .layout import (
     W_ACTIVE,
-    W_GRID_HX,
-    W_GRID_HY,
-    W_GRID_NX,
-    W_GRID_NY,
-    W_GRID_X0,
-    W_GRID_Y0,
     W_STALLED,
     W_SUBSTEP_START,
     W_SUBSTEPS_DONE,
@@ -129,14 +123,7 @@ def step_substeps(
         m = mass[sc]
         b = body[sc]
         w = omega[sc]
-        geo = (
-            work_f[sc, W_GRID_X0],
-            work_f[sc, W_GRID_Y0],
-            work_f[sc, W_GRID_HX],
-            work_f[sc, W_GRID_HY],
-            work_i[sc, W_GRID_NX],
-            work_i[sc, W_GRID_NY],
-        )
+        geo = scene_geometry(work_f, work_i, sc)
         u_min = elastic_threshold(v, ratio, floor)
         while done[sc] < k_total:
             cells = _cell_lists(n, p, v, h, scratch, geo)
