@@ -22,6 +22,14 @@ ways:
   kernel called from another kernel is compiled for the arguments' plain types only.
 * **It says so when it compiles.** The first compilation in a process (a fresh install, or edited
   sources) prints one line on stderr, since it takes a while and is otherwise silent.
+
+``@njit(refcount=False)`` compiles a kernel without numba's reference counting of arrays (its
+private ``_nrt`` target option). Numba increments and decrements an array's count whenever a
+kernel binds it to a new name, and an inlined helper with a branch binds every array it takes:
+about 10 ns per array per call, which costs more than the arithmetic of a small scene. A kernel
+compiled so must only borrow the arrays it is passed (slices of them included) and allocate none;
+the kernels it calls that do allocate (a contact group's least-distance solve) keep their own
+counting, since every other kernel is compiled with it explicitly.
 """
 
 from __future__ import annotations
@@ -183,16 +191,19 @@ def _in_package(func) -> bool:
         return False
 
 
-def njit(func=None, **options):
+def njit(func=None, *, refcount=True, **options):
     """Compile ``func`` with numba in nopython mode (cached), or return it unchanged.
 
-    Use bare (``@njit``) or with extra numba options (``@njit(inline="always")``). Kernels outside
-    the package (a test's, say) get numba's own per-file cache.
+    Use bare (``@njit``) or with extra numba options (``@njit(inline="always")``);
+    ``refcount=False``: see the module docstring. Kernels outside the package (a test's, say) get
+    numba's own per-file cache.
     """
     if func is None:
-        return lambda f: njit(f, **options)
+        return lambda f: njit(f, refcount=refcount, **options)
     if not HAVE_NUMBA:
         return func
+    # set explicitly, so that a kernel called from a ``refcount=False`` one does not inherit it
+    options["_nrt"] = bool(refcount)
     if not _in_package(func):
         return _numba.njit(cache=True, nogil=True, **options)(func)
     dispatcher = _KernelDispatcher(

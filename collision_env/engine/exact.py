@@ -163,7 +163,7 @@ def snap_to_wall(i, wall, pos, radius, bounds):
         pos[i, 1] = bounds[3] - radius[i]
 
 
-@njit
+@njit(refcount=False)
 def _predict_pair(i, k, now, horizon, pos, vel, mass, radius, body, omega, rot, ki, kj, counters):
     if body[i] == body[k]:
         return INF
@@ -225,7 +225,7 @@ def wall_contact(i, wall, pos, radius, bounds):
     return wall_gap(i, wall, pos, radius, bounds) <= contact_tolerance(2.0 * radius[i], coord, CONTACT_RTOL)
 
 
-@njit
+@njit(refcount=False)
 def _resolve_contact_group(
     sc,
     t_abs,
@@ -367,7 +367,7 @@ def _contact_normal(c, c_a, c_b, pos):
     return 0.0, 1.0
 
 
-@njit
+@njit(refcount=False)
 def _record_contact(sc, t_abs, c, c_a, c_b, c_hit, pos, radius, bounds, speed, imp, n_imp):
     """Report contact ``c`` of a group the first time it takes an impulse."""
     if c_hit[c]:
@@ -463,7 +463,7 @@ def _settle_contact_group(
             _record_contact(sc, t_abs, c, c_a, c_b, c_hit, pos, radius, bounds, closing[c], imp, n_imp)
 
 
-@njit
+@njit(refcount=False)
 def _contacts_open(vel, pos, c_a, c_b, n_contacts, slack):
     """No contact of the group closes faster than ``slack`` (m/s)."""
     for c in range(n_contacts):
@@ -478,7 +478,7 @@ def _contacts_open(vel, pos, c_a, c_b, n_contacts, slack):
     return True
 
 
-@njit
+@njit(refcount=False)
 def _stop_group(vel, inv_mass, group, size, c_b, n_contacts):
     """The last resort of :func:`_settle_contact_group`: every contact at rest, at once."""
     on_wall = False
@@ -924,7 +924,7 @@ def _resolve_pair(
 
 
 # ---------------------------------------------------------------------------- the scheduler
-@njit
+@njit(refcount=False)
 def step_exact(
     balls,
     body_all,

@@ -38,7 +38,7 @@ def ball_views(balls):
     )
 
 
-@njit
+@njit(refcount=False)
 def body_kinematics(i, pos, vel, mass, body, omega):
     """Centre of mass, its velocity, ball ``i``'s offset from it and the angular velocity.
 
@@ -67,7 +67,7 @@ def body_kinematics(i, pos, vel, mass, body, omega):
     return cx, cy, vx / m_tot, vy / m_tot, pos[i, 0] - cx, pos[i, 1] - cy, w
 
 
-@njit
+@njit(refcount=False)
 def position_at(tau, cx, cy, vcx, vcy, dx, dy, w):
     """Position and velocity, ``tau`` seconds on, of a point of a body in rigid motion."""
     if w == 0.0:
@@ -79,7 +79,7 @@ def position_at(tau, cx, cy, vcx, vcy, dx, dy, w):
     return cx + vcx * tau + rx, cy + vcy * tau + ry, vcx - w * ry, vcy + w * rx
 
 
-@njit
+@njit(refcount=False)
 def advance_body(root, dt, pos, vel, mass, body, omega):
     """Move the members of the rotating cluster rooted at ``root`` on by ``dt``."""
     cx, cy, vcx, vcy, _, _, w = body_kinematics(root, pos, vel, mass, body, omega)
@@ -119,7 +119,7 @@ def has_rotation(body, omega):
     return False
 
 
-@njit
+@njit(refcount=False)
 def apply_impulses(balls, body, dv, sticky):
     """Add ``dv`` to every ball's velocity as an impulse ``m dv`` at its centre.
 

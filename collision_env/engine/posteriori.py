@@ -43,7 +43,7 @@ def _move(i, dt, pos, vel, mass, body, omega):
                 pos[k, 1] += vel[k, 1] * dt
 
 
-@njit
+@njit(refcount=False)
 def overlap_time_pair(dx, dy, dvx, dvy, sigma):
     """How long ago an overlapping pair touched: the non-negative root of PhET's quadratic."""
     a = dvx * dvx + dvy * dvy

@@ -148,7 +148,7 @@ def ball_wall(i, wall, vel, e, u_min):
     return abs(vn)
 
 
-@njit
+@njit(refcount=False)
 def merge_bodies(i, j, pos, vel, mass, body, omega):
     """Stick balls ``i`` and ``j`` (and their clusters) into one rigid body. Returns the root."""
     bi = body[i]

@@ -105,7 +105,7 @@ class Impact:
     speed: float  #: normal closing speed just before the impact (m/s)
 
 
-@njit
+@njit(refcount=False)
 def _copy_impacts(buf, out, sign, sort):
     """Copy the first ``len(out)`` impact records of ``buf`` into ``out``; with ``sort``, order each
     scene's records by ``sign * time`` (stable, so simultaneous impacts keep their order). The
@@ -167,7 +167,7 @@ def _real_array(value, shapes, field, where):
     return arr
 
 
-@njit
+@njit(refcount=False)
 def _advance_clocks(time, clock, work_f, dt_abs, sign):
     """Compensated clocks. ``clock[sc]`` = (the time at the start of the step, its compensation):
     the exact time is their sum, and ``time`` (which the kernels read, and overwrite during the step)

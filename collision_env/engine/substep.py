@@ -71,7 +71,7 @@ def _grid_worst_case(n, cells):
     return worst
 
 
-@njit
+@njit(refcount=False)
 def step_substeps(
     mode,
     k_total,

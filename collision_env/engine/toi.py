@@ -89,7 +89,7 @@ def toi_wall(x, y, vx, vy, r, bounds, dim):
     return t, wall
 
 
-@njit
+@njit(refcount=False)
 def _pair_gap(tau, ki, kj, sigma):
     xi, yi, vxi, vyi = position_at(tau, ki[0], ki[1], ki[2], ki[3], ki[4], ki[5], ki[6])
     xj, yj, vxj, vyj = position_at(tau, kj[0], kj[1], kj[2], kj[3], kj[4], kj[5], kj[6])
@@ -100,7 +100,7 @@ def _pair_gap(tau, ki, kj, sigma):
     return dist - sigma, rate
 
 
-@njit
+@njit(refcount=False)
 def _wall_gap(tau, k, r, wall, bounds):
     x, y, vx, vy = position_at(tau, k[0], k[1], k[2], k[3], k[4], k[5], k[6])
     if wall == 0:
@@ -112,7 +112,7 @@ def _wall_gap(tau, k, r, wall, bounds):
     return (bounds[3] - r) - y, -vy
 
 
-@njit
+@njit(refcount=False)
 def _ca_solve(is_pair, ki, kj, sigma, wall, bounds, bound_speed, horizon, tol):
     """Conservative advancement on a gap function ``g(tau)`` with ``|g'| <= bound_speed``.
 
@@ -163,7 +163,7 @@ def _ca_solve(is_pair, ki, kj, sigma, wall, bounds, bound_speed, horizon, tol):
     return tau
 
 
-@njit
+@njit(refcount=False)
 def ca_pair(ki, kj, sigma, horizon):
     """Time until two balls, either of them in a rotating cluster, touch (or inf).
 
@@ -176,7 +176,7 @@ def ca_pair(ki, kj, sigma, horizon):
     return _ca_solve(True, ki, kj, sigma, -1, ki, bound, horizon, tol)
 
 
-@njit
+@njit(refcount=False)
 def ca_wall(k, r, bounds, dim, horizon):
     """First wall a ball of a rotating cluster touches: ``(t, wall)``."""
     best = INF

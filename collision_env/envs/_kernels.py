@@ -86,7 +86,7 @@ def _capped_change(vx, vy, dx, dy, max_speed):  # pragma: no cover - numba
     return nx - vx, ny - vy
 
 
-@njit
+@njit(refcount=False)
 def nudge_kernel(actions, active, balls, body, ctrl, P, Q, dv, S):  # pragma: no cover - numba
     """Scale actions to velocity changes ``dv`` (B, N, 2) and their size ``S[:, nudge]``, and apply
     them to the engine's balls with the engine's own impulse kernel.
@@ -424,7 +424,7 @@ def _settle(flags, S, C, T, t_geo, pos, vel, radii, body, qual, seq, cluster, n_
             S[b, SF.phi] = phi_new
 
 
-@njit
+@njit(refcount=False)
 def task_kernel(
     flags, imp, balls, sim_time, clusters, S, C, T, t_geo, body, qual, P, Q, obs
 ):  # pragma: no cover - numba
