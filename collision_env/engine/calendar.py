@@ -11,15 +11,17 @@ O(log N).
 Invalidation is lazy (Sedgewick & Wayne, *Algorithms*, 4th ed., 6.1): every ball counts the
 changes of its trajectory, and a pair event stores its partner's count when it was predicted. An
 event whose partner has changed since is stale; when it comes to the top of the heap the ball is
-simply predicted afresh. When a prediction finds a pair event earlier than the partner's own, the
-partner's entry is overwritten too (Smallenburg's rule), so every pair's next collision is held by
-at least one of its two balls.
+simply predicted afresh. A pair event is held only by the ball whose prediction found it (as in
+Smallenburg's code): the earliest pending event is always held, because the ball of the pair that
+changed last looked at the other when it was predicted, and every event of a ball before that
+time would have changed it.
 
 Times in the calendar are relative to the start of the current step (the simulator rebases them
 when a step ends), so no large absolute time enters it.
 
-The per-ball fields live in the packed arrays ``cf`` (floats) and ``ci`` (ints) of one scene,
-laid out as ``layout.CAL_F`` and ``layout.CAL_I``; the heap itself in ``hp`` (``layout.HEAP``).
+The per-ball fields live in one scene's calendar records ``rec`` (``layout.CAL_RECORD``: the event
+time and the change counter) and its int32 rows ``ci`` (``layout.CAL_I``: what the event is, the
+partner's count, the heap slot); the heap itself in ``hp`` (``layout.HEAP``).
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._jit import njit
-from .layout import C_CHANGES, C_EVENT_OTHER, C_EVENT_STAMP, C_EVENT_TIME, C_HEAP_SLOT, H_BALL, H_TIME
+from .layout import C_EVENT_OTHER, C_EVENT_STAMP, C_HEAP_SLOT, H_BALL, H_TIME
 
 #: ``event_other`` codes below zero. A ball's wall events are ``EV_WALL - wall`` (wall codes 0..3
 #: as in ``scene.WALL_NAMES``); its grid-cell crossings are ``EV_CROSS - direction`` (0: -x,
@@ -94,80 +96,117 @@ def _before(ta, a, tb, b, ci):
 
 
 #: Children per node of the heap: a 4-ary heap is half as deep as a binary one, and a node's
-#: children lie side by side in ``hp`` (one or two cache lines), which is what a heap of 10^5
-#: balls is bound by.
+#: children lie side by side in ``hp``, in one cache line, which is what a heap of 10^5 balls is
+#: bound by.
 ARITY = 4
+#: Slot s of the heap is row ``s + HEAP_OFFSET`` of ``hp``: the children of slot s (slots
+#: 4s + 1 ... 4s + 4) then start on a 64-byte boundary, the 16-byte rows of an aligned array.
+HEAP_OFFSET = ARITY - 1
+
+
+def heap_rows(n):
+    """Rows of a scene's heap array for ``n`` balls: the offset, then whole cache lines."""
+    return -(-(n + HEAP_OFFSET) // ARITY) * ARITY
 
 
 # The heap lives in ``hp`` (``layout.HEAP``: the event time and the ball of each slot), so that
 # sifting reads neighbouring rows instead of chasing every ball's own row.
 @njit(inline="always")
 def _place(slot, ball, t, ci, hp):
-    hp[slot, H_TIME] = t
-    hp[slot, H_BALL] = ball
+    hp[slot + HEAP_OFFSET, H_TIME] = t
+    hp[slot + HEAP_OFFSET, H_BALL] = ball
     ci[ball, C_HEAP_SLOT] = slot
 
 
 @njit(inline="always")
 def _ball_at(slot, hp):
-    return np.int64(hp[slot, H_BALL])
+    return np.int64(hp[slot + HEAP_OFFSET, H_BALL])
 
 
 @njit(inline="always")
-def _sift_up(slot, cf, ci, hp):
+def _time_at(slot, hp):
+    return hp[slot + HEAP_OFFSET, H_TIME]
+
+
+@njit(inline="always")
+def _sift_up(slot, rec, ci, hp):
     ball = _ball_at(slot, hp)
-    t = cf[ball, C_EVENT_TIME]
+    t = rec[ball]["event_time"]
     while slot > 0:
         parent = (slot - 1) // ARITY
         above = _ball_at(parent, hp)
-        if not _before(t, ball, hp[parent, H_TIME], above, ci):
+        t_above = _time_at(parent, hp)
+        if not _before(t, ball, t_above, above, ci):
             break
-        _place(slot, above, hp[parent, H_TIME], ci, hp)
+        _place(slot, above, t_above, ci, hp)
         slot = parent
     _place(slot, ball, t, ci, hp)
     return slot
 
 
 @njit(inline="always")
-def _sift_down(slot, n, cf, ci, hp):
+def _first_child(first, n, ci, hp):
+    """The child slot (of ``first`` ... ``first + ARITY - 1``) whose event comes first, and its time."""
+    if first + ARITY <= n:
+        # four children: the earliest time without branches (a heap's comparisons are coin flips
+        # to a branch predictor); exact ties fall through to the full order below
+        t0 = _time_at(first, hp)
+        t1 = _time_at(first + 1, hp)
+        t2 = _time_at(first + 2, hp)
+        t3 = _time_at(first + 3, hp)
+        m01 = min(t0, t1)
+        m23 = min(t2, t3)
+        if t0 != t1 and t2 != t3 and m01 != m23:
+            c01 = first + np.int64(t1 < t0)
+            c23 = first + 2 + np.int64(t3 < t2)
+            return (c23 if m23 < m01 else c01), min(m01, m23)
+    child = first
+    t_child = _time_at(first, hp)
+    for c in range(first + 1, min(first + ARITY, n)):
+        t_c = _time_at(c, hp)
+        if t_c <= t_child and _before(t_c, _ball_at(c, hp), t_child, _ball_at(child, hp), ci):
+            child = c
+            t_child = t_c
+    return child, t_child
+
+
+@njit(inline="always")
+def _sift_down(slot, n, rec, ci, hp):
     ball = _ball_at(slot, hp)
-    t = cf[ball, C_EVENT_TIME]
+    t = rec[ball]["event_time"]
     while True:
         first = ARITY * slot + 1
         if first >= n:
             break
-        child = first
-        for c in range(first + 1, min(first + ARITY, n)):
-            if _before(hp[c, H_TIME], _ball_at(c, hp), hp[child, H_TIME], _ball_at(child, hp), ci):
-                child = c
+        child, t_child = _first_child(first, n, ci, hp)
         below = _ball_at(child, hp)
-        if not _before(hp[child, H_TIME], below, t, ball, ci):
+        if not _before(t_child, below, t, ball, ci):
             break
-        _place(slot, below, hp[child, H_TIME], ci, hp)
+        _place(slot, below, t_child, ci, hp)
         slot = child
     _place(slot, ball, t, ci, hp)
 
 
 @njit(inline="always")
-def reschedule(ball, n, cf, ci, hp):
+def reschedule(ball, n, rec, ci, hp):
     """Restore the heap order after ``ball``'s event time changed (either way)."""
-    slot = _sift_up(ci[ball, C_HEAP_SLOT], cf, ci, hp)
-    _sift_down(slot, n, cf, ci, hp)
+    slot = _sift_up(ci[ball, C_HEAP_SLOT], rec, ci, hp)
+    _sift_down(slot, n, rec, ci, hp)
 
 
 @njit(inline="always")
-def heapify(n, cf, ci, hp):
+def heapify(n, rec, ci, hp):
     """Order the heap from scratch (Floyd's O(N) construction), from the balls' event times."""
     for slot in range((n - 2) // ARITY, -1, -1):
-        _sift_down(slot, n, cf, ci, hp)
+        _sift_down(slot, n, rec, ci, hp)
 
 
 @njit(inline="always")
-def reset_heap(n, cf, ci, hp):
+def reset_heap(n, rec, ci, hp):
     """Put every ball in the heap (slot = index) and order it."""
     for i in range(n):
-        _place(i, i, cf[i, C_EVENT_TIME], ci, hp)
-    heapify(n, cf, ci, hp)
+        _place(i, i, rec[i]["event_time"], ci, hp)
+    heapify(n, rec, ci, hp)
 
 
 @njit(inline="always")
@@ -177,27 +216,23 @@ def next_ball(hp):
 
 
 @njit(inline="always")
-def set_event(ball, t, code, stamp, cf, ci):
+def rebase(n, t, hp):
+    """Subtract ``t`` from every event time in the heap (the balls' own times are the caller's)."""
+    for slot in range(n):
+        hp[slot + HEAP_OFFSET, H_TIME] -= t
+
+
+@njit(inline="always")
+def set_event(ball, t, code, stamp, rec, ci):
     """Give ``ball`` the pending event ``(t, code)`` (``stamp``: the partner's change count);
     the caller restores the heap order."""
-    cf[ball, C_EVENT_TIME] = t
+    rec[ball]["event_time"] = t
     ci[ball, C_EVENT_OTHER] = code
     ci[ball, C_EVENT_STAMP] = stamp
 
 
 @njit(inline="always")
-def offer_pair(k, t, partner, n, ordered, cf, ci, hp):
-    """Offer ball ``k`` a collision with ``partner`` at ``t``; it takes it if it comes before its
-    own pending event (Smallenburg's rule). ``ordered``: restore the heap order (not while a whole
-    scene is being predicted, before the heap is built)."""
-    if earlier(t, partner, cf[k, C_EVENT_TIME], ci[k, C_EVENT_OTHER], k):
-        set_event(k, t, partner, ci[partner, C_CHANGES], cf, ci)
-        if ordered:
-            reschedule(k, n, cf, ci, hp)
-
-
-@njit(inline="always")
-def is_stale(ball, ci):
+def is_stale(ball, rec, ci):
     """A pair event whose partner's trajectory changed after it was predicted."""
     other = ci[ball, C_EVENT_OTHER]
-    return other >= 0 and ci[other, C_CHANGES] != ci[ball, C_EVENT_STAMP]
+    return other >= 0 and rec[other]["changes"] != ci[ball, C_EVENT_STAMP]

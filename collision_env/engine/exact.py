@@ -48,18 +48,7 @@ from . import grid
 from ._jit import njit
 from .layout import (
     C_CELL,
-    C_CELL_HEAD,
-    C_CELL_NEXT,
-    C_CHANGES,
     C_EVENT_OTHER,
-    C_EVENT_STAMP,
-    C_EVENT_TIME,
-    C_REF_TIME,
-    C_SEEN_VX,
-    C_SEEN_VY,
-    C_SEEN_X,
-    C_SEEN_Y,
-    H_TIME,
     S_COLLAPSE_FLOOR,
     S_COLLAPSE_RATIO,
     S_DIM,
@@ -522,56 +511,109 @@ def impacts_per_event(n, cascades):
 
 
 # ---------------------------------------------------------------------------- lazy motion
+# A ball's calendar record (``layout.CAL_RECORD``) holds its straight-line trajectory: its centre
+# at its own ``ref_time`` and its velocity. Balls are moved there lazily, only when an event
+# touches them. The engine's ball state (``pos``, ``vel``: what the response kernels change and
+# what the caller reads) is brought up to date from the records for the balls of an event before
+# it is resolved, and for every ball when the step ends; the records take back what the response
+# changed. Stick scenes are the exception: their clusters move as a whole, so the ball state is
+# advanced for every ball at once and the records are loaded from it.
 @njit(inline="always")
-def _position_at(k, t, pos, vel, cf):
-    """Where ball ``k`` is at step time ``t`` (its stored position refers to its ``ref_time``)."""
-    dt = t - cf[k, C_REF_TIME]
-    return pos[k, 0] + vel[k, 0] * dt, pos[k, 1] + vel[k, 1] * dt
+def _position_at(k, t, rec):
+    """Where ball ``k`` is at step time ``t``."""
+    r = rec[k]
+    dt = t - r["ref_time"]
+    return r["x"] + r["vx"] * dt, r["y"] + r["vy"] * dt
 
 
 @njit(inline="always")
-def _sync(k, t, pos, vel, cf):
-    """Bring ball ``k``'s stored position to step time ``t`` (straight-line motion)."""
-    dt = t - cf[k, C_REF_TIME]
+def _sync(k, t, rec):
+    """Move ball ``k``'s record to step time ``t`` (straight-line motion)."""
+    r = rec[k]
+    dt = t - r["ref_time"]
     if dt != 0.0:
-        pos[k, 0] += vel[k, 0] * dt
-        pos[k, 1] += vel[k, 1] * dt
-        cf[k, C_REF_TIME] = t
+        r["x"] += r["vx"] * dt
+        r["y"] += r["vy"] * dt
+        r["ref_time"] = t
 
 
 @njit(inline="always")
-def _sync_all(t, pos, vel, mass, body, omega, rot, sticky, cf):
-    """Bring every ball to step time ``t``. Stick scenes keep all balls at one time (a rotating
-    cluster moves as a whole), so they advance together; elsewhere each ball moves on its own."""
+def _store(k, rec, pos, vel):
+    """Ball ``k``'s record (position and velocity) into the ball state."""
+    r = rec[k]
+    pos[k, 0] = r["x"]
+    pos[k, 1] = r["y"]
+    vel[k, 0] = r["vx"]
+    vel[k, 1] = r["vy"]
+
+
+@njit(inline="always")
+def _load(k, t, rec, pos, vel):
+    """The ball state of ball ``k`` into its record, as of step time ``t``."""
+    r = rec[k]
+    r["x"] = pos[k, 0]
+    r["y"] = pos[k, 1]
+    r["vx"] = vel[k, 0]
+    r["vy"] = vel[k, 1]
+    r["ref_time"] = t
+
+
+@njit(inline="always")
+def _sync_all(t, pos, vel, mass, body, omega, rot, sticky, rec):
+    """Bring every ball to step time ``t``, in the records and in the ball state alike."""
     n = pos.shape[0]
     if sticky:
-        dt = t - cf[0, C_REF_TIME]
+        dt = t - rec[0]["ref_time"]
         if dt != 0.0:
             advance_all(dt, pos, vel, mass, body, omega, rot)
             for k in range(n):
-                cf[k, C_REF_TIME] = t
+                _load(k, t, rec, pos, vel)
     else:
         for k in range(n):
-            _sync(k, t, pos, vel, cf)
+            _sync(k, t, rec)
+            _store(k, rec, pos, vel)
 
 
 @njit(inline="always")
-def _pair_time(i, k, pos, vel, radius, cf):
+def _pair_gap(i, k, rec):
+    """Balls ``i`` and ``k`` at the later of their reference times ``tc``: ``(tc, dx, dy, dvx, dvy,
+    sigma)``, the separation and relative velocity of ``k`` from ``i`` and the radii sum."""
+    ri = rec[i]
+    rk = rec[k]
+    tc = max(ri["ref_time"], rk["ref_time"])
+    xi, yi = _position_at(i, tc, rec)
+    xk, yk = _position_at(k, tc, rec)
+    return tc, xk - xi, yk - yi, rk["vx"] - ri["vx"], rk["vy"] - ri["vy"], ri["radius"] + rk["radius"]
+
+
+@njit(inline="always")
+def _pair_time(i, k, rec):
     """Step time at which balls ``i`` and ``k`` in straight-line motion meet (inf: never), computed
-    from their stored states at the later of their reference times. Every prediction and every
-    re-verification of a pair uses this one formula on the stored states alone, so the answer does
-    not depend on when it is asked: a calendar kept for many steps and a fresh one agree."""
-    tc = max(cf[i, C_REF_TIME], cf[k, C_REF_TIME])
-    xi, yi = _position_at(i, tc, pos, vel, cf)
-    xk, yk = _position_at(k, tc, pos, vel, cf)
-    return tc + toi_pair(xk - xi, yk - yi, vel[k, 0] - vel[i, 0], vel[k, 1] - vel[i, 1], radius[i] + radius[k])
+    from their records at the later of their reference times. Every prediction and every
+    re-verification of a pair uses this one formula on the records alone, so the answer does not
+    depend on when it is asked: a calendar kept for many steps and a fresh one agree."""
+    tc, dx, dy, dvx, dvy, sigma = _pair_gap(i, k, rec)
+    return tc + toi_pair(dx, dy, dvx, dvy, sigma)
 
 
 @njit(inline="always")
-def _wall_time(i, pos, vel, radius, bounds, dim, cf):
+def _not_before(dx, dy, dvx, dvy, sigma, span):
+    """Two balls apart by ``(dx, dy)``, closing at ``(dvx, dvy)``, cannot touch within ``span``
+    seconds: their time of impact is at least ``c / (-2 b)`` (``b = dr . dv < 0``, ``c = |dr|^2 -
+    sigma^2``: the quadratic's ``t^2`` term is never negative), with a margin far above the round-off
+    of the time of impact itself. A cheap test that spares the square root and the division of
+    most pairs a prediction looks at (Smallenburg 2022)."""
+    b = dx * dvx + dy * dvy
+    c = dx * dx + dy * dy - sigma * sigma
+    return b >= 0.0 or c * (1.0 - 1e-9) > -2.0 * b * span
+
+
+@njit(inline="always")
+def _wall_time(i, bounds, dim, rec):
     """Step time and code of the first wall ball ``i`` meets in straight-line motion."""
-    tau, wall = toi_wall(pos[i, 0], pos[i, 1], vel[i, 0], vel[i, 1], radius[i], bounds, dim)
-    return cf[i, C_REF_TIME] + tau, wall
+    r = rec[i]
+    tau, wall = toi_wall(r["x"], r["y"], r["vx"], r["vy"], r["radius"], bounds, dim)
+    return r["ref_time"] + tau, wall
 
 
 # ---------------------------------------------------------------------------- predict
@@ -594,8 +636,9 @@ def _predict(
     pairs,
     dim,
     geo,
-    cf,
+    rec,
     ci,
+    heads,
     hp,
     ki,
     kj,
@@ -604,143 +647,143 @@ def _predict(
     """Find ball ``i``'s next event and schedule it.
 
     Looks at its wall, its partners in the 3 x 3 cells around it and its next cell crossing, from
-    the balls' stored states (``now`` and ``horizon`` matter only to rotating clusters). Every
-    partner is offered the pair event too (``calendar.offer_pair``). ``rebuild`` is the first
-    prediction of a whole scene: only partners of higher index are looked at (each pair once),
-    ball ``i`` keeps what lower ones offered it, and the heap is ordered afterwards.
+    the records (rotating clusters from the ball state, which stick scenes keep at ``now``;
+    ``horizon`` matters only to them). ``rebuild`` is the first prediction of a whole scene: only
+    partners of higher index are looked at, so each pair is tested once, by its lower ball (which
+    is enough: the earliest event of the scene is then held by its lower ball), and the heap is
+    ordered afterwards.
     """
     n = pos.shape[0]
     x0, y0, hx, hy, nx, ny = geo
-    if rebuild:
-        best_t = cf[i, C_EVENT_TIME]
-        best_code = ci[i, C_EVENT_OTHER]
-        best_stamp = ci[i, C_EVENT_STAMP]
-    else:
-        best_t = INF
-        best_code = cal.EV_NONE
-        best_stamp = 0
+    best_t = INF
+    best_code = cal.EV_NONE
+    best_stamp = 0
     if has_walls:
-        if rot:  # (stick scenes keep every ball at ``now``)
+        if rot:
             t_wall, wall = _predict_wall(
                 i, now, horizon, pos, vel, mass, radius, body, omega, rot, bounds, dim, ki, counters
             )
         else:
             counters[WALL_TESTS] += 1
-            t_wall, wall = _wall_time(i, pos, vel, radius, bounds, dim, cf)
+            t_wall, wall = _wall_time(i, bounds, dim, rec)
         if wall >= 0 and cal.earlier(t_wall, cal.EV_WALL - wall, best_t, best_code, i):
             best_t = t_wall
             best_code = cal.EV_WALL - wall
     if pairs:
         # one cell (small scenes): the partners are simply every other ball, in index order
         one_cell = nx * ny == 1
+        if not one_cell:  # (first: an early bound spares most pairs their time of impact)
+            r = rec[i]
+            tau, direction = grid.crossing(r["x"], r["y"], r["vx"], r["vy"], ci[i, C_CELL], x0, y0, hx, hy, nx, ny)
+            tau += r["ref_time"]
+            if direction >= 0 and cal.earlier(tau, cal.EV_CROSS - direction, best_t, best_code, i):
+                best_t = tau
+                best_code = cal.EV_CROSS - direction
+        tests = 0
         cx0, cx1, cy0, cy1 = (0, 0, 0, 0) if one_cell else grid.block(ci[i, C_CELL], nx, ny)
         for cy in range(cy0, cy1 + 1):
             for cx in range(cx0, cx1 + 1):
-                k = (i + 1 if rebuild else 0) if one_cell else ci[cy * nx + cx, C_CELL_HEAD]
+                k = (i + 1 if rebuild else 0) if one_cell else heads[cy * nx + cx]
                 while 0 <= k < n:
                     if k != i and (k > i or not rebuild):
                         if rot:
                             t = _predict_pair(
                                 i, k, now, horizon, pos, vel, mass, radius, body, omega, rot, ki, kj, counters
                             )
-                        elif body[i] == body[k]:
+                        elif sticky and body[i] == body[k]:
                             t = INF
                         else:
-                            counters[PAIR_TESTS] += 1
-                            t = _pair_time(i, k, pos, vel, radius, cf)
-                        if t < INF:
-                            if cal.earlier(t, k, best_t, best_code, i):
-                                best_t = t
-                                best_code = k
-                                best_stamp = ci[k, C_CHANGES]
-                            cal.offer_pair(k, t, i, n, not rebuild, cf, ci, hp)
-                    k = k + 1 if one_cell else ci[k, C_CELL_NEXT]
-        if nx * ny > 1:
-            tau, direction = grid.crossing(
-                pos[i, 0], pos[i, 1], vel[i, 0], vel[i, 1], ci[i, C_CELL], x0, y0, hx, hy, nx, ny
-            )
-            tau += cf[i, C_REF_TIME]
-            if direction >= 0 and cal.earlier(tau, cal.EV_CROSS - direction, best_t, best_code, i):
-                best_t = tau
-                best_code = cal.EV_CROSS - direction
-    cal.set_event(i, best_t, best_code, best_stamp, cf, ci)
+                            tests += 1
+                            tc, dx, dy, dvx, dvy, sigma = _pair_gap(i, k, rec)
+                            if _not_before(dx, dy, dvx, dvy, sigma, best_t - tc):
+                                t = INF
+                            else:
+                                t = tc + toi_pair(dx, dy, dvx, dvy, sigma)
+                        if t < INF and cal.earlier(t, k, best_t, best_code, i):
+                            best_t = t
+                            best_code = k
+                            best_stamp = rec[k]["changes"]
+                    k = k + 1 if one_cell else rec[k]["cell_next"]
+        counters[PAIR_TESTS] += tests
+    cal.set_event(i, best_t, best_code, best_stamp, rec, ci)
     if not rebuild:
-        cal.reschedule(i, n, cf, ci, hp)
+        cal.reschedule(i, n, rec, ci, hp)
 
 
 # ---------------------------------------------------------------------------- begin
 @njit(inline="always")
-def _begin_whole_scene(pos, cf, ci, geo, pending):
-    """Forget every prediction of a scene and lay its balls into the grid; every ball is then to
-    be predicted (listed in ``pending``). Returns how many."""
+def _begin_whole_scene(pos, vel, radius, rec, ci, heads, geo, pending):
+    """Forget every prediction of a scene, take every ball's state (its radius too) into its
+    record and lay the balls into the grid; every ball is then to be predicted (listed in
+    ``pending``). Returns how many."""
     n = pos.shape[0]
     x0, y0, hx, hy, nx, ny = geo
-    grid.fill_cells(n, pos, ci, x0, y0, hx, hy, nx, ny)
     for i in range(n):
-        cf[i, C_REF_TIME] = 0.0
-        cal.set_event(i, INF, cal.EV_NONE, 0, cf, ci)
+        _load(i, 0.0, rec, pos, vel)
+        rec[i]["radius"] = radius[i]
+        cal.set_event(i, INF, cal.EV_NONE, 0, rec, ci)
         pending[i] = i
+    grid.fill_cells(n, rec, ci, heads, x0, y0, hx, hy, nx, ny)
     return n
 
 
 @njit(inline="always")
-def _changed_since_last_step(i, pos, vel, cf):
-    return (
-        pos[i, 0] != cf[i, C_SEEN_X]
-        or pos[i, 1] != cf[i, C_SEEN_Y]
-        or vel[i, 0] != cf[i, C_SEEN_VX]
-        or vel[i, 1] != cf[i, C_SEEN_VY]
-    )
+def _changed_since_last_step(i, pos, vel, rec):
+    r = rec[i]
+    return pos[i, 0] != r["x"] or pos[i, 1] != r["y"] or vel[i, 0] != r["vx"] or vel[i, 1] != r["vy"]
 
 
 @njit(inline="always")
-def _begin_changed_balls(pos, vel, cf, ci, geo, pending):
+def _begin_changed_balls(pos, vel, rec, ci, heads, geo, pending):
     """List in ``pending`` the balls whose position or velocity changed since the last step ended
-    (a nudge, an env's action, the negated velocities of a reversal of time): their trajectories
-    are new (their change counters move on, which makes events others hold with them stale) and
-    they may sit in another cell. Returns how many."""
+    (a nudge, an env's action, the negated velocities of a reversal of time): their records take
+    the new state, their trajectories are new (their change counters move on, which makes events
+    others hold with them stale) and they may sit in another cell. Returns how many."""
     n = pos.shape[0]
     x0, y0, hx, hy, nx, ny = geo
     n_changed = 0
     for i in range(n):
-        if _changed_since_last_step(i, pos, vel, cf):
+        if _changed_since_last_step(i, pos, vel, rec):
             pending[n_changed] = i
             n_changed += 1
-            ci[i, C_CHANGES] += 1
-            c = grid.cell_of(pos[i, 0], pos[i, 1], x0, y0, hx, hy, nx, ny) if nx * ny > 1 else 0
-            if c != ci[i, C_CELL]:
-                grid.unlink(i, ci)
-                grid.link(i, c, ci)
+            _load(i, 0.0, rec, pos, vel)
+            rec[i]["changes"] += 1
+            if nx * ny > 1:
+                grid.move_to_cell(i, grid.cell_of(pos[i, 0], pos[i, 1], x0, y0, hx, hy, nx, ny), rec, ci, heads)
     return n_changed
 
 
 # ---------------------------------------------------------------------------- verify
 @njit(inline="always")
-def _verified_time(i, code, pos, vel, radius, bounds, dim, cf):
-    """The popped event's time, computed afresh from the stored states (a prediction from an
-    earlier step carries the round-off of rebasing its time), or inf if it no longer happens."""
+def _verified_time(i, code, bounds, dim, rec):
+    """The popped event's time, computed afresh from the records (a prediction from an earlier
+    step carries the round-off of rebasing its time), or inf if it no longer happens."""
     if code >= 0:
-        return _pair_time(i, code, pos, vel, radius, cf)
-    t, wall = _wall_time(i, pos, vel, radius, bounds, dim, cf)
+        return _pair_time(i, code, rec)
+    t, wall = _wall_time(i, bounds, dim, rec)
     return t if wall == cal.EV_WALL - code else INF
 
 
 # ---------------------------------------------------------------------------- finish
 @njit(inline="always")
-def _finish(t_end, pos, vel, mass, body, omega, rot, sticky, cf, ci, hp):
-    """End the step at step time ``t_end``: every ball there, the calendar's times made relative to
-    it (the next step starts at 0), and the state remembered for the next step's change check."""
+def _finish(t_end, pos, vel, mass, body, omega, rot, sticky, rec, ci, hp):
+    """End the step at step time ``t_end``: every ball there (records and ball state), and the
+    calendar's times made relative to it (the next step starts at 0)."""
     n = pos.shape[0]
-    _sync_all(t_end, pos, vel, mass, body, omega, rot, sticky, cf)
+    if sticky:
+        _sync_all(t_end, pos, vel, mass, body, omega, rot, sticky, rec)
     for i in range(n):
-        cf[i, C_EVENT_TIME] -= t_end
-        hp[i, H_TIME] -= t_end  # (row i: heap slot i, the same times rebased the same way)
-        cf[i, C_REF_TIME] = 0.0
-        cf[i, C_SEEN_X] = pos[i, 0]
-        cf[i, C_SEEN_Y] = pos[i, 1]
-        cf[i, C_SEEN_VX] = vel[i, 0]
-        cf[i, C_SEEN_VY] = vel[i, 1]
-    cal.heapify(n, cf, ci, hp)  # rebasing can round two times into a tie the heap must order by index
+        r = rec[i]
+        if not sticky:
+            dt = t_end - r["ref_time"]
+            r["x"] += r["vx"] * dt
+            r["y"] += r["vy"] * dt
+            pos[i, 0] = r["x"]
+            pos[i, 1] = r["y"]
+        r["ref_time"] = 0.0
+        r["event_time"] -= t_end
+    cal.rebase(n, t_end, hp)  # the same times, rebased the same way
+    cal.heapify(n, rec, ci, hp)  # rebasing can round two times into a tie the heap must order by index
 
 
 # ---------------------------------------------------------------------------- resolve
@@ -937,8 +980,9 @@ def step_exact(
     counters,
     work_f,
     work_i,
-    cal_f,
+    cal_rec,
     cal_i,
+    cal_heads,
     cal_heap,
     scratch_f,
     scratch_i,
@@ -951,8 +995,9 @@ def step_exact(
     ``balls`` is the (B, N, 8) per-ball state (``layout.BALL``), ``body_all`` the (B, N) cluster
     roots, ``time`` the (B,) clocks; ``fparams``/``iparams`` the scene parameters
     (``layout.SCENE_F``/``SCENE_I``); ``work_f``/``work_i`` the per-scene bookkeeping and grid
-    geometry (``layout.WORK_F``/``WORK_I``); ``cal_f``/``cal_i``/``cal_heap`` the persistent
-    calendar, grid and event queue (``layout.CAL_F``/``CAL_I``/``HEAP``). ``fresh`` starts a step
+    geometry (``layout.WORK_F``/``WORK_I``); ``cal_rec``/``cal_i``/``cal_heads``/``cal_heap`` the
+    persistent calendar records, its int rows, the grid's cell heads and the event queue
+    (``layout.CAL_RECORD``/``CAL_I``/``HEAP``). ``fresh`` starts a step
     of ``dt_abs`` for every scene; otherwise the call resumes the scenes flagged active.
     Impacts go to ``imp`` rows (``simulator.IMPACT_DTYPE``) from row 0, ``n_imp[0]`` rows in all; a
     scene that finds the buffer full stops where it is and is flagged stalled, so the caller can
@@ -997,8 +1042,9 @@ def step_exact(
         radius = radius_all[sc]
         body = body_all[sc]
         omega = omega_all[sc]
-        cf = cal_f[sc]
+        rec = cal_rec[sc]
         ci = cal_i[sc]
+        heads = cal_heads[sc]
         hp = cal_heap[sc]
         geo = grid.scene_geometry(work_f, work_i, sc)
         nx = geo[4]
@@ -1011,9 +1057,9 @@ def step_exact(
         # only to the end of a step), otherwise only the balls changed since the last step
         whole = not work_i[sc, W_CALENDAR_VALID] or rot
         if whole:
-            n_pending = _begin_whole_scene(pos, cf, ci, geo, pending)
+            n_pending = _begin_whole_scene(pos, vel, radius, rec, ci, heads, geo, pending)
         elif fresh:
-            n_pending = _begin_changed_balls(pos, vel, cf, ci, geo, pending)
+            n_pending = _begin_changed_balls(pos, vel, rec, ci, heads, geo, pending)
         else:
             n_pending = 0
 
@@ -1038,25 +1084,26 @@ def step_exact(
                     pairs,
                     dim,
                     geo,
-                    cf,
+                    rec,
                     ci,
+                    heads,
                     hp,
                     ki,
                     kj,
                     counters,
                 )
             if whole:
-                cal.reset_heap(n, cf, ci, hp)
+                cal.reset_heap(n, rec, ci, hp)
                 work_i[sc, W_CALENDAR_VALID] = True
                 whole = False
             n_pending = 0
             # pop
             bi = cal.next_ball(hp)
-            t = cf[bi, C_EVENT_TIME]
+            t = rec[bi]["event_time"]
             code = ci[bi, C_EVENT_OTHER]
             if not t <= horizon_end:
                 break
-            if cal.is_stale(bi, ci):
+            if cal.is_stale(bi, rec, ci):
                 counters[STALE_EVENTS] += 1
                 pending[0] = bi
                 n_pending = 1
@@ -1064,21 +1111,21 @@ def step_exact(
             if cal.is_crossing(code):
                 now = max(now, t)
                 counters[CELL_CROSSINGS] += 1
-                grid.unlink(bi, ci)
-                grid.link(bi, grid.neighbour_cell(ci[bi, C_CELL], cal.EV_CROSS - code, nx), ci)
+                grid.unlink(bi, rec, ci, heads)
+                grid.link(bi, grid.neighbour_cell(ci[bi, C_CELL], cal.EV_CROSS - code, nx), rec, ci, heads)
                 pending[0] = bi
                 n_pending = 1
                 continue
             # verify (rotating clusters' predictions are re-checked by the contact test instead)
             if not sticky:
-                t_check = _verified_time(bi, code, pos, vel, radius, bounds, dim, cf)
+                t_check = _verified_time(bi, code, bounds, dim, rec)
                 if t_check > t:
                     if t_check == INF:
                         pending[0] = bi
                         n_pending = 1
                     else:
-                        cf[bi, C_EVENT_TIME] = t_check
-                        cal.reschedule(bi, n, cf, ci, hp)
+                        rec[bi]["event_time"] = t_check
+                        cal.reschedule(bi, n, rec, ci, hp)
                     continue
                 t = t_check
             if work_i[sc, W_EVENTS] >= max_events:
@@ -1093,14 +1140,14 @@ def step_exact(
             if code >= 0:  # a pair is resolved, and reported, from its lower ball
                 bj = max(bi, code)
                 bi = min(bi, code)
-            if sticky:
-                _sync_all(now, pos, vel, mass, body, omega, rot, sticky, cf)
+            if sticky or cascades:  # a cluster or a contact group reaches beyond the two balls
+                _sync_all(now, pos, vel, mass, body, omega, rot, sticky, rec)
             else:
-                _sync(bi, now, pos, vel, cf)
+                _sync(bi, now, rec)
+                _store(bi, rec, pos, vel)
                 if bj >= 0:
-                    _sync(bj, now, pos, vel, cf)
-                if cascades:  # a contact group reaches beyond the two balls
-                    _sync_all(now, pos, vel, mass, body, omega, rot, sticky, cf)
+                    _sync(bj, now, rec)
+                    _store(bj, rec, pos, vel)
             work_i[sc, W_EVENTS] += 1
             counters[EVENTS] += 1
             t_abs = t0 + sign * now
@@ -1168,15 +1215,18 @@ def step_exact(
                 )
             if sticky:
                 rot = has_rotation(body, omega)
-            # invalidate: events that other balls hold with these become stale through the change
-            # counters; the balls themselves are predicted afresh at the top of the loop
+            # invalidate: the balls whose motion changed take their new state into their records;
+            # events that other balls hold with them become stale through the change counters; the
+            # balls themselves are predicted afresh at the top of the loop
             for q in range(n_pending):
-                ci[pending[q], C_CHANGES] += 1
+                k = pending[q]
+                _load(k, now, rec, pos, vel)
+                rec[k]["changes"] += 1
 
         # finish
         stopped = capped[sc] or work_i[sc, W_STALLED]
         t_end = now if stopped else horizon_end
-        _finish(t_end, pos, vel, mass, body, omega, rot, sticky, cf, ci, hp)
+        _finish(t_end, pos, vel, mass, body, omega, rot, sticky, rec, ci, hp)
         time[sc] = t0 + sign * t_end
         work_f[sc, W_REMAINING] = horizon_end - t_end
         n_stalled += work_i[sc, W_STALLED]

@@ -8,15 +8,17 @@ event); in the cheap modes the grid is rebuilt at every sub-step, which is O(N).
 
 Cells are numbered ``cy * nx + cx``. The grid covers the border, or, without one, the box around
 the balls' starting positions; the outermost cells reach to infinity (positions are clamped), so
-a ball far outside still has a cell and the neighbour rule still holds. The number of cells is
-at most the number of balls, so the grid costs O(N) memory.
+a ball far outside still has a cell and the neighbour rule still holds. There are at most a few
+cells per ball, so the grid costs O(N) memory.
 
 The grid is used only where it pays (the model-only-what-is-needed rule): with fewer than
 :data:`GRID_MIN_BALLS` balls, in stick scenes, or when ball pairs are not modelled, the grid has
 one cell and the neighbours of a ball are all the others.
 
-Per-ball fields (``layout.CAL_I``): ``cell``, ``cell_next``, ``cell_prev`` (doubly linked lists,
-so a ball leaves its cell in O(1)); the head of cell c is in row c of ``cell_head``.
+Exact mode's cell lists are doubly linked, so a ball leaves its cell in O(1): a ball's
+``cell_next`` is in its calendar record (``layout.CAL_RECORD``, read for every neighbour), its
+``cell`` and ``cell_prev`` in its int32 row (``layout.CAL_I``); the first ball of cell c is
+``heads[c]``, in an int32 array of its own (the heads of a 3 x 3 block share a few cache lines).
 """
 
 from __future__ import annotations
@@ -28,8 +30,6 @@ import numpy as np
 from ._jit import njit
 from .layout import (
     C_CELL,
-    C_CELL_HEAD,
-    C_CELL_NEXT,
     C_CELL_PREV,
     W_GRID_HX,
     W_GRID_HY,
@@ -42,20 +42,25 @@ from .layout import (
 #: Scenes with fewer balls keep one cell (every ball is every other's neighbour): below this size
 #: the grid's bookkeeping costs more than the pairs it saves (measured by the engine benchmark).
 GRID_MIN_BALLS = 64
-#: Balls per cell the grid aims at (cells are never narrower than a diameter): fewer cells cost
-#: more pair predictions per event, more cells more cell crossings.
-BALLS_PER_CELL = 1.0
+#: Balls per cell exact mode's grid aims at, and the most cells it has per ball (cells are never
+#: narrower than a diameter): fewer cells cost more pair predictions per event, more cells more
+#: cell crossings (measured by the scale benchmark). The cheap modes rebuild their grid at every
+#: sub-step and aim at one ball per cell.
+EXACT_BALLS_PER_CELL = 0.3
+EXACT_CELLS_PER_BALL = 4
 #: Cells are this much wider than the largest diameter, so that round-off in a ball's position at
 #: a cell boundary can never hide a neighbour.
 CELL_MARGIN = 1.0 + 1e-6
 
 
-def grid_geometry(bounds, positions, radii, use_grid, reach=1.0):
+def grid_geometry(bounds, positions, radii, use_grid, reach=1.0, balls_per_cell=1.0, cells_per_ball=1):
     """Per-scene grid ``(x0, y0, hx, hy)`` and ``(nx, ny)`` for ``(B, N, 2)`` positions and
     ``(B, N)`` radii; scenes with ``use_grid`` False get a single cell. The cells are at least
-    ``reach * CELL_MARGIN`` largest diameters wide, and about as many as the balls (at most that
-    many). The cheap modes use ``reach = 2``: their grid is built before a sub-step's overlaps are
-    pushed apart, and a pushed ball must still find the balls it now overlaps."""
+    ``reach * CELL_MARGIN`` largest diameters wide, hold about ``balls_per_cell`` balls each, and
+    number at most ``cells_per_ball`` per ball. The cheap modes use ``reach = 2``: their grid is
+    built before a sub-step's overlaps are pushed apart, and a pushed ball must still find the
+    balls it now overlaps. Exact mode uses :data:`EXACT_BALLS_PER_CELL` and
+    :data:`EXACT_CELLS_PER_BALL`."""
     n_scenes, n = radii.shape
     if bounds is not None:
         lo = np.broadcast_to(np.array(bounds[:2], dtype=np.float64), (n_scenes, 2))
@@ -67,15 +72,16 @@ def grid_geometry(bounds, positions, radii, use_grid, reach=1.0):
     size = hi - lo
     sigma = 2.0 * reach * radii.max(axis=1) * CELL_MARGIN
     # about one ball per cell, but never narrower than a diameter
-    width = np.maximum(sigma, np.sqrt(BALLS_PER_CELL * size[:, 0] * size[:, 1] / n))
+    width = np.maximum(sigma, np.sqrt(balls_per_cell * size[:, 0] * size[:, 1] / n))
+    most = cells_per_ball * n
     counts = np.ones((n_scenes, 2), dtype=np.int64)
     if use_grid:
         for axis in range(2):
             c = np.floor(size[:, axis] / width)
-            counts[:, axis] = np.clip(np.nan_to_num(c, nan=1.0, posinf=1.0), 1, n).astype(np.int64)
+            counts[:, axis] = np.clip(np.nan_to_num(c, nan=1.0, posinf=1.0), 1, most).astype(np.int64)
         # a thin box: cells along its long axis alone
-        while np.any(counts[:, 0] * counts[:, 1] > n):
-            over = counts[:, 0] * counts[:, 1] > n
+        while np.any(counts[:, 0] * counts[:, 1] > most):
+            over = counts[:, 0] * counts[:, 1] > most
             big = np.argmax(counts, axis=1)
             counts[over, big[over]] -= 1
     cell = np.where(counts > 1, size / counts, np.inf)  # one cell along an axis: no boundary there
@@ -113,37 +119,45 @@ def cell_of(x, y, x0, y0, hx, hy, nx, ny):
 
 
 @njit(inline="always")
-def link(i, c, ci):
+def link(i, c, rec, ci, heads):
     """Put ball ``i`` at the front of cell ``c``'s list."""
-    head = ci[c, C_CELL_HEAD]
+    head = heads[c]
     ci[i, C_CELL] = c
     ci[i, C_CELL_PREV] = -1
-    ci[i, C_CELL_NEXT] = head
+    rec[i]["cell_next"] = head
     if head >= 0:
         ci[head, C_CELL_PREV] = i
-    ci[c, C_CELL_HEAD] = i
+    heads[c] = i
 
 
 @njit(inline="always")
-def unlink(i, ci):
+def unlink(i, rec, ci, heads):
     """Take ball ``i`` out of its cell's list."""
     prev = ci[i, C_CELL_PREV]
-    nxt = ci[i, C_CELL_NEXT]
+    nxt = rec[i]["cell_next"]
     if prev >= 0:
-        ci[prev, C_CELL_NEXT] = nxt
+        rec[prev]["cell_next"] = nxt
     else:
-        ci[ci[i, C_CELL], C_CELL_HEAD] = nxt
+        heads[ci[i, C_CELL]] = nxt
     if nxt >= 0:
         ci[nxt, C_CELL_PREV] = prev
 
 
 @njit(inline="always")
-def fill_cells(n, pos, ci, x0, y0, hx, hy, nx, ny):
-    """Empty every cell and put every ball in the cell of its position."""
+def move_to_cell(i, c, rec, ci, heads):
+    """Move ball ``i`` into cell ``c`` (nothing to do if it is there already)."""
+    if c != ci[i, C_CELL]:
+        unlink(i, rec, ci, heads)
+        link(i, c, rec, ci, heads)
+
+
+@njit(inline="always")
+def fill_cells(n, rec, ci, heads, x0, y0, hx, hy, nx, ny):
+    """Empty every cell and put every ball in the cell of its calendar position."""
     for c in range(nx * ny):
-        ci[c, C_CELL_HEAD] = -1
+        heads[c] = -1
     for i in range(n - 1, -1, -1):
-        link(i, cell_of(pos[i, 0], pos[i, 1], x0, y0, hx, hy, nx, ny), ci)
+        link(i, cell_of(rec[i]["x"], rec[i]["y"], x0, y0, hx, hy, nx, ny), rec, ci, heads)
 
 
 @njit(inline="always")

@@ -9,9 +9,9 @@ tuple and its constants agree.
 Per ball, ``(B, N, len(fields))``:
 
 - :data:`BALL` (float64): the physical state, see :mod:`collision_env.engine.motion`.
-- :data:`CAL_F` / :data:`CAL_I` (float64 / int64): exact mode's persistent event calendar and
-  cell grid, see :mod:`collision_env.engine.calendar` and :mod:`collision_env.engine.grid`;
-  :data:`HEAP` (float64): the calendar's event queue.
+- :data:`CAL_RECORD` (a structured dtype, ``(B, N)``) and :data:`CAL_I` (int32): exact mode's
+  persistent event calendar and cell grid, see :mod:`collision_env.engine.calendar` and
+  :mod:`collision_env.engine.grid`; :data:`HEAP` (float64): the calendar's event queue.
 
 Per scene:
 
@@ -23,25 +23,44 @@ Per scene:
 
 from __future__ import annotations
 
+import numpy as np
+
 #: Per-ball physical state: centre (m), velocity (m/s), mass (kg), its inverse, radius (m), and
 #: the angular velocity (rad/s) of the rigid cluster the ball roots (0 unless it roots one).
 BALL = ("x", "y", "vx", "vy", "mass", "inv_mass", "radius", "omega")
 B_X, B_Y, B_VX, B_VY, B_MASS, B_INV_MASS, B_RADIUS, B_OMEGA = range(8)
 
-#: Per-ball calendar floats: the time of the ball's next event (relative to the step's start);
-#: the time its stored position refers to (balls are moved lazily, when an event touches them);
-#: the position and velocity it had when the last step ended (a change made between steps, by a
-#: nudge or an env, is found by comparing against them).
-CAL_F = ("event_time", "ref_time", "seen_x", "seen_y", "seen_vx", "seen_vy")
-C_EVENT_TIME, C_REF_TIME, C_SEEN_X, C_SEEN_Y, C_SEEN_VX, C_SEEN_VY = range(6)
+#: Exact mode's calendar record of a ball: one 64-byte row, one cache line, holding everything a
+#: prediction reads of a neighbour, so that looking at a neighbour costs one memory access (the
+#: event loop's cost at 10^4 balls and more is memory traffic, not arithmetic). The ball's
+#: straight-line trajectory as the calendar knows it: its centre (m) at ``ref_time``, its velocity
+#: (m/s) and radius (m); the time of its next event; the next ball in its grid cell's list; and its
+#: change counter (a pair event predicted with a ball is stale once the ball's counter has moved).
+#: Times are relative to the start of the current step. Between steps the record holds the state
+#: the last step ended in, which is how a change made in between (a nudge, an env's action) is
+#: found. A structured dtype: kernels read a field by its name, ``cal[i]["x"]``.
+CAL_RECORD = np.dtype(
+    [
+        ("x", np.float64),
+        ("y", np.float64),
+        ("vx", np.float64),
+        ("vy", np.float64),
+        ("radius", np.float64),
+        ("ref_time", np.float64),
+        ("event_time", np.float64),
+        ("cell_next", np.int32),
+        ("changes", np.int32),
+    ],
+    align=True,
+)
 
-#: Per-ball calendar ints: what the next event is (a partner ball >= 0, or an ``calendar.EV_*``
-#: code); the partner's change counter when the event was predicted (a mismatch makes the event
-#: stale); the ball's own change counter; its slot in the event queue's heap; the ball's grid
-#: cell, the next and previous ball in that cell's list; and, in the first ``n_cells`` rows, the
-#: first ball of each cell (row c holds cell c's head).
-CAL_I = ("event_other", "event_stamp", "changes", "heap_slot", "cell", "cell_next", "cell_prev", "cell_head")
-C_EVENT_OTHER, C_EVENT_STAMP, C_CHANGES, C_HEAP_SLOT, C_CELL, C_CELL_NEXT, C_CELL_PREV, C_CELL_HEAD = range(8)
+#: Per-ball calendar ints (int32), read only for the ball's own event or when it moves between
+#: cells: what the next event is (a partner ball >= 0, or a ``calendar.EV_*`` code); the partner's
+#: change counter when it was predicted; the ball's slot in the event queue's heap; its grid cell
+#: and the previous ball in that cell's list. (The first ball of each cell is in a (B, cells) int32
+#: array of its own, so that the heads of neighbouring cells share cache lines.)
+CAL_I = ("event_other", "event_stamp", "heap_slot", "cell", "cell_prev")
+C_EVENT_OTHER, C_EVENT_STAMP, C_HEAP_SLOT, C_CELL, C_CELL_PREV = range(5)
 
 #: The event queue's heap, one row per slot (float64): the event time held there and the ball
 #: (an integer stored as a float, so that a node and its children share cache lines).
@@ -71,10 +90,10 @@ W_REMAINING, W_SUBSTEP_START, W_GRID_X0, W_GRID_Y0, W_GRID_HX, W_GRID_HY = range
 WORK_I = ("events", "active", "stalled", "substeps_done", "calendar_valid", "grid_nx", "grid_ny")
 W_EVENTS, W_ACTIVE, W_STALLED, W_SUBSTEPS_DONE, W_CALENDAR_VALID, W_GRID_NX, W_GRID_NY = range(7)
 
-#: Every packed layout, by name (for documentation and the layout test).
+#: Every packed layout indexed by column constants, by name (for documentation and the layout test);
+#: the calendar record, :data:`CAL_RECORD`, names its fields in its dtype.
 LAYOUTS = {
     "BALL": BALL,
-    "CAL_F": CAL_F,
     "CAL_I": CAL_I,
     "HEAP": HEAP,
     "SCENE_F": SCENE_F,

@@ -17,7 +17,9 @@ from typing import Any, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
+from . import grid
 from ._jit import BACKEND, njit
+from .calendar import heap_rows
 from .exact import COUNTERS, impacts_per_event, scratch_sizes, step_exact
 from .grid import GRID_MIN_BALLS, first_overlap, grid_geometry
 from .layout import (
@@ -27,8 +29,8 @@ from .layout import (
     B_RADIUS,
     B_VX,
     B_X,
-    CAL_F,
     CAL_I,
+    CAL_RECORD,
     HEAP,
     S_ELASTICITY,
     S_PAIRS,
@@ -122,6 +124,22 @@ def _copy_impacts(buf, out, sign, sort):
             out[j] = out[j - 1]
             out[j - 1] = buf[0]
             j -= 1
+
+
+def _aligned_zeros(shape, dtype, align=64):
+    """Zeros whose rows start on ``align``-byte boundaries: a 64-byte calendar record is then one
+    cache line (numpy itself aligns to 16 bytes)."""
+    dtype = np.dtype(dtype)
+    size = int(np.prod(shape)) * dtype.itemsize
+    buffer = np.zeros(size + align, dtype=np.uint8)
+    start = -buffer.ctypes.data % align
+    return buffer[start : start + size].view(dtype).reshape(shape)
+
+
+def _aligned_copy(array, align=64):
+    out = _aligned_zeros(array.shape, array.dtype, align)
+    out[...] = array
+    return out
 
 
 def _is_real(x):
@@ -307,10 +325,11 @@ class BatchSimulator:
         self._iparams = np.array([scene_i[name] for name in SCENE_I], dtype=np.int64)
         self._work_f = np.zeros((n_scenes, len(WORK_F)))
         self._work_i = np.zeros((n_scenes, len(WORK_I)), dtype=np.int64)
-        # exact mode's event calendar and grid, kept from step to step
-        self._cal_f = np.zeros((n_scenes, n, len(CAL_F)))
-        self._cal_i = np.zeros((n_scenes, n, len(CAL_I)), dtype=np.int64)
-        self._cal_heap = np.zeros((n_scenes, n, len(HEAP)))
+        # exact mode's event calendar and grid, kept from step to step (at most n cells per scene)
+        self._cal = _aligned_zeros((n_scenes, n), CAL_RECORD)
+        self._cal_i = np.zeros((n_scenes, n, len(CAL_I)), dtype=np.int32)
+        self._cal_heads = np.zeros((n_scenes, grid.EXACT_CELLS_PER_BALL * n), dtype=np.int32)
+        self._cal_heap = _aligned_zeros((n_scenes, heap_rows(n), len(HEAP)), np.float64)
         self._invalidate(np.arange(n_scenes))
         self._alloc_work()
 
@@ -432,9 +451,12 @@ class BatchSimulator:
     def _invalidate(self, scenes):
         """Drop the calendar's predictions for ``scenes`` (they are made afresh at the next step)
         and lay out their grid for the balls they now hold."""
-        reach = 1.0 if self.mode == "exact" else 2.0
+        if self.mode == "exact":
+            shape = dict(balls_per_cell=grid.EXACT_BALLS_PER_CELL, cells_per_ball=grid.EXACT_CELLS_PER_BALL)
+        else:
+            shape = dict(reach=2.0)
         origin_and_cells, counts = grid_geometry(
-            self.scene.bounds, self._pos[scenes], self._radius[scenes], self._uses_grid(), reach
+            self.scene.bounds, self._pos[scenes], self._radius[scenes], self._uses_grid(), **shape
         )
         self._work_f[scenes, W_GRID_X0 : W_GRID_X0 + 4] = origin_and_cells
         self._work_i[scenes, W_GRID_NX : W_GRID_NX + 2] = counts
@@ -471,7 +493,7 @@ class BatchSimulator:
             nf, ni, nb = scratch_sizes(self._n)
             self._kernel = step_exact
             scratch = (np.empty(nf), np.empty(ni, dtype=np.int64), np.zeros(nb, dtype=np.bool_))
-            self._kernel_args = state + (self._cal_f, self._cal_i, self._cal_heap) + scratch
+            self._kernel_args = state + (self._cal, self._cal_i, self._cal_heads, self._cal_heap) + scratch
         else:
             self._kernel = step_substeps
             self._kernel_args = (
@@ -807,6 +829,9 @@ class BatchSimulator:
 
     def __setstate__(self, state):
         self.__dict__.update(state)
+        # a copy or an unpickled array has numpy's alignment
+        self._cal = _aligned_copy(self._cal)
+        self._cal_heap = _aligned_copy(self._cal_heap)
         self._bind_views()
         self._alloc_work()
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import re
 
+import numpy as np
 import pytest
 
 from collision_env.engine import layout
@@ -14,7 +15,6 @@ def test_each_field_has_the_constant_of_its_position(name):
     fields = layout.LAYOUTS[name]
     prefix = {
         "BALL": "B_",
-        "CAL_F": "C_",
         "CAL_I": "C_",
         "HEAP": "H_",
         "SCENE_F": "S_",
@@ -34,7 +34,7 @@ def test_engine_arrays_are_as_wide_as_their_layouts():
     sim = Simulator(Scene(), [[0.0, 0.0], [1.0, 0.0]], [[1.0, 0.0], [0.0, 0.0]], [1.0, 1.0])
     b = sim.batch
     assert b._balls.shape[-1] == len(layout.BALL)
-    assert b._cal_f.shape[-1] == len(layout.CAL_F)
+    assert b._cal.dtype == layout.CAL_RECORD
     assert b._cal_i.shape[-1] == len(layout.CAL_I)
     assert b._cal_heap.shape[-1] == len(layout.HEAP)
     assert b._fparams.shape == (len(layout.SCENE_F),)
@@ -42,3 +42,16 @@ def test_engine_arrays_are_as_wide_as_their_layouts():
     assert b._work_f.shape[-1] == len(layout.WORK_F)
     assert b._work_i.shape[-1] == len(layout.WORK_I)
     assert b._fparams[layout.S_XMAX] == 2.0 and b._iparams[layout.S_DIM] == 2
+
+
+def test_a_calendar_record_is_one_cache_line():
+    """Everything a prediction reads of a neighbour is in one 64-byte row, aligned to one."""
+    from collision_env.engine import Scene, Simulator
+
+    assert layout.CAL_RECORD.itemsize == 64
+    n = 100
+    sim = Simulator(
+        Scene(), np.stack([np.linspace(-1.8, 1.8, n), np.zeros(n)], 1), np.zeros((n, 2)), np.ones(n), np.full(n, 0.01)
+    )
+    for cal in (sim.batch._cal, sim.copy().batch._cal):
+        assert cal.ctypes.data % 64 == 0
