@@ -45,10 +45,13 @@ import numpy as np
 
 from . import calendar as cal
 from . import grid
-from ._jit import njit
+from ._jit import HAVE_NUMBA, njit
+from .clock import finish_step
 from .layout import (
     C_CELL,
     C_EVENT_OTHER,
+    CAL_RECORD,
+    IMPACT_DTYPE,
     S_COLLAPSE_FLOOR,
     S_COLLAPSE_RATIO,
     S_DIM,
@@ -67,6 +70,9 @@ from .layout import (
     W_STALLED,
 )
 from .ldp import least_distance
+
+if HAVE_NUMBA:
+    from .argpack import view1, view2, view3
 from .motion import advance_all, ball_views, body_kinematics, has_rotation
 from .response import ball_ball, ball_wall, group_threshold, impact_threshold, merge_bodies, stop_body
 from .toi import INF, ca_pair, ca_wall, toi_pair, toi_wall
@@ -980,6 +986,7 @@ def step_exact(
     counters,
     work_f,
     work_i,
+    clock,
     cal_rec,
     cal_i,
     cal_heads,
@@ -997,7 +1004,8 @@ def step_exact(
     (``layout.SCENE_F``/``SCENE_I``); ``work_f``/``work_i`` the per-scene bookkeeping and grid
     geometry (``layout.WORK_F``/``WORK_I``); ``cal_rec``/``cal_i``/``cal_heads``/``cal_heap`` the
     persistent calendar records, its int rows, the grid's cell heads and the event queue
-    (``layout.CAL_RECORD``/``CAL_I``/``HEAP``). ``fresh`` starts a step
+    (``layout.CAL_RECORD``/``CAL_I``/``HEAP``); ``clock`` the compensated clocks
+    (:mod:`~collision_env.engine.clock`), advanced when a scene's step ends. ``fresh`` starts a step
     of ``dt_abs`` for every scene; otherwise the call resumes the scenes flagged active.
     Impacts go to ``imp`` rows (``simulator.IMPACT_DTYPE``) from row 0, ``n_imp[0]`` rows in all; a
     scene that finds the buffer full stops where it is and is flagged stalled, so the caller can
@@ -1232,4 +1240,38 @@ def step_exact(
         n_stalled += work_i[sc, W_STALLED]
         n_imp[1] += capped[sc]
         work_i[sc, W_ACTIVE] = work_i[sc, W_STALLED]
+        if not work_i[sc, W_STALLED]:
+            finish_step(sc, not capped[sc], sign * dt_abs, time, clock)
     return n_stalled
+
+
+if HAVE_NUMBA:
+
+    @njit
+    def step_exact_packed(h, dt_abs, fresh):
+        """:func:`step_exact` on the arrays packed in ``h`` (:mod:`~collision_env.engine.argpack`),
+        one slot per array in the order of its parameters; the call Python makes, with one array
+        to check instead of nineteen."""
+        return step_exact(
+            view3(h, 0, np.float64),
+            view2(h, 1, np.int64),
+            view1(h, 2, np.float64),
+            view1(h, 3, np.bool_),
+            view1(h, 4, np.float64),
+            view1(h, 5, np.int64),
+            view1(h, 6, IMPACT_DTYPE),
+            view1(h, 7, np.int64),
+            view1(h, 8, np.int64),
+            view2(h, 9, np.float64),
+            view2(h, 10, np.int64),
+            view2(h, 11, np.float64),
+            view2(h, 12, CAL_RECORD),
+            view3(h, 13, np.int32),
+            view2(h, 14, np.int32),
+            view3(h, 15, np.float64),
+            view1(h, 16, np.float64),
+            view1(h, 17, np.int64),
+            view1(h, 18, np.bool_),
+            dt_abs,
+            fresh,
+        )

@@ -90,6 +90,20 @@ W_REMAINING, W_SUBSTEP_START, W_GRID_X0, W_GRID_Y0, W_GRID_HX, W_GRID_HY = range
 WORK_I = ("events", "active", "stalled", "substeps_done", "calendar_valid", "grid_nx", "grid_ny")
 W_EVENTS, W_ACTIVE, W_STALLED, W_SUBSTEPS_DONE, W_CALENDAR_VALID, W_GRID_NX, W_GRID_NY = range(7)
 
+#: One row per impact, as ``BatchSimulator.step`` returns them (the kernels write them).
+IMPACT_DTYPE = np.dtype(
+    [
+        ("scene", np.int64),
+        ("time", np.float64),
+        ("ball", np.int64),
+        ("other", np.int64),  # -1: a wall
+        ("wall", np.int64),  # index into WALL_NAMES, -1: another ball
+        ("x", np.float64),
+        ("y", np.float64),
+        ("speed", np.float64),  # normal closing speed just before the impact
+    ]
+)
+
 #: Every packed layout indexed by column constants, by name (for documentation and the layout test);
 #: the calendar record, :data:`CAL_RECORD`, names its fields in its dtype.
 LAYOUTS = {

@@ -11,16 +11,20 @@ import copy
 import numbers
 import warnings
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from . import grid
-from ._jit import BACKEND, njit
+from ._jit import BACKEND, HAVE_NUMBA, njit
+from .argpack import pack
 from .calendar import heap_rows
 from .exact import COUNTERS, impacts_per_event, scratch_sizes, step_exact
+
+if HAVE_NUMBA:
+    from .exact import step_exact_packed
+    from .substep import step_substeps_packed
 from .grid import GRID_MIN_BALLS, first_overlap, grid_geometry
 from .layout import (
     B_INV_MASS,
@@ -32,6 +36,7 @@ from .layout import (
     CAL_I,
     CAL_RECORD,
     HEAP,
+    IMPACT_DTYPE,
     S_ELASTICITY,
     S_PAIRS,
     S_SIGN,
@@ -40,7 +45,6 @@ from .layout import (
     W_CALENDAR_VALID,
     W_GRID_NX,
     W_GRID_X0,
-    W_REMAINING,
     WORK_F,
     WORK_I,
 )
@@ -52,19 +56,10 @@ from .tolerance import CONTACT_RTOL, EPS, roundoff
 
 MODES = ("naive", "posteriori", "exact")
 
-#: One row per impact, as :meth:`BatchSimulator.step` returns them.
-IMPACT_DTYPE = np.dtype(
-    [
-        ("scene", np.int64),
-        ("time", np.float64),
-        ("ball", np.int64),
-        ("other", np.int64),  # -1: a wall
-        ("wall", np.int64),  # index into WALL_NAMES, -1: another ball
-        ("x", np.float64),
-        ("y", np.float64),
-        ("speed", np.float64),  # normal closing speed just before the impact
-    ]
-)
+#: What a step without impacts returns: one shared array of no rows (read-only, as nothing can be
+#: written to it; a fresh empty structured array costs more than a small scene's step).
+_NO_IMPACTS = np.empty(0, dtype=IMPACT_DTYPE)
+_NO_IMPACTS.flags.writeable = False
 
 #: Relative tolerance for "touching" in the start-state checks (exact contact is allowed).
 _CONTACT_RTOL = 1e-12
@@ -95,9 +90,8 @@ class EventCapWarning(RuntimeWarning):
     """A scene reached the cap on events per step and stopped early (in a valid state)."""
 
 
-@dataclass(frozen=True)
-class Impact:
-    """One collision inside a step."""
+class Impact(NamedTuple):
+    """One collision inside a step (a named tuple: cheap to make, immutable)."""
 
     time: float  #: absolute simulation time (s)
     ball: int  #: index of the ball
@@ -108,15 +102,13 @@ class Impact:
 
 
 @njit(refcount=False)
-def _copy_impacts(buf, out, sign, sort):
-    """Copy the first ``len(out)`` impact records of ``buf`` into ``out``; with ``sort``, order each
-    scene's records by ``sign * time`` (stable, so simultaneous impacts keep their order). The
-    rows of one scene are contiguous and scenes come in order, so an insertion sort is linear here."""
+def _copy_impacts(buf, out, sign):
+    """Copy the first ``len(out)`` impact records of ``buf`` into ``out``, each scene's records
+    ordered by ``sign * time`` (stable, so simultaneous impacts keep their order). The rows of one
+    scene are contiguous and scenes come in order, so an insertion sort is linear here."""
     n = out.shape[0]
     for k in range(n):
         out[k] = buf[k]
-    if not sort:
-        return
     for k in range(1, n):
         j = k
         while j > 0 and out[j - 1]["scene"] == out[j]["scene"] and sign * out[j - 1]["time"] > sign * out[j]["time"]:
@@ -183,26 +175,6 @@ def _real_array(value, shapes, field, where):
     if arr.shape not in shapes:
         raise ValueError(f"{field}: expected shape {' or '.join(map(str, shapes))}, got {arr.shape}")
     return arr
-
-
-@njit(refcount=False)
-def _advance_clocks(time, clock, work_f, dt_abs, sign):
-    """Compensated clocks. ``clock[sc]`` = (the time at the start of the step, its compensation):
-    the exact time is their sum, and ``time`` (which the kernels read, and overwrite during the step)
-    its correctly rounded value. A scene that completed its step (``work_f[sc, 0]``, the time left
-    in it, is 0) advances by ``sign * dt_abs`` through Knuth's TwoSum and a renormalisation, so the
-    clock stays within an ulp of the exact sum of the steps. A scene that stopped short (the event
-    cap) keeps the time of its last event, as the kernel set it."""
-    a = sign * dt_abs
-    for sc in range(time.shape[0]):
-        start = clock[sc, 0]
-        if work_f[sc, W_REMAINING] == 0.0:
-            hi = start + a
-            b = hi - start
-            lo = clock[sc, 1] + ((start - (hi - b)) + (a - b))
-            time[sc] = hi + lo
-            clock[sc, 1] = lo - (time[sc] - hi)
-        clock[sc, 0] = time[sc]
 
 
 class BatchSimulator:
@@ -474,6 +446,7 @@ class BatchSimulator:
                 worst = 16 * self._n if self._uses_grid() else worst_case_impacts(self._n)
             rows = max(4096, 2 * worst)
         self._imp = np.empty(rows, dtype=IMPACT_DTYPE)
+        self._imp_bytes = memoryview(self._imp.view(np.uint8))
         self._n_imp = np.zeros(2, dtype=np.int64)  # rows filled, scenes that reached the cap
         # the mode's kernel and its arguments, bound once (the arrays are only ever updated in place)
         state = (
@@ -488,20 +461,24 @@ class BatchSimulator:
             self._counters,
             self._work_f,
             self._work_i,
+            self._clock,
         )
         if self.mode == "exact":
             nf, ni, nb = scratch_sizes(self._n)
-            self._kernel = step_exact
             scratch = (np.empty(nf), np.empty(ni, dtype=np.int64), np.zeros(nb, dtype=np.bool_))
-            self._kernel_args = state + (self._cal, self._cal_i, self._cal_heads, self._cal_heap) + scratch
+            arrays = state + (self._cal, self._cal_i, self._cal_heads, self._cal_heap) + scratch
+            self._kernel, self._kernel_args = step_exact, arrays
+            if HAVE_NUMBA:  # one packed array per call instead of nineteen (see argpack)
+                self._kernel, self._kernel_args = step_exact_packed, (pack(arrays),)
         else:
-            self._kernel = step_substeps
-            self._kernel_args = (
-                (NAIVE if self.mode == "naive" else POSTERIORI, self.substeps)
-                + state
-                + (np.empty(substep_scratch_size(self._n), dtype=np.int64),)
-            )
+            arrays = state + (np.empty(substep_scratch_size(self._n), dtype=np.int64),)
+            flavour = (NAIVE if self.mode == "naive" else POSTERIORI, self.substeps)
+            self._kernel, self._kernel_args = step_substeps, flavour + arrays
+            if HAVE_NUMBA:
+                self._kernel, self._kernel_args = step_substeps_packed, flavour + (pack(arrays),)
+        self._kernel_arrays = arrays  # (what a pack refers to, kept alive with it)
         self._sign = float(self._fparams[S_SIGN])  # the direction _fparams are set for (see step)
+        self._forward = self._sign > 0.0 and self.scene.bounds is not None  # step's fast path applies
         self._live = LiveArrays(
             self._balls, self._pos, self._vel, self._mass, self._radius, self._time, self._body, self._capped
         )
@@ -518,6 +495,13 @@ class BatchSimulator:
         back again returns it to exactly where it was).
         """
         dt = _real_number(dt, "dt")
+        if self._forward and 0.0 < dt <= _MAX_MAGNITUDE:  # the common case, checked in one test
+            stalled = self._kernel(*self._kernel_args, dt, True)
+            n_imp = self._n_imp
+            if not (stalled or n_imp[1]):  # no scene stalled or reached the event cap
+                rows = n_imp[0]
+                return self._take_impacts(rows) if rows else _NO_IMPACTS
+            return self._finish(self._run(dt, stalled), 1.0)
         if not abs(dt) <= _MAX_MAGNITUDE:
             raise ValueError(f"dt: must be finite and at most {_MAX_MAGNITUDE:g} s, got {dt}")
         if self.scene.bounds is None:
@@ -529,13 +513,14 @@ class BatchSimulator:
             )
         if dt == 0.0:
             self._capped[:] = False
-            return np.zeros(0, dtype=IMPACT_DTYPE)
+            return _NO_IMPACTS
         sign = 1.0 if dt > 0.0 else -1.0
         if sign != self._sign:  # reverse steps use 1/e
             fp = self._fparams
             fp[S_ELASTICITY] = e if sign > 0 else 1.0 / e
             fp[S_SIGN] = sign
             self._sign = sign
+            self._forward = sign > 0.0 and self.scene.bounds is not None
         if sign < 0:
             np.negative(self._vel, out=self._vel)
             np.negative(self._omega, out=self._omega)
@@ -545,15 +530,23 @@ class BatchSimulator:
             if sign < 0:
                 np.negative(self._vel, out=self._vel)
                 np.negative(self._omega, out=self._omega)
-            _advance_clocks(self._time, self._clock, self._work_f, abs(dt), sign)
+        return self._finish(chunks, sign)
+
+    def _finish(self, chunks, sign):
+        """Warn about scenes that reached the event cap; the step's impacts as one array."""
         if self._n_imp[1]:
             warnings.warn(
                 f"event cap of {self.max_events} per step reached in scene(s) {np.flatnonzero(self._capped).tolist()}; "
                 "they stopped early at their last event (see cap_reached and time)",
                 EventCapWarning,
-                stacklevel=2,
+                stacklevel=3,
             )
-        return self._impacts(chunks, sign)
+        if not chunks:
+            return _NO_IMPACTS
+        if len(chunks) == 1:
+            return chunks[0]
+        out = np.concatenate(chunks)  # a stalled step: a scene's impacts may span chunks
+        return out[np.lexsort((sign * out["time"], out["scene"]))]
 
     def _check_reach(self, dt):
         """Without a border, a step of ``dt`` must keep every ball within the representable range."""
@@ -565,34 +558,35 @@ class BatchSimulator:
                 f"{_MAX_MAGNITUDE:g} m (no border), where positions are no longer representable"
             )
 
-    def _run(self, dt_abs):
+    def _run(self, dt_abs, stalled=None):
+        """Run the mode's kernel until every scene has stepped ``dt_abs``; the impacts in chunks,
+        one per call (a call stops the scenes that find the impact buffer full, which the next
+        call resumes). ``stalled``: what the step's first call, already made, returned."""
         chunks = []
-        fresh = True
         kernel, args, n_imp = self._kernel, self._kernel_args, self._n_imp
+        if stalled is None:
+            stalled = kernel(*args, dt_abs, True)
         while True:  # each call resets n_imp[0] and fills the impact buffer from row 0
-            stalled = kernel(*args, dt_abs, fresh)
             rows = n_imp[0]
             if rows:
-                out = np.empty(rows, dtype=IMPACT_DTYPE)
-                # exact mode records each scene's impacts in the order they happen, scenes in order;
-                # the cheap modes' reconstructed times need sorting within each scene
-                _copy_impacts(self._imp, out, self._sign, kernel is step_substeps)
-                chunks.append(out)
+                chunks.append(self._take_impacts(rows))
             if not stalled:
                 return chunks
             if not rows:  # not even one sub-step's worst case fits: a bigger buffer
                 self._alloc_work(2 * len(self._imp))
                 kernel, args = self._kernel, self._kernel_args
-            fresh = False
+            stalled = kernel(*args, dt_abs, False)
 
-    @staticmethod
-    def _impacts(chunks, sign):
-        if not chunks:
-            return np.empty(0, dtype=IMPACT_DTYPE)
-        if len(chunks) == 1:
-            return chunks[0]
-        out = np.concatenate(chunks)  # a stalled step: a scene's impacts may span chunks
-        return out[np.lexsort((sign * out["time"], out["scene"]))]
+    def _take_impacts(self, rows):
+        """A copy of the first ``rows`` impact records. Exact mode records each scene's impacts
+        in the order they happen, scenes in order; the cheap modes' reconstructed times need
+        sorting within each scene."""
+        if self.mode == "exact":
+            # (numpy copies structured arrays slowly: a byte copy is several times cheaper)
+            return np.frombuffer(bytearray(self._imp_bytes[: rows * IMPACT_DTYPE.itemsize]), IMPACT_DTYPE)
+        out = np.empty(rows, dtype=IMPACT_DTYPE)
+        _copy_impacts(self._imp, out, self._sign)
+        return out
 
     # ------------------------------------------------------------------ state access
     @property
@@ -812,10 +806,13 @@ class BatchSimulator:
         state = self.__dict__.copy()
         for key in (
             "_imp",
+            "_imp_bytes",
             "_n_imp",
             "_kernel",
             "_kernel_args",
+            "_kernel_arrays",
             "_sign",
+            "_forward",
             "_live",
             "_pos",
             "_vel",
@@ -890,16 +887,11 @@ class Simulator:
     def step(self, dt: float) -> list[Impact]:
         """Advance by ``dt`` seconds (negative: backwards). Returns the step's impacts in time order."""
         rows = self._batch.step(dt)
+        if not len(rows):
+            return []
         return [
-            Impact(
-                time=float(r["time"]),
-                ball=int(r["ball"]),
-                other=None if r["other"] < 0 else int(r["other"]),
-                wall=None if r["wall"] < 0 else WALL_NAMES[r["wall"]],
-                point=(float(r["x"]), float(r["y"])),
-                speed=float(r["speed"]),
-            )
-            for r in rows
+            Impact(t, ball, None if other < 0 else other, None if wall < 0 else WALL_NAMES[wall], (x, y), speed)
+            for _, t, ball, other, wall, x, y, speed in rows.tolist()
         ]
 
     positions = property(lambda self: self._batch._pos[0].copy(), doc="(N, 2) centres, m (a copy).")

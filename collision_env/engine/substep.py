@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
-from ._jit import njit
+from ._jit import HAVE_NUMBA, njit
+from .clock import finish_step
 from .exact import scene_params
 from .grid import block, cell_of, scene_geometry
 from .layout import (
+    IMPACT_DTYPE,
     W_ACTIVE,
     W_STALLED,
     W_SUBSTEP_START,
@@ -15,6 +17,11 @@ from .motion import advance_all, ball_views, has_rotation
 from .naive import resolve_naive
 from .posteriori import resolve_posteriori
 from .response import elastic_threshold
+
+if HAVE_NUMBA:
+    import numpy as np
+
+    from .argpack import view1, view2, view3
 
 NAIVE, POSTERIORI = 0, 1
 
@@ -86,6 +93,7 @@ def step_substeps(
     counters,
     work_f,
     work_i,
+    clock,
     scratch,
     dt_abs,
     fresh,
@@ -185,4 +193,33 @@ def step_substeps(
             time[sc] = t_end
         n_stalled += stalled[sc]
         active[sc] = stalled[sc]
+        if not stalled[sc]:
+            finish_step(sc, True, sign * dt_abs, time, clock)
     return n_stalled
+
+
+if HAVE_NUMBA:
+
+    @njit
+    def step_substeps_packed(mode, k_total, h, dt_abs, fresh):
+        """:func:`step_substeps` on the arrays packed in ``h`` (:mod:`~collision_env.engine.argpack`),
+        one slot per array in the order of its parameters."""
+        return step_substeps(
+            mode,
+            k_total,
+            view3(h, 0, np.float64),
+            view2(h, 1, np.int64),
+            view1(h, 2, np.float64),
+            view1(h, 3, np.bool_),
+            view1(h, 4, np.float64),
+            view1(h, 5, np.int64),
+            view1(h, 6, IMPACT_DTYPE),
+            view1(h, 7, np.int64),
+            view1(h, 8, np.int64),
+            view2(h, 9, np.float64),
+            view2(h, 10, np.int64),
+            view2(h, 11, np.float64),
+            view1(h, 12, np.int64),
+            dt_abs,
+            fresh,
+        )

@@ -174,7 +174,7 @@ def test_memory_and_construction_are_linear_in_the_balls():
     scene, pos, vel, radii = gas(n)
     sim = Simulator(scene, pos, vel, np.ones(n), radii=radii)
     arrays = [v for v in vars(sim.batch).values() if isinstance(v, np.ndarray)]
-    arrays += [a for a in sim.batch._kernel_args if isinstance(a, np.ndarray)]
+    arrays += [a for a in sim.batch._kernel_arrays if isinstance(a, np.ndarray)]
     per_ball = sum({id(a): a.nbytes for a in arrays}.values()) / n
     assert per_ball < 2048
     assert GRID_MIN_BALLS < n
