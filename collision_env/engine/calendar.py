@@ -171,9 +171,13 @@ def _first_child(first, n, ci, hp):
 
 
 @njit(inline="always")
-def _sift_down(slot, n, rec, ci, hp):
+def _sift_down(slot, n, ci, hp):
+    """Move the ball at ``slot`` down to its place (its time is the one held in the heap; a ball
+    already in place is not written again, so ordering a heap that is in order reads only the
+    heap)."""
     ball = _ball_at(slot, hp)
-    t = rec[ball]["event_time"]
+    t = _time_at(slot, hp)
+    start = slot
     while True:
         first = ARITY * slot + 1
         if first >= n:
@@ -184,21 +188,22 @@ def _sift_down(slot, n, rec, ci, hp):
             break
         _place(slot, below, t_child, ci, hp)
         slot = child
-    _place(slot, ball, t, ci, hp)
+    if slot != start:
+        _place(slot, ball, t, ci, hp)
 
 
 @njit(inline="always")
 def reschedule(ball, n, rec, ci, hp):
     """Restore the heap order after ``ball``'s event time changed (either way)."""
     slot = _sift_up(ci[ball, C_HEAP_SLOT], rec, ci, hp)
-    _sift_down(slot, n, rec, ci, hp)
+    _sift_down(slot, n, ci, hp)
 
 
 @njit(inline="always")
-def heapify(n, rec, ci, hp):
-    """Order the heap from scratch (Floyd's O(N) construction), from the balls' event times."""
+def heapify(n, ci, hp):
+    """Order the heap from scratch (Floyd's O(N) construction), from the event times it holds."""
     for slot in range((n - 2) // ARITY, -1, -1):
-        _sift_down(slot, n, rec, ci, hp)
+        _sift_down(slot, n, ci, hp)
 
 
 @njit(inline="always")
@@ -206,7 +211,7 @@ def reset_heap(n, rec, ci, hp):
     """Put every ball in the heap (slot = index) and order it."""
     for i in range(n):
         _place(i, i, rec[i]["event_time"], ci, hp)
-    heapify(n, rec, ci, hp)
+    heapify(n, ci, hp)
 
 
 @njit(inline="always")

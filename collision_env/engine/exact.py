@@ -789,7 +789,7 @@ def _finish(t_end, pos, vel, mass, body, omega, rot, sticky, rec, ci, hp):
         r["ref_time"] = 0.0
         r["event_time"] -= t_end
     cal.rebase(n, t_end, hp)  # the same times, rebased the same way
-    cal.heapify(n, rec, ci, hp)  # rebasing can round two times into a tie the heap must order by index
+    cal.heapify(n, ci, hp)  # rebasing can round two times into a tie the heap must order by index
 
 
 # ---------------------------------------------------------------------------- resolve
