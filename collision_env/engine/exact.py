@@ -3,21 +3,26 @@
 The scheduler of the event-driven loop (Alder & Wainwright 1959; Rapaport 1980; Lubachevsky
 1991). Its parts, each with one job:
 
-- the **calendar** (:mod:`~collision_env.engine.calendar`): one pending event per ball in a binary
+- the **calendar** (:mod:`~collision_env.engine.calendar`): one pending event per ball in a 4-ary
   heap, invalidated lazily; it persists from one step to the next;
 - the **broad phase** (:mod:`~collision_env.engine.grid`): a cell grid, so that a prediction looks
   only at the 3 x 3 cells around a ball, kept current by cell-crossing events (one cell, i.e. all
   pairs, in small scenes);
-- this **scheduler**, :func:`step_exact`, in named phases: *begin* (re-predict only the balls that
-  changed since the last step: a nudge, an env's action, a reversal of time; everything after a
-  reset or ``set_state``), then repeatedly *pop* the earliest event, *verify* it, *advance* the
-  balls it involves, *resolve* it, and *invalidate* (re-predict the balls whose motion changed),
-  and finally *finish* (bring every ball to the end of the step and rebase the calendar's times).
+- this **scheduler**, :func:`step_exact`, in named phases: *begin* (:func:`_begin_changed_balls`:
+  re-predict only the balls that changed since the last step, a nudge, an env's action, a
+  reversal of time; :func:`_begin_whole_scene` after a reset or ``set_state``), then repeatedly
+  *predict* (:func:`_predict`), *pop* the earliest event and screen it (:func:`_screen`: stale,
+  a cell crossing, or re-verified), *advance* the balls it involves (:func:`_advance`), *resolve*
+  it (:func:`_resolve_wall`, :func:`_resolve_pair`, and a contact group's cascade) and
+  *invalidate* (:func:`_invalidate`), and finally *finish* (:func:`_finish`: bring every ball to
+  the end of the step and rebase the calendar's times). The phases take a scene's arrays in
+  named bundles (:class:`SceneBalls`, :class:`SceneCalendar`, :class:`Physics`, :class:`Work`);
+  they are inlined, so the bundles cost nothing.
 
-Balls move lazily: a ball's stored position refers to its own ``ref_time`` and is brought up to
-date only when an event involves it (or when the step ends), so an event costs O(log N) with O(1)
-partners instead of moving every ball. Stick scenes (rotating clusters) keep every ball at the
-same time instead, as their kinematics need.
+Balls move lazily: a ball's calendar record holds its position at its own ``ref_time``, brought
+up to date only when an event involves it (or when the step ends), so an event costs O(log N)
+with O(1) partners instead of moving every ball. Stick scenes (rotating clusters) keep every ball
+at the same time instead, as their kinematics need.
 
 Determinism: ties are broken by index (a ball's wall before its partners, then the lowest ball
 index, then the lowest partner index). Simultaneous events are therefore resolved one after
@@ -40,6 +45,7 @@ Reverse steps are run forward on negated velocities with restitution 1/e (the ca
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -104,6 +110,80 @@ def scene_params(fparams, iparams):
         iparams[S_DIM],
         iparams[S_STICKY] != 0,
         iparams[S_MAX_EVENTS],
+    )
+
+
+class SceneBalls(NamedTuple):
+    """One scene's ball state: views of the batch's ``layout.BALL`` array and cluster roots."""
+
+    pos: np.ndarray  #: (N, 2) centres, m
+    vel: np.ndarray  #: (N, 2) velocities, m/s
+    mass: np.ndarray  #: (N,) kg
+    inv_mass: np.ndarray  #: (N,) 1 / kg
+    radius: np.ndarray  #: (N,) m
+    body: np.ndarray  #: (N,) the ball rooting each ball's cluster
+    omega: np.ndarray  #: (N,) angular velocity of the cluster each ball roots, rad/s
+
+
+class SceneCalendar(NamedTuple):
+    """One scene's calendar (see :mod:`~collision_env.engine.calendar`)."""
+
+    rec: np.ndarray  #: (N,) ``layout.CAL_RECORD``
+    ci: np.ndarray  #: (N, len(CAL_I)) int32
+    heads: np.ndarray  #: (cells,) int32, the first ball of each grid cell
+    hp: np.ndarray  #: the event queue (``layout.HEAP``)
+
+
+class Physics(NamedTuple):
+    """What a step's physics depends on, shared by the scenes of a batch (``scene_params``)."""
+
+    bounds: np.ndarray  #: (xmin, ymin, xmax, ymax), m
+    e: float  #: restitution used this step
+    ratio: float  #: collapse regulariser: u_min / fastest speed
+    floor: float  #: collapse regulariser: smallest u_min, m/s
+    sign: float  #: direction of time, +1 or -1
+    has_walls: bool
+    pairs: bool  #: ball pairs are modelled
+    dim: int
+    sticky: bool  #: stick clusters are formed
+    cascades: bool  #: forward inelastic: touching groups are resolved at one instant
+
+
+class Work(NamedTuple):
+    """The step's buffers: impact records and counters, and scratch space (``scratch_sizes``)."""
+
+    imp: np.ndarray  #: impact records (``layout.IMPACT_DTYPE``)
+    n_imp: np.ndarray  #: rows filled, scenes that reached the event cap
+    counters: np.ndarray  #: work counters (``COUNTERS``)
+    pending: np.ndarray  #: balls to predict (or whose motion an event changed)
+    in_group: np.ndarray  #: a contact group's membership, per ball
+    c_a: np.ndarray  #: a contact group's contacts: the lower ball
+    c_b: np.ndarray  #: ... and the other ball (>= 0) or the wall (-1 - wall)
+    c_hit: np.ndarray  #: ... and whether it was reported already
+    ki: np.ndarray  #: a rotating cluster member's kinematics (7 floats)
+    kj: np.ndarray  #: ... and its partner's
+
+
+@njit(inline="always")
+def _physics(fparams, iparams):
+    bounds, e, ratio, floor, sign, has_walls, pairs, dim, sticky, _ = scene_params(fparams, iparams)
+    return Physics(bounds, e, ratio, floor, sign, has_walls, pairs, dim, sticky, e < 1.0)
+
+
+@njit(inline="always")
+def _work(n, imp, n_imp, counters, scratch_f, scratch_i, scratch_b):
+    nc = contact_capacity(n)
+    return Work(
+        imp,
+        n_imp,
+        counters,
+        scratch_i[0:n],
+        scratch_b[0:n],
+        scratch_i[n : n + nc],
+        scratch_i[n + nc : n + 2 * nc],
+        scratch_b[n : n + nc],
+        scratch_f[0:7],
+        scratch_f[7:14],
     )
 
 
@@ -624,96 +704,91 @@ def _wall_time(i, bounds, dim, rec):
 
 # ---------------------------------------------------------------------------- predict
 @njit(inline="always")
-def _predict(
-    i,
-    now,
-    horizon,
-    rebuild,
-    pos,
-    vel,
-    mass,
-    radius,
-    body,
-    omega,
-    rot,
-    sticky,
-    bounds,
-    has_walls,
-    pairs,
-    dim,
-    geo,
-    rec,
-    ci,
-    heads,
-    hp,
-    ki,
-    kj,
-    counters,
-):
-    """Find ball ``i``'s next event and schedule it.
+def _wall_event(i, now, horizon, rot, b, ph, rec, wk):
+    """Ball ``i``'s next wall: ``(time, code)``, or ``(inf, EV_NONE)``."""
+    if not ph.has_walls:
+        return INF, cal.EV_NONE
+    if rot:  # (from the ball state, which stick scenes keep at ``now``)
+        t, wall = _predict_wall(
+            i, now, horizon, b.pos, b.vel, b.mass, b.radius, b.body, b.omega, rot, ph.bounds, ph.dim, wk.ki, wk.counters
+        )
+    else:
+        wk.counters[WALL_TESTS] += 1
+        t, wall = _wall_time(i, ph.bounds, ph.dim, rec)
+    return (t, cal.EV_WALL - wall) if wall >= 0 else (INF, cal.EV_NONE)
 
-    Looks at its wall, its partners in the 3 x 3 cells around it and its next cell crossing, from
-    the records (rotating clusters from the ball state, which stick scenes keep at ``now``;
-    ``horizon`` matters only to them). ``rebuild`` is the first prediction of a whole scene: only
-    partners of higher index are looked at, so each pair is tested once, by its lower ball (which
-    is enough: the earliest event of the scene is then held by its lower ball), and the heap is
-    ordered afterwards.
-    """
-    n = pos.shape[0]
+
+@njit(inline="always")
+def _crossing_event(i, rec, ci, geo):
+    """When ball ``i`` leaves its grid cell, and for which neighbour: ``(time, code)``."""
     x0, y0, hx, hy, nx, ny = geo
-    best_t = INF
-    best_code = cal.EV_NONE
-    best_stamp = 0
-    if has_walls:
-        if rot:
-            t_wall, wall = _predict_wall(
-                i, now, horizon, pos, vel, mass, radius, body, omega, rot, bounds, dim, ki, counters
-            )
-        else:
-            counters[WALL_TESTS] += 1
-            t_wall, wall = _wall_time(i, bounds, dim, rec)
-        if wall >= 0 and cal.earlier(t_wall, cal.EV_WALL - wall, best_t, best_code, i):
-            best_t = t_wall
-            best_code = cal.EV_WALL - wall
-    if pairs:
-        # one cell (small scenes): the partners are simply every other ball, in index order
-        one_cell = nx * ny == 1
-        if not one_cell:  # (first: an early bound spares most pairs their time of impact)
-            r = rec[i]
-            tau, direction = grid.crossing(r["x"], r["y"], r["vx"], r["vy"], ci[i, C_CELL], x0, y0, hx, hy, nx, ny)
-            tau += r["ref_time"]
-            if direction >= 0 and cal.earlier(tau, cal.EV_CROSS - direction, best_t, best_code, i):
-                best_t = tau
-                best_code = cal.EV_CROSS - direction
-        tests = 0
-        cx0, cx1, cy0, cy1 = (0, 0, 0, 0) if one_cell else grid.block(ci[i, C_CELL], nx, ny)
-        for cy in range(cy0, cy1 + 1):
-            for cx in range(cx0, cx1 + 1):
-                k = (i + 1 if rebuild else 0) if one_cell else heads[cy * nx + cx]
-                while 0 <= k < n:
-                    if k != i and (k > i or not rebuild):
-                        if rot:
-                            t = _predict_pair(
-                                i, k, now, horizon, pos, vel, mass, radius, body, omega, rot, ki, kj, counters
-                            )
-                        elif sticky and body[i] == body[k]:
+    r = rec[i]
+    tau, direction = grid.crossing(r["x"], r["y"], r["vx"], r["vy"], ci[i, C_CELL], x0, y0, hx, hy, nx, ny)
+    return (tau + r["ref_time"], cal.EV_CROSS - direction) if direction >= 0 else (INF, cal.EV_NONE)
+
+
+@njit(inline="always")
+def _partner_event(i, now, horizon, rebuild, rot, best_t, best_code, best_stamp, b, ph, cl, geo, wk):
+    """Ball ``i``'s earliest collision with a partner in the 3 x 3 cells around it (every other
+    ball when the grid has one cell), if it comes before ``(best_t, best_code)``: the new best
+    ``(time, code, partner's change count)``. With ``rebuild``, only partners of higher index."""
+    rec = cl.rec
+    n = rec.shape[0]
+    nx, ny = geo[4], geo[5]
+    one_cell = nx * ny == 1
+    tests = 0
+    cx0, cx1, cy0, cy1 = (0, 0, 0, 0) if one_cell else grid.block(cl.ci[i, C_CELL], nx, ny)
+    for cy in range(cy0, cy1 + 1):
+        for cx in range(cx0, cx1 + 1):
+            k = (i + 1 if rebuild else 0) if one_cell else cl.heads[cy * nx + cx]
+            while 0 <= k < n:
+                if k != i and (k > i or not rebuild):
+                    if rot:
+                        t = _predict_pair(
+                            i, k, now, horizon, b.pos, b.vel, b.mass, b.radius, b.body, b.omega, rot, wk.ki, wk.kj,
+                            wk.counters,
+                        )  # fmt: skip
+                    elif ph.sticky and b.body[i] == b.body[k]:
+                        t = INF
+                    else:
+                        tests += 1
+                        tc, dx, dy, dvx, dvy, sigma = _pair_gap(i, k, rec)
+                        if _not_before(dx, dy, dvx, dvy, sigma, best_t - tc):
                             t = INF
                         else:
-                            tests += 1
-                            tc, dx, dy, dvx, dvy, sigma = _pair_gap(i, k, rec)
-                            if _not_before(dx, dy, dvx, dvy, sigma, best_t - tc):
-                                t = INF
-                            else:
-                                t = tc + toi_pair(dx, dy, dvx, dvy, sigma)
-                        if t < INF and cal.earlier(t, k, best_t, best_code, i):
-                            best_t = t
-                            best_code = k
-                            best_stamp = rec[k]["changes"]
-                    k = k + 1 if one_cell else rec[k]["cell_next"]
-        counters[PAIR_TESTS] += tests
-    cal.set_event(i, best_t, best_code, best_stamp, rec, ci)
+                            t = tc + toi_pair(dx, dy, dvx, dvy, sigma)
+                    if t < INF and cal.earlier(t, k, best_t, best_code, i):
+                        best_t = t
+                        best_code = k
+                        best_stamp = rec[k]["changes"]
+                k = k + 1 if one_cell else rec[k]["cell_next"]
+    wk.counters[PAIR_TESTS] += tests
+    return best_t, best_code, best_stamp
+
+
+@njit(inline="always")
+def _predict(i, now, horizon, rebuild, rot, b, cl, ph, geo, wk):
+    """Find ball ``i``'s next event and schedule it: the earliest of its wall, its cell crossing
+    (found first: an early bound spares most pairs their time of impact) and its partners, from the
+    records (rotating clusters from the ball state; ``horizon`` matters only to them).
+
+    ``rebuild`` is the first prediction of a whole scene: only partners of higher index are
+    looked at, so each pair is tested once, by its lower ball (which is enough: the earliest event
+    of the scene is then held by its lower ball), and the heap is ordered afterwards.
+    """
+    best_t, best_code = _wall_event(i, now, horizon, rot, b, ph, cl.rec, wk)
+    best_stamp = 0
+    if ph.pairs:
+        if geo[4] * geo[5] > 1:
+            t, code = _crossing_event(i, cl.rec, cl.ci, geo)
+            if cal.earlier(t, code, best_t, best_code, i):
+                best_t, best_code = t, code
+        best_t, best_code, best_stamp = _partner_event(
+            i, now, horizon, rebuild, rot, best_t, best_code, best_stamp, b, ph, cl, geo, wk
+        )
+    cal.set_event(i, best_t, best_code, best_stamp, cl.rec, cl.ci)
     if not rebuild:
-        cal.reschedule(i, n, rec, ci, hp)
+        cal.reschedule(i, cl.rec.shape[0], cl.rec, cl.ci, cl.hp)
 
 
 # ---------------------------------------------------------------------------- begin
@@ -794,46 +869,32 @@ def _finish(t_end, pos, vel, mass, body, omega, rot, sticky, rec, ci, hp):
 
 # ---------------------------------------------------------------------------- resolve
 @njit(inline="always")
-def _resolve_wall(
-    sc,
-    t_abs,
-    bi,
-    wall,
-    pos,
-    vel,
-    inv_mass,
-    radius,
-    body,
-    omega,
-    bounds,
-    has_walls,
-    pairs,
-    dim,
-    e,
-    ratio,
-    floor,
-    sticky,
-    cascades,
-    imp,
-    n_imp,
-    counters,
-    involved,
-    in_group,
-    c_a,
-    c_b,
-    c_hit,
-):
-    """Ball ``bi`` meets ``wall``. Returns how many balls' motion it changed (listed in ``involved``)."""
+def _cascade(sc, t_abs, i0, j0, b, ph, wk):
+    """The contact group an impact of ball ``i0`` with ``j0`` (a ball, or the wall ``-1 - j0``)
+    started, resolved at one instant (:func:`_resolve_contact_group`); its balls are listed in
+    ``wk.pending``. Returns how many."""
+    return _resolve_contact_group(
+        sc, t_abs, i0, j0, b.pos, b.vel, b.inv_mass, b.radius, ph.bounds, ph.has_walls, ph.pairs, ph.dim, ph.e,
+        ph.ratio, ph.floor, wk.imp, wk.n_imp, wk.counters, wk.pending, wk.in_group, wk.c_a, wk.c_b, wk.c_hit,
+    )  # fmt: skip
+
+
+@njit(inline="always")
+def _resolve_wall(sc, t_abs, bi, wall, b, ph, wk):
+    """Ball ``bi`` meets ``wall``. Returns how many balls' motion it changed (listed in
+    ``wk.pending``)."""
+    pos, vel, radius, body, omega, bounds = b.pos, b.vel, b.radius, b.body, b.omega, ph.bounds
+    involved = wk.pending
     n = pos.shape[0]
     n_inv = 0
-    if sticky:
+    if ph.sticky:
         axis = 0 if wall < 2 else 1
         into = vel[bi, axis] < 0.0 if wall % 2 == 0 else vel[bi, axis] > 0.0
         if wall_contact(bi, wall, pos, radius, bounds) and into:
             if omega[body[bi]] == 0.0:
                 snap_to_wall(bi, wall, pos, radius, bounds)
             x, y = wall_point(bi, wall, pos, radius, bounds)
-            record(imp, n_imp, sc, t_abs, bi, -1, wall, x, y, abs(vel[bi, axis]))
+            record(wk.imp, wk.n_imp, sc, t_abs, bi, -1, wall, x, y, abs(vel[bi, axis]))
             root = body[bi]
             for k in range(n):
                 if body[k] == root:
@@ -845,86 +906,36 @@ def _resolve_wall(
             n_inv = 1
         return n_inv
     snap_to_wall(bi, wall, pos, radius, bounds)
-    u_min = impact_threshold(bi, -1, vel, ratio, floor)
-    speed = ball_wall(bi, wall, vel, e, u_min)
+    u_min = impact_threshold(bi, -1, vel, ph.ratio, ph.floor)
+    speed = ball_wall(bi, wall, vel, ph.e, u_min)
     if speed > 0.0:
         x, y = wall_point(bi, wall, pos, radius, bounds)
-        record(imp, n_imp, sc, t_abs, bi, -1, wall, x, y, speed)
+        record(wk.imp, wk.n_imp, sc, t_abs, bi, -1, wall, x, y, speed)
     involved[0] = bi
     n_inv = 1
-    if cascades and speed > 0.0:
-        n_inv = _resolve_contact_group(
-            sc,
-            t_abs,
-            bi,
-            -1 - wall,
-            pos,
-            vel,
-            inv_mass,
-            radius,
-            bounds,
-            has_walls,
-            pairs,
-            dim,
-            e,
-            ratio,
-            floor,
-            imp,
-            n_imp,
-            counters,
-            involved,
-            in_group,
-            c_a,
-            c_b,
-            c_hit,
-        )
+    if ph.cascades and speed > 0.0:
+        n_inv = _cascade(sc, t_abs, bi, -1 - wall, b, ph, wk)
     return n_inv
 
 
 @njit(inline="always")
-def _resolve_pair(
-    sc,
-    t_abs,
-    bi,
-    bj,
-    pos,
-    vel,
-    mass,
-    inv_mass,
-    radius,
-    body,
-    omega,
-    bounds,
-    has_walls,
-    pairs,
-    dim,
-    e,
-    ratio,
-    floor,
-    sticky,
-    cascades,
-    imp,
-    n_imp,
-    counters,
-    involved,
-    in_group,
-    c_a,
-    c_b,
-    c_hit,
-):
-    """Balls ``bi`` and ``bj`` meet. Returns how many balls' motion it changed (in ``involved``)."""
+def _resolve_pair(sc, t_abs, bi, bj, b, ph, wk):
+    """Balls ``bi`` and ``bj`` meet. Returns how many balls' motion it changed (listed in
+    ``wk.pending``)."""
+    pos, vel, radius, body = b.pos, b.vel, b.radius, b.body
+    involved = wk.pending
     n = pos.shape[0]
     n_inv = 0
     dx = pos[bj, 0] - pos[bi, 0]
     dy = pos[bj, 1] - pos[bi, 1]
     dist = math.sqrt(dx * dx + dy * dy)
     closing = (vel[bj, 0] - vel[bi, 0]) * dx + (vel[bj, 1] - vel[bi, 1]) * dy
-    if sticky:
+    if ph.sticky:
         if _touching(bi, bj, pos, radius) and closing < 0.0:
             x = pos[bi, 0] + radius[bi] * dx / dist
             y = pos[bi, 1] + radius[bi] * dy / dist
-            record(imp, n_imp, sc, t_abs, bi, bj, -1, x, y, -closing / dist)
-            root = merge_bodies(bi, bj, pos, vel, mass, body, omega)
+            record(wk.imp, wk.n_imp, sc, t_abs, bi, bj, -1, x, y, -closing / dist)
+            root = merge_bodies(bi, bj, pos, vel, b.mass, body, b.omega)
             for k in range(n):
                 if body[k] == root:
                     involved[n_inv] = k
@@ -934,42 +945,76 @@ def _resolve_pair(
             involved[1] = bj
             n_inv = 2
         return n_inv
-    u_min = impact_threshold(bi, bj, vel, ratio, floor)
-    speed = ball_ball(bi, bj, pos, vel, inv_mass, e, u_min)
+    u_min = impact_threshold(bi, bj, vel, ph.ratio, ph.floor)
+    speed = ball_ball(bi, bj, pos, vel, b.inv_mass, ph.e, u_min)
     if speed > 0.0:
         x = pos[bi, 0] + radius[bi] * dx / dist
         y = pos[bi, 1] + radius[bi] * dy / dist
-        record(imp, n_imp, sc, t_abs, bi, bj, -1, x, y, speed)
+        record(wk.imp, wk.n_imp, sc, t_abs, bi, bj, -1, x, y, speed)
     involved[0] = bi
     involved[1] = bj
     n_inv = 2
-    if cascades and speed > 0.0:
-        n_inv = _resolve_contact_group(
-            sc,
-            t_abs,
-            bi,
-            bj,
-            pos,
-            vel,
-            inv_mass,
-            radius,
-            bounds,
-            has_walls,
-            pairs,
-            dim,
-            e,
-            ratio,
-            floor,
-            imp,
-            n_imp,
-            counters,
-            involved,
-            in_group,
-            c_a,
-            c_b,
-            c_hit,
-        )
+    if ph.cascades and speed > 0.0:
+        n_inv = _cascade(sc, t_abs, bi, bj, b, ph, wk)
     return n_inv
+
+
+# ---------------------------------------------------------------------------- pop, advance, invalidate
+@njit(inline="always")
+def _screen(bi, t, now, ph, cl, geo, wk):
+    """Look at ball ``bi``'s popped event (due at ``t``) before it is run.
+
+    Returns ``(n, t, now)``: ``n = -1``, an event to resolve at the re-verified time ``t``;
+    otherwise there is none, and ``n`` balls (ball ``bi``, listed in ``wk.pending``) are to be
+    predicted afresh: a stale pair, a grid-cell crossing (the ball moves to its new cell), or an
+    event that no longer happens; or none (``n = 0``), when the event comes later than it said and
+    was rescheduled."""
+    code = cl.ci[bi, C_EVENT_OTHER]
+    if cal.is_stale(bi, cl.rec, cl.ci):
+        wk.counters[STALE_EVENTS] += 1
+        wk.pending[0] = bi
+        return 1, t, now
+    if cal.is_crossing(code):
+        wk.counters[CELL_CROSSINGS] += 1
+        grid.unlink(bi, cl.rec, cl.ci, cl.heads)
+        grid.link(bi, grid.neighbour_cell(cl.ci[bi, C_CELL], cal.EV_CROSS - code, geo[4]), cl.rec, cl.ci, cl.heads)
+        wk.pending[0] = bi
+        return 1, t, max(now, t)
+    if ph.sticky:  # (rotating clusters' predictions are re-checked by the contact test instead)
+        return -1, t, now
+    t_check = _verified_time(bi, code, ph.bounds, ph.dim, cl.rec)
+    if t_check <= t:
+        return -1, t_check, now
+    if t_check == INF:
+        wk.pending[0] = bi
+        return 1, t, now
+    cl.rec[bi]["event_time"] = t_check
+    cal.reschedule(bi, cl.rec.shape[0], cl.rec, cl.ci, cl.hp)
+    return 0, t, now
+
+
+@njit(inline="always")
+def _advance(bi, bj, now, rot, b, cl, ph):
+    """Bring the balls of an event (``bj < 0``: a wall) to ``now``, in their records and in the
+    ball state the response reads: every ball in stick scenes and when a contact group may form."""
+    if ph.sticky or ph.cascades:
+        _sync_all(now, b.pos, b.vel, b.mass, b.body, b.omega, rot, ph.sticky, cl.rec)
+    else:
+        _sync(bi, now, cl.rec)
+        _store(bi, cl.rec, b.pos, b.vel)
+        if bj >= 0:
+            _sync(bj, now, cl.rec)
+            _store(bj, cl.rec, b.pos, b.vel)
+
+
+@njit(inline="always")
+def _invalidate(n_changed, now, b, cl, wk):
+    """The balls whose motion an event changed (``wk.pending``) take their new state into their
+    records, and their change counters move on: events other balls hold with them become stale."""
+    for q in range(n_changed):
+        k = wk.pending[q]
+        _load(k, now, cl.rec, b.pos, b.vel)
+        cl.rec[k]["changes"] += 1
 
 
 # ---------------------------------------------------------------------------- the scheduler
@@ -1020,17 +1065,10 @@ def step_exact(
     n_imp[0] = 0
     n_scenes = pos_all.shape[0]
     n = pos_all.shape[1]
-    nc = contact_capacity(n)
-    ki = scratch_f[0:7]
-    kj = scratch_f[7:14]
-    pending = scratch_i[0:n]  # balls to predict
-    c_a = scratch_i[n : n + nc]
-    c_b = scratch_i[n + nc : n + 2 * nc]
-    in_group = scratch_b[0:n]
-    c_hit = scratch_b[n : n + nc]
-    bounds, e, ratio, floor, sign, has_walls, pairs, dim, sticky, max_events = scene_params(fparams, iparams)
-    cascades = e < 1.0  # forward inelastic: resolve touching groups at one instant
-    room = impacts_per_event(n, cascades)
+    ph = _physics(fparams, iparams)
+    max_events = iparams[S_MAX_EVENTS]
+    wk = _work(n, imp, n_imp, counters, scratch_f, scratch_i, scratch_b)
+    room = impacts_per_event(n, ph.cascades)
     if fresh:
         for sc in range(n_scenes):
             work_i[sc, W_ACTIVE] = True
@@ -1043,205 +1081,78 @@ def step_exact(
         if not work_i[sc, W_ACTIVE]:
             continue
         work_i[sc, W_STALLED] = False
-        pos = pos_all[sc]
-        vel = vel_all[sc]
-        mass = mass_all[sc]
-        inv_mass = inv_mass_all[sc]
-        radius = radius_all[sc]
-        body = body_all[sc]
-        omega = omega_all[sc]
-        rec = cal_rec[sc]
-        ci = cal_i[sc]
-        heads = cal_heads[sc]
-        hp = cal_heap[sc]
+        b = SceneBalls(
+            pos_all[sc], vel_all[sc], mass_all[sc], inv_mass_all[sc], radius_all[sc], body_all[sc], omega_all[sc]
+        )
+        cl = SceneCalendar(cal_rec[sc], cal_i[sc], cal_heads[sc], cal_heap[sc])
         geo = grid.scene_geometry(work_f, work_i, sc)
-        nx = geo[4]
         horizon_end = work_f[sc, W_REMAINING]
         t0 = time[sc]
         now = 0.0
-        rot = sticky and has_rotation(body, omega)
+        rot = ph.sticky and has_rotation(b.body, b.omega)
 
         # begin: everything afresh after a reset (and for rotating clusters, whose predictions reach
         # only to the end of a step), otherwise only the balls changed since the last step
         whole = not work_i[sc, W_CALENDAR_VALID] or rot
         if whole:
-            n_pending = _begin_whole_scene(pos, vel, radius, rec, ci, heads, geo, pending)
+            n_pending = _begin_whole_scene(b.pos, b.vel, b.radius, cl.rec, cl.ci, cl.heads, geo, wk.pending)
         elif fresh:
-            n_pending = _begin_changed_balls(pos, vel, rec, ci, heads, geo, pending)
+            n_pending = _begin_changed_balls(b.pos, b.vel, cl.rec, cl.ci, cl.heads, geo, wk.pending)
         else:
             n_pending = 0
 
         while True:
             # predict (the one place where predictions are made: what begin or the last event listed)
             for q in range(n_pending):
-                _predict(
-                    pending[q],
-                    now,
-                    horizon_end - now,
-                    whole,
-                    pos,
-                    vel,
-                    mass,
-                    radius,
-                    body,
-                    omega,
-                    rot,
-                    sticky,
-                    bounds,
-                    has_walls,
-                    pairs,
-                    dim,
-                    geo,
-                    rec,
-                    ci,
-                    heads,
-                    hp,
-                    ki,
-                    kj,
-                    counters,
-                )
+                _predict(wk.pending[q], now, horizon_end - now, whole, rot, b, cl, ph, geo, wk)
             if whole:
-                cal.reset_heap(n, rec, ci, hp)
+                cal.reset_heap(n, cl.rec, cl.ci, cl.hp)
                 work_i[sc, W_CALENDAR_VALID] = True
                 whole = False
-            n_pending = 0
             # pop
-            bi = cal.next_ball(hp)
-            t = rec[bi]["event_time"]
-            code = ci[bi, C_EVENT_OTHER]
+            bi = cal.next_ball(cl.hp)
+            t = cl.rec[bi]["event_time"]
             if not t <= horizon_end:
                 break
-            if cal.is_stale(bi, rec, ci):
-                counters[STALE_EVENTS] += 1
-                pending[0] = bi
-                n_pending = 1
+            n_pending, t, now = _screen(bi, t, now, ph, cl, geo, wk)
+            if n_pending >= 0:
                 continue
-            if cal.is_crossing(code):
-                now = max(now, t)
-                counters[CELL_CROSSINGS] += 1
-                grid.unlink(bi, rec, ci, heads)
-                grid.link(bi, grid.neighbour_cell(ci[bi, C_CELL], cal.EV_CROSS - code, nx), rec, ci, heads)
-                pending[0] = bi
-                n_pending = 1
-                continue
-            # verify (rotating clusters' predictions are re-checked by the contact test instead)
-            if not sticky:
-                t_check = _verified_time(bi, code, bounds, dim, rec)
-                if t_check > t:
-                    if t_check == INF:
-                        pending[0] = bi
-                        n_pending = 1
-                    else:
-                        rec[bi]["event_time"] = t_check
-                        cal.reschedule(bi, n, rec, ci, hp)
-                    continue
-                t = t_check
             if work_i[sc, W_EVENTS] >= max_events:
                 capped[sc] = True
                 break
             if n_imp[0] + room > imp.shape[0]:
                 work_i[sc, W_STALLED] = True
                 break
-            # advance
+            # advance (a pair is resolved, and reported, from its lower ball)
             now = max(now, t)
-            bj = -1
-            if code >= 0:  # a pair is resolved, and reported, from its lower ball
-                bj = max(bi, code)
-                bi = min(bi, code)
-            if sticky or cascades:  # a cluster or a contact group reaches beyond the two balls
-                _sync_all(now, pos, vel, mass, body, omega, rot, sticky, rec)
-            else:
-                _sync(bi, now, rec)
-                _store(bi, rec, pos, vel)
-                if bj >= 0:
-                    _sync(bj, now, rec)
-                    _store(bj, rec, pos, vel)
+            code = cl.ci[bi, C_EVENT_OTHER]
+            bj = max(bi, code) if code >= 0 else -1
+            bi = min(bi, code) if code >= 0 else bi
+            _advance(bi, bj, now, rot, b, cl, ph)
             work_i[sc, W_EVENTS] += 1
             counters[EVENTS] += 1
-            t_abs = t0 + sign * now
-            # resolve: the balls whose motion changed are listed in ``pending``
+            # resolve (the balls whose motion changed are listed in ``wk.pending``)
+            t_abs = t0 + ph.sign * now
             if bj < 0:
-                n_pending = _resolve_wall(
-                    sc,
-                    t_abs,
-                    bi,
-                    cal.EV_WALL - code,
-                    pos,
-                    vel,
-                    inv_mass,
-                    radius,
-                    body,
-                    omega,
-                    bounds,
-                    has_walls,
-                    pairs,
-                    dim,
-                    e,
-                    ratio,
-                    floor,
-                    sticky,
-                    cascades,
-                    imp,
-                    n_imp,
-                    counters,
-                    pending,
-                    in_group,
-                    c_a,
-                    c_b,
-                    c_hit,
-                )
+                n_pending = _resolve_wall(sc, t_abs, bi, cal.EV_WALL - code, b, ph, wk)
             else:
-                n_pending = _resolve_pair(
-                    sc,
-                    t_abs,
-                    bi,
-                    bj,
-                    pos,
-                    vel,
-                    mass,
-                    inv_mass,
-                    radius,
-                    body,
-                    omega,
-                    bounds,
-                    has_walls,
-                    pairs,
-                    dim,
-                    e,
-                    ratio,
-                    floor,
-                    sticky,
-                    cascades,
-                    imp,
-                    n_imp,
-                    counters,
-                    pending,
-                    in_group,
-                    c_a,
-                    c_b,
-                    c_hit,
-                )
-            if sticky:
-                rot = has_rotation(body, omega)
-            # invalidate: the balls whose motion changed take their new state into their records;
-            # events that other balls hold with them become stale through the change counters; the
-            # balls themselves are predicted afresh at the top of the loop
-            for q in range(n_pending):
-                k = pending[q]
-                _load(k, now, rec, pos, vel)
-                rec[k]["changes"] += 1
+                n_pending = _resolve_pair(sc, t_abs, bi, bj, b, ph, wk)
+            if ph.sticky:
+                rot = has_rotation(b.body, b.omega)
+            # invalidate (the changed balls are predicted afresh at the top of the loop)
+            _invalidate(n_pending, now, b, cl, wk)
 
         # finish
         stopped = capped[sc] or work_i[sc, W_STALLED]
         t_end = now if stopped else horizon_end
-        _finish(t_end, pos, vel, mass, body, omega, rot, sticky, rec, ci, hp)
-        time[sc] = t0 + sign * t_end
+        _finish(t_end, b.pos, b.vel, b.mass, b.body, b.omega, rot, ph.sticky, cl.rec, cl.ci, cl.hp)
+        time[sc] = t0 + ph.sign * t_end
         work_f[sc, W_REMAINING] = horizon_end - t_end
         n_stalled += work_i[sc, W_STALLED]
         n_imp[1] += capped[sc]
         work_i[sc, W_ACTIVE] = work_i[sc, W_STALLED]
         if not work_i[sc, W_STALLED]:
-            finish_step(sc, not capped[sc], sign * dt_abs, time, clock)
+            finish_step(sc, not capped[sc], ph.sign * dt_abs, time, clock)
     return n_stalled
 
 
