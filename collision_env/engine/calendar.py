@@ -222,9 +222,19 @@ def next_ball(hp):
 
 @njit(inline="always")
 def rebase(n, t, hp):
-    """Subtract ``t`` from every event time in the heap (the balls' own times are the caller's)."""
+    """Subtract ``t`` from every event time in the heap (the balls' own times are the caller's),
+    and restore the heap order if that rounded a node's and its parent's times into a tie (which
+    the tie rule, :func:`order_key`, may order the other way). Subtracting the same number keeps
+    every other pair in order, so the heap is re-ordered only then (or when finite times were tied
+    already, which is rare)."""
+    tie = False
     for slot in range(n):
-        hp[slot + HEAP_OFFSET, H_TIME] -= t
+        row = slot + HEAP_OFFSET
+        hp[row, H_TIME] -= t
+        if slot > 0:
+            above = _time_at((slot - 1) // ARITY, hp)
+            tie = tie or (hp[row, H_TIME] == above and above < np.inf)
+    return tie
 
 
 @njit(inline="always")

@@ -863,8 +863,8 @@ def _finish(t_end, pos, vel, mass, body, omega, rot, sticky, rec, ci, hp):
             pos[i, 1] = r["y"]
         r["ref_time"] = 0.0
         r["event_time"] -= t_end
-    cal.rebase(n, t_end, hp)  # the same times, rebased the same way
-    cal.heapify(n, ci, hp)  # rebasing can round two times into a tie the heap must order by index
+    if cal.rebase(n, t_end, hp):  # the same times, rebased the same way
+        cal.heapify(n, ci, hp)
 
 
 # ---------------------------------------------------------------------------- resolve
