@@ -1052,10 +1052,11 @@ def step_exact(
     (``layout.CAL_RECORD``/``CAL_I``/``HEAP``); ``clock`` the compensated clocks
     (:mod:`~collision_env.engine.clock`), advanced when a scene's step ends. ``fresh`` starts a step
     of ``dt_abs`` for every scene; otherwise the call resumes the scenes flagged active.
-    Impacts go to ``imp`` rows (``simulator.IMPACT_DTYPE``) from row 0, ``n_imp[0]`` rows in all; a
+    Impacts go to ``imp`` rows (``layout.IMPACT_DTYPE``) from row 0, ``n_imp[0]`` rows in all; a
     scene that finds the buffer full stops where it is and is flagged stalled, so the caller can
-    empty the buffer and call again for those scenes. Returns the number of stalled scenes;
-    ``n_imp[1]`` counts the scenes that reached the event cap.
+    empty the buffer and call again for those scenes. ``n_imp[1]`` counts the scenes that reached
+    the event cap, ``n_imp[2]`` the stalled ones. Returns ``n_imp[0]`` when neither happened (the
+    common case, read without looking at ``n_imp``), else -1.
     ``scratch_*`` are work buffers of :func:`scratch_sizes` (allocated once by the caller).
 
     The whole batch is one call with the scene loop inside: a call between compiled functions
@@ -1076,7 +1077,7 @@ def step_exact(
             work_i[sc, W_EVENTS] = 0
             capped[sc] = False
         n_imp[1] = 0
-    n_stalled = 0
+    n_imp[2] = 0
     for sc in range(n_scenes):
         if not work_i[sc, W_ACTIVE]:
             continue
@@ -1148,12 +1149,12 @@ def step_exact(
         _finish(t_end, b.pos, b.vel, b.mass, b.body, b.omega, rot, ph.sticky, cl.rec, cl.ci, cl.hp)
         time[sc] = t0 + ph.sign * t_end
         work_f[sc, W_REMAINING] = horizon_end - t_end
-        n_stalled += work_i[sc, W_STALLED]
+        n_imp[2] += work_i[sc, W_STALLED]
         n_imp[1] += capped[sc]
         work_i[sc, W_ACTIVE] = work_i[sc, W_STALLED]
         if not work_i[sc, W_STALLED]:
             finish_step(sc, not capped[sc], ph.sign * dt_abs, time, clock)
-    return n_stalled
+    return n_imp[0] if n_imp[1] == 0 and n_imp[2] == 0 else -1
 
 
 if HAVE_NUMBA:

@@ -447,7 +447,10 @@ class BatchSimulator:
             rows = max(4096, 2 * worst)
         self._imp = np.empty(rows, dtype=IMPACT_DTYPE)
         self._imp_bytes = memoryview(self._imp.view(np.uint8))
-        self._n_imp = np.zeros(2, dtype=np.int64)  # rows filled, scenes that reached the cap
+        counts = getattr(self, "_n_imp", None)  # (kept when the buffer grows in the middle of a step)
+        self._n_imp = np.zeros(3, dtype=np.int64)  # rows filled, scenes that reached the cap, stalled
+        if counts is not None:
+            self._n_imp[:] = counts
         # the mode's kernel and its arguments, bound once (the arrays are only ever updated in place)
         state = (
             self._balls,
@@ -494,14 +497,17 @@ class BatchSimulator:
         number of steps ``time`` is within an ulp of the exact sum of the ``dt`` taken (forward and
         back again returns it to exactly where it was).
         """
+        return self._step(dt, True)
+
+    def _step(self, dt, copy):
+        """:meth:`step`; with ``copy`` False, exact mode's impacts may come as a view of the impact
+        buffer, valid until the next step (for :meth:`Simulator.step`, which converts them at once)."""
         dt = _real_number(dt, "dt")
         if self._forward and 0.0 < dt <= _MAX_MAGNITUDE:  # the common case, checked in one test
-            stalled = self._kernel(*self._kernel_args, dt, True)
-            n_imp = self._n_imp
-            if not (stalled or n_imp[1]):  # no scene stalled or reached the event cap
-                rows = n_imp[0]
-                return self._take_impacts(rows) if rows else _NO_IMPACTS
-            return self._finish(self._run(dt, stalled), 1.0)
+            rows = self._kernel(*self._kernel_args, dt, True)
+            if rows >= 0:  # no scene stalled or reached the event cap
+                return self._take_impacts(rows, copy) if rows else _NO_IMPACTS
+            return self._finish(self._run(dt, first_done=True), 1.0)
         if not abs(dt) <= _MAX_MAGNITUDE:
             raise ValueError(f"dt: must be finite and at most {_MAX_MAGNITUDE:g} s, got {dt}")
         if self.scene.bounds is None:
@@ -539,7 +545,7 @@ class BatchSimulator:
                 f"event cap of {self.max_events} per step reached in scene(s) {np.flatnonzero(self._capped).tolist()}; "
                 "they stopped early at their last event (see cap_reached and time)",
                 EventCapWarning,
-                stacklevel=3,
+                stacklevel=4,  # (the caller of step: _finish, _step, step)
             )
         if not chunks:
             return _NO_IMPACTS
@@ -558,30 +564,32 @@ class BatchSimulator:
                 f"{_MAX_MAGNITUDE:g} m (no border), where positions are no longer representable"
             )
 
-    def _run(self, dt_abs, stalled=None):
+    def _run(self, dt_abs, first_done=False):
         """Run the mode's kernel until every scene has stepped ``dt_abs``; the impacts in chunks,
         one per call (a call stops the scenes that find the impact buffer full, which the next
-        call resumes). ``stalled``: what the step's first call, already made, returned."""
+        call resumes). ``first_done``: the step's first call was made already."""
         chunks = []
         kernel, args, n_imp = self._kernel, self._kernel_args, self._n_imp
-        if stalled is None:
-            stalled = kernel(*args, dt_abs, True)
+        if not first_done:
+            kernel(*args, dt_abs, True)
         while True:  # each call resets n_imp[0] and fills the impact buffer from row 0
             rows = n_imp[0]
             if rows:
                 chunks.append(self._take_impacts(rows))
-            if not stalled:
+            if not n_imp[2]:  # no scene stalled
                 return chunks
             if not rows:  # not even one sub-step's worst case fits: a bigger buffer
                 self._alloc_work(2 * len(self._imp))
-                kernel, args = self._kernel, self._kernel_args
-            stalled = kernel(*args, dt_abs, False)
+                kernel, args, n_imp = self._kernel, self._kernel_args, self._n_imp
+            kernel(*args, dt_abs, False)
 
-    def _take_impacts(self, rows):
-        """A copy of the first ``rows`` impact records. Exact mode records each scene's impacts
-        in the order they happen, scenes in order; the cheap modes' reconstructed times need
-        sorting within each scene."""
+    def _take_impacts(self, rows, copy=True):
+        """A copy of the first ``rows`` impact records (a view of them if not ``copy``, in exact
+        mode). Exact mode records each scene's impacts in the order they happen, scenes in order;
+        the cheap modes' reconstructed times need sorting within each scene."""
         if self.mode == "exact":
+            if not copy:
+                return self._imp[:rows]
             # (numpy copies structured arrays slowly: a byte copy is several times cheaper)
             return np.frombuffer(bytearray(self._imp_bytes[: rows * IMPACT_DTYPE.itemsize]), IMPACT_DTYPE)
         out = np.empty(rows, dtype=IMPACT_DTYPE)
@@ -886,7 +894,7 @@ class Simulator:
 
     def step(self, dt: float) -> list[Impact]:
         """Advance by ``dt`` seconds (negative: backwards). Returns the step's impacts in time order."""
-        rows = self._batch.step(dt)
+        rows = self._batch._step(dt, False)  # (converted here, before the next step)
         if not len(rows):
             return []
         return [

@@ -103,8 +103,8 @@ def step_substeps(
     Parameters as :func:`exact.step_exact` (``fresh`` starts a step for every scene; ``capped``
     is not used: the cheap modes have no event cap; ``scratch`` is an int buffer of
     :func:`scratch_size`); a scene stops between sub-steps when the impact buffer could not
-    hold another sub-step's worst case, and is flagged stalled. Returns the number of stalled
-    scenes.
+    hold another sub-step's worst case, and is flagged stalled. Returns as
+    :func:`exact.step_exact` does: the impact rows written, or -1 when a scene stalled.
     """
     pos, vel, mass, inv_mass, radius, omega = ball_views(balls)
     t_start = work_f[:, W_SUBSTEP_START]
@@ -121,7 +121,7 @@ def step_substeps(
             t_start[sc] = time[sc]
             done[sc] = 0
         n_imp[1] = 0
-    n_stalled = 0
+    n_imp[2] = 0
     for sc in range(pos.shape[0]):
         if not active[sc]:
             continue
@@ -191,11 +191,11 @@ def step_substeps(
                 )
             done[sc] = k
             time[sc] = t_end
-        n_stalled += stalled[sc]
+        n_imp[2] += stalled[sc]
         active[sc] = stalled[sc]
         if not stalled[sc]:
             finish_step(sc, True, sign * dt_abs, time, clock)
-    return n_stalled
+    return n_imp[0] if n_imp[2] == 0 else -1
 
 
 if HAVE_NUMBA:
