@@ -189,7 +189,7 @@ def _work(n, imp, n_imp, counters, scratch_f, scratch_i, scratch_b):
 
 @njit(inline="always")
 def record(imp, n_imp, scene, time, ball, other, wall, x, y, speed):
-    """Append an impact to the record buffer ``imp`` (``simulator.IMPACT_DTYPE``)."""
+    """Append an impact to the record buffer ``imp`` (``layout.IMPACT_DTYPE``)."""
     k = n_imp[0]
     r = imp[k]  # a view of row k (in numba and in numpy alike)
     r["scene"] = scene
