@@ -1,4 +1,4 @@
-"""Exact mode's event calendar: one pending event per ball, in a binary heap of balls.
+"""Exact mode's event calendar: one pending event per ball, in a 4-ary heap of balls.
 
 This is the sorter of an event-driven simulation (the scheduler is ``exact.step_exact``, the
 neighbour search is :mod:`collision_env.engine.grid`). Following Lubachevsky (1991) and

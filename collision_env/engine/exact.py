@@ -153,7 +153,7 @@ class Work(NamedTuple):
     """The step's buffers: impact records and counters, and scratch space (``scratch_sizes``)."""
 
     imp: np.ndarray  #: impact records (``layout.IMPACT_DTYPE``)
-    n_imp: np.ndarray  #: rows filled, scenes that reached the event cap
+    n_imp: np.ndarray  #: rows filled, scenes that reached the event cap, scenes that stalled
     counters: np.ndarray  #: work counters (``COUNTERS``)
     pending: np.ndarray  #: balls to predict (or whose motion an event changed)
     in_group: np.ndarray  #: a contact group's membership, per ball

@@ -297,7 +297,7 @@ class BatchSimulator:
         self._iparams = np.array([scene_i[name] for name in SCENE_I], dtype=np.int64)
         self._work_f = np.zeros((n_scenes, len(WORK_F)))
         self._work_i = np.zeros((n_scenes, len(WORK_I)), dtype=np.int64)
-        # exact mode's event calendar and grid, kept from step to step (at most n cells per scene)
+        # exact mode's event calendar and grid, kept from step to step (a few cells per ball at most)
         self._cal = _aligned_zeros((n_scenes, n), CAL_RECORD)
         self._cal_i = np.zeros((n_scenes, n, len(CAL_I)), dtype=np.int32)
         self._cal_heads = np.zeros((n_scenes, grid.EXACT_CELLS_PER_BALL * n), dtype=np.int32)
