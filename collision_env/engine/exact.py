@@ -1159,12 +1159,13 @@ def step_exact(
 
 if HAVE_NUMBA:
 
-    @njit
-    def step_exact_packed(h, dt_abs, fresh):
-        """:func:`step_exact` on the arrays packed in ``h`` (:mod:`~collision_env.engine.argpack`),
-        one slot per array in the order of its parameters; the call Python makes, with one array
-        to check instead of nineteen."""
-        return step_exact(
+    @njit(inline="always")
+    def unpack_state(h):
+        """Slots 0 to 11 of a pack (:mod:`~collision_env.engine.argpack`): the arrays every mode's
+        kernel takes first, in order (the balls, cluster roots, clocks, cap flags, scene
+        parameters, impact buffer and counts, work counters, per-scene work arrays and compensated
+        clocks)."""
+        return (
             view3(h, 0, np.float64),
             view2(h, 1, np.int64),
             view1(h, 2, np.float64),
@@ -1177,6 +1178,15 @@ if HAVE_NUMBA:
             view2(h, 9, np.float64),
             view2(h, 10, np.int64),
             view2(h, 11, np.float64),
+        )
+
+    @njit
+    def step_exact_packed(h, dt_abs, fresh):
+        """:func:`step_exact` on the arrays packed in ``h`` (:mod:`~collision_env.engine.argpack`),
+        one slot per array in the order of its parameters; the call Python makes, with one array
+        to check instead of nineteen."""
+        return step_exact(
+            *unpack_state(h),
             view2(h, 12, CAL_RECORD),
             view3(h, 13, np.int32),
             view2(h, 14, np.int32),

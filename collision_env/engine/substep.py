@@ -7,7 +7,6 @@ from .clock import finish_step
 from .exact import scene_params
 from .grid import block, cell_of, scene_geometry
 from .layout import (
-    IMPACT_DTYPE,
     W_ACTIVE,
     W_STALLED,
     W_SUBSTEP_START,
@@ -21,7 +20,8 @@ from .response import elastic_threshold
 if HAVE_NUMBA:
     import numpy as np
 
-    from .argpack import view1, view2, view3
+    from .argpack import view1
+    from .exact import unpack_state
 
 NAIVE, POSTERIORI = 0, 1
 
@@ -204,22 +204,4 @@ if HAVE_NUMBA:
     def step_substeps_packed(mode, k_total, h, dt_abs, fresh):
         """:func:`step_substeps` on the arrays packed in ``h`` (:mod:`~collision_env.engine.argpack`),
         one slot per array in the order of its parameters."""
-        return step_substeps(
-            mode,
-            k_total,
-            view3(h, 0, np.float64),
-            view2(h, 1, np.int64),
-            view1(h, 2, np.float64),
-            view1(h, 3, np.bool_),
-            view1(h, 4, np.float64),
-            view1(h, 5, np.int64),
-            view1(h, 6, IMPACT_DTYPE),
-            view1(h, 7, np.int64),
-            view1(h, 8, np.int64),
-            view2(h, 9, np.float64),
-            view2(h, 10, np.int64),
-            view2(h, 11, np.float64),
-            view1(h, 12, np.int64),
-            dt_abs,
-            fresh,
-        )
+        return step_substeps(mode, k_total, *unpack_state(h), view1(h, 12, np.int64), dt_abs, fresh)
