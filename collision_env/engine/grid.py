@@ -44,10 +44,11 @@ from .layout import (
 GRID_MIN_BALLS = 64
 #: Balls per cell exact mode's grid aims at, and the most cells it has per ball (cells are never
 #: narrower than a diameter): fewer cells cost more pair predictions per event, more cells more
-#: cell crossings (measured by the scale benchmark). The cheap modes rebuild their grid at every
-#: sub-step and aim at one ball per cell.
+#: cell crossings (measured by the scale benchmark).
 EXACT_BALLS_PER_CELL = 0.3
 EXACT_CELLS_PER_BALL = 4
+#: The cheap modes' grid: cells at least two diameters wide, up to this many per ball.
+CHEAP_CELLS_PER_BALL = 4
 #: Cells are this much wider than the largest diameter, so that round-off in a ball's position at
 #: a cell boundary can never hide a neighbour.
 CELL_MARGIN = 1.0 + 1e-6

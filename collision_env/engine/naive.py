@@ -24,7 +24,10 @@ from .response import ball_ball, ball_wall, merge_bodies, stop_body
 
 
 @njit(inline="always")
-def body_inverse_mass(i, mass, body):
+def body_inverse_mass(i, mass, body, sticky):
+    """1 / the mass of ball ``i``'s cluster (of the ball alone unless the scene is a stick one)."""
+    if not sticky:
+        return 1.0 / mass[i]
     root = body[i]
     m_tot = 0.0
     for k in range(mass.shape[0]):
@@ -34,7 +37,12 @@ def body_inverse_mass(i, mass, body):
 
 
 @njit(inline="always")
-def shift_body(i, dx, dy, pos, body):
+def shift_body(i, dx, dy, pos, body, sticky):
+    """Move ball ``i``'s cluster (the ball alone unless the scene is a stick one) by (dx, dy)."""
+    if not sticky:
+        pos[i, 0] += dx
+        pos[i, 1] += dy
+        return
     root = body[i]
     for k in range(pos.shape[0]):
         if body[k] == root:
@@ -62,9 +70,9 @@ def contain(sc, t_abs, pos, vel, radius, body, omega, bounds, dim, e, u_min, sti
             else:
                 continue
             if axis == 0:
-                shift_body(i, push, 0.0, pos, body)
+                shift_body(i, push, 0.0, pos, body, sticky)
             else:
-                shift_body(i, 0.0, push, pos, body)
+                shift_body(i, 0.0, push, pos, body, sticky)
             v = vel[i, axis]
             if (v < 0.0) if wall % 2 == 0 else (v > 0.0):
                 if sticky:
@@ -113,8 +121,10 @@ def resolve_naive(
                 counters[PAIR_TESTS] += 1
                 dx = pos[j, 0] - pos[i, 0]
                 dy = pos[j, 1] - pos[i, 1]
-                dist = math.sqrt(dx * dx + dy * dy)
                 sigma = radius[i] + radius[j]
+                if dx * dx + dy * dy > sigma * sigma * (1.0 + 1e-12):  # (spares the root of far pairs)
+                    continue
+                dist = math.sqrt(dx * dx + dy * dy)
                 if dist >= sigma:
                     continue
                 if dist > 0.0:
@@ -124,11 +134,11 @@ def resolve_naive(
                     nx = 1.0
                     ny = 0.0
                 closing = (vel[j, 0] - vel[i, 0]) * nx + (vel[j, 1] - vel[i, 1]) * ny
-                wi = body_inverse_mass(i, mass, body)
-                wj = body_inverse_mass(j, mass, body)
+                wi = body_inverse_mass(i, mass, body, sticky)
+                wj = body_inverse_mass(j, mass, body, sticky)
                 overlap = sigma - dist
-                shift_body(i, -overlap * wi / (wi + wj) * nx, -overlap * wi / (wi + wj) * ny, pos, body)
-                shift_body(j, overlap * wj / (wi + wj) * nx, overlap * wj / (wi + wj) * ny, pos, body)
+                shift_body(i, -overlap * wi / (wi + wj) * nx, -overlap * wi / (wi + wj) * ny, pos, body, sticky)
+                shift_body(j, overlap * wj / (wi + wj) * nx, overlap * wj / (wi + wj) * ny, pos, body, sticky)
                 if closing < 0.0:
                     x = pos[i, 0] + radius[i] * nx
                     y = pos[i, 1] + radius[i] * ny

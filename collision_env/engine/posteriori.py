@@ -31,8 +31,13 @@ from .response import ball_ball, ball_wall, merge_bodies, stop_body
 
 
 @njit(inline="always")
-def _move(i, dt, pos, vel, mass, body, omega):
-    """Move ball ``i``'s body by ``dt`` (negative: rewind), leaving the other balls in place."""
+def _move(i, dt, pos, vel, mass, body, omega, sticky):
+    """Move ball ``i``'s body by ``dt`` (negative: rewind), leaving the other balls in place (the
+    ball alone unless the scene is a stick one)."""
+    if not sticky:
+        pos[i, 0] += vel[i, 0] * dt
+        pos[i, 1] += vel[i, 1] * dt
+        return
     root = body[i]
     if omega[root] != 0.0:
         advance_body(root, dt, pos, vel, mass, body, omega)
@@ -112,8 +117,8 @@ def resolve_posteriori(
                     continue
                 t = overlap_time_pair(dx, dy, vel[j, 0] - vel[i, 0], vel[j, 1] - vel[i, 1], sigma)
                 t = min(max(t, 0.0), h)
-                _move(i, -t, pos, vel, mass, body, omega)
-                _move(j, -t, pos, vel, mass, body, omega)
+                _move(i, -t, pos, vel, mass, body, omega, sticky)
+                _move(j, -t, pos, vel, mass, body, omega, sticky)
                 dx = pos[j, 0] - pos[i, 0]
                 dy = pos[j, 1] - pos[i, 1]
                 dist = math.sqrt(dx * dx + dy * dy)
@@ -128,9 +133,9 @@ def resolve_posteriori(
                         speed = ball_ball(i, j, pos, vel, inv_mass, e, u_min)
                     record(imp, n_imp, sc, t_end - sign * t, i, j, -1, x, y, speed)
                     counters[EVENTS] += 1
-                _move(i, t, pos, vel, mass, body, omega)
+                _move(i, t, pos, vel, mass, body, omega, sticky)
                 if body[j] != body[i]:
-                    _move(j, t, pos, vel, mass, body, omega)
+                    _move(j, t, pos, vel, mass, body, omega, sticky)
     if has_walls:
         for i in range(n):
             counters[WALL_TESTS] += 1
@@ -139,7 +144,7 @@ def resolve_posteriori(
                 continue
             t = min(max(t, 0.0), h)
             t_abs = t_end - sign * t
-            shift_body(i, -t * vel[i, 0], -t * vel[i, 1], pos, body)
+            shift_body(i, -t * vel[i, 0], -t * vel[i, 1], pos, body, sticky)
             for axis in range(2):
                 ds = dsx if axis == 0 else dsy
                 if ds == 0.0:
@@ -157,5 +162,5 @@ def resolve_posteriori(
                     x, y = wall_point(i, wall, pos, radius, bounds)
                     record(imp, n_imp, sc, t_abs, i, -1, wall, x, y, speed)
                     counters[EVENTS] += 1
-            shift_body(i, t * vel[i, 0], t * vel[i, 1], pos, body)
+            shift_body(i, t * vel[i, 0], t * vel[i, 1], pos, body, sticky)
         contain(sc, t_end, pos, vel, radius, body, omega, bounds, dim, e, u_min, sticky, imp, n_imp, counters)

@@ -426,7 +426,7 @@ class BatchSimulator:
         if self.mode == "exact":
             shape = dict(balls_per_cell=grid.EXACT_BALLS_PER_CELL, cells_per_ball=grid.EXACT_CELLS_PER_BALL)
         else:
-            shape = dict(reach=2.0)
+            shape = dict(reach=2.0, balls_per_cell=0.0, cells_per_ball=grid.CHEAP_CELLS_PER_BALL)
         origin_and_cells, counts = grid_geometry(
             self.scene.bounds, self._pos[scenes], self._radius[scenes], self._uses_grid(), **shape
         )
@@ -443,7 +443,7 @@ class BatchSimulator:
             if self.mode == "exact":
                 worst = impacts_per_event(self._n, self.scene.elasticity < 1.0)
             else:  # with a grid, a sub-step's bound is counted from its cells; the buffer grows if needed
-                worst = 16 * self._n if self._uses_grid() else worst_case_impacts(self._n)
+                worst = 32 * self._n if self._uses_grid() else worst_case_impacts(self._n)
             rows = max(4096, 2 * worst)
         self._imp = np.empty(rows, dtype=IMPACT_DTYPE)
         self._imp_bytes = memoryview(self._imp.view(np.uint8))

@@ -5,7 +5,7 @@ from __future__ import annotations
 from ._jit import HAVE_NUMBA, njit
 from .clock import finish_step
 from .exact import scene_params
-from .grid import block, cell_of, scene_geometry
+from .grid import CHEAP_CELLS_PER_BALL, block, cell_of, scene_geometry
 from .layout import (
     W_ACTIVE,
     W_STALLED,
@@ -33,8 +33,9 @@ def worst_case_impacts(n):
 
 
 def scratch_size(n):
-    """Length of :func:`step_substeps`'s int work buffer for ``n`` balls (the sub-step's grid)."""
-    return 4 * n
+    """Length of :func:`step_substeps`'s int work buffer for ``n`` balls (the sub-step's grid: at
+    most ``grid.CHEAP_CELLS_PER_BALL`` cells per ball)."""
+    return (2 + 2 * CHEAP_CELLS_PER_BALL) * n
 
 
 @njit(inline="always")
@@ -43,10 +44,11 @@ def _cell_lists(n, p, v, h, scratch, geo):
     it is made, so that a scene can still stall untouched), and return the lists as
     ``(head, nxt, cell, near, nx, ny)`` for the resolvers."""
     x0, y0, hx, hy, nx, ny = geo
-    head = scratch[0:n]
-    nxt = scratch[n : 2 * n]
-    cell = scratch[2 * n : 3 * n]
-    near = scratch[3 * n : 4 * n]
+    m = CHEAP_CELLS_PER_BALL * n  # (``near`` holds a count per cell, or a ball's neighbours)
+    head = scratch[0:m]
+    nxt = scratch[m : m + n]
+    cell = scratch[m + n : m + 2 * n]
+    near = scratch[m + 2 * n : 2 * m + 2 * n]
     if nx * ny > 1:
         for c in range(nx * ny):
             head[c] = -1
@@ -59,16 +61,21 @@ def _cell_lists(n, p, v, h, scratch, geo):
 
 
 @njit(inline="always")
-def _grid_worst_case(n, cells):
+def _grid_worst_case(n, cells, room):
     """Most impacts a sub-step can record on the grid: a pair per neighbour, and border and
-    containment impacts."""
+    containment impacts; counted cell by cell only when a cruder bound (every ball's 3 x 3 block
+    as full as the fullest cell) exceeds the ``room`` left in the buffer."""
     head, nxt, cell, near, nx, ny = cells
     if nx * ny == 1:
         return n * (n - 1) // 2 + 4 * n
     for c in range(nx * ny):
         near[c] = 0
+    fullest = 0
     for i in range(n):
         near[cell[i]] += 1
+        fullest = max(fullest, near[cell[i]])
+    if 4 * n + 9 * n * fullest <= room:
+        return 4 * n + 9 * n * fullest
     worst = 4 * n
     for i in range(n):
         cx0, cx1, cy0, cy1 = block(cell[i], nx, ny)
@@ -135,7 +142,8 @@ def step_substeps(
         u_min = elastic_threshold(v, ratio, floor)
         while done[sc] < k_total:
             cells = _cell_lists(n, p, v, h, scratch, geo)
-            if imp.shape[0] - n_imp[0] < _grid_worst_case(n, cells):
+            room = imp.shape[0] - n_imp[0]
+            if room < _grid_worst_case(n, cells, room):
                 stalled[sc] = True
                 break
             k = done[sc] + 1
