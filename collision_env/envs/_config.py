@@ -21,6 +21,7 @@ from collision_env.engine.scene import PLAY_AREA_1D, PLAY_AREA_2D, WALL_NAMES, r
 from collision_env.envs._layout import BALL_OBS, GLOBAL_OBS, PREDICTED_OBS, TARGET_OBS
 
 OBSERVATIONS = ("plain", "predicted")
+OBSERVED_BALLS = ("all", "controlled")
 AIMS = ("straight", "predicted")
 SCORERS = ("any", "controlled", "others", "cluster")
 LAYOUTS = ("random", "rack")
@@ -97,9 +98,11 @@ class TaskConfig:
         term takes each scoring ball's next wall contact from: "straight", flying straight on, a
         heuristic that ignores other balls; "predicted", the engine's prediction, as for ``observe``).
     Observation:
-        ``observe`` ("plain": balls, targets and the globals; "predicted": also, per ball, its next wall
-        impact as the engine predicts it with no further nudge, found by running a copy of the engine
-        ``lookahead`` s ahead at every step: contact point, time, and whether it hits a target).
+        ``observed_balls`` ("all": a block per ball; "controlled": the controlled balls' blocks only,
+        for scenes of many balls that the agent does not steer); ``observe`` ("plain": balls, targets
+        and the globals; "predicted": also, per observed ball, its next wall impact as the engine
+        predicts it with no further nudge, found by running a copy of the engine ``lookahead`` s
+        ahead at every step: contact point, time, and whether it hits a target).
     Episode:
         ``time_limit`` (s of simulated time; the env truncates after round(time_limit / dt) steps).
     Engine:
@@ -135,6 +138,7 @@ class TaskConfig:
     action_cost: float = 0.02
     shaping: float = 0.0
     aim: str = "straight"
+    observed_balls: str = "all"
     observe: str = "plain"
     lookahead: float = 5.0
     time_limit: float = 10.0
@@ -223,6 +227,8 @@ class TaskConfig:
             raise ValueError("scorers: 'cluster' needs at least 2 balls")
         for name in ("hit_reward", "success_bonus", "miss_penalty", "action_cost", "shaping"):
             s(name, _number(name, getattr(self, name)))
+        if self.observed_balls not in OBSERVED_BALLS:
+            raise ValueError(f"observed_balls: expected one of {OBSERVED_BALLS}, got {self.observed_balls!r}")
         if self.aim not in AIMS:
             raise ValueError(f"aim: expected one of {AIMS}, got {self.aim!r}")
         if self.observe not in OBSERVATIONS:
@@ -273,8 +279,23 @@ class TaskConfig:
 
     @property
     def obs_dim(self) -> int:
-        plain = self.n_balls * BALL_FEATURES + self.target_slots * TARGET_FEATURES + GLOBAL_FEATURES
-        return plain + (self.n_balls * PREDICTED_FEATURES if self.observe == "predicted" else 0)
+        shown = self.n_observed
+        plain = shown * BALL_FEATURES + self.target_slots * TARGET_FEATURES + GLOBAL_FEATURES
+        return plain + (shown * PREDICTED_FEATURES if self.observe == "predicted" else 0)
+
+    @property
+    def shown_mask(self) -> np.ndarray:
+        """(n_balls,) bool: the balls that have a block in the observation (``observed_balls``)."""
+        if self.observed_balls == "all":
+            return np.ones(self.n_balls, dtype=bool)
+        mask = np.zeros(self.n_balls, dtype=bool)
+        mask[list(self.controlled)] = True
+        return mask
+
+    @property
+    def n_observed(self) -> int:
+        """Number of ball blocks in the observation."""
+        return self.n_balls if self.observed_balls == "all" else len(self.controlled)
 
     @property
     def scoring_mask(self) -> np.ndarray:

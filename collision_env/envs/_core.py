@@ -278,6 +278,7 @@ class TaskCore:
         )
         self.ctrl = np.array(cfg.controlled, dtype=np.int64)
         self.qual = cfg.scoring_mask
+        self.shown = cfg.shown_mask
         self.obs_dim = cfg.obs_dim
         self.action_dim = cfg.action_dim
 
@@ -397,6 +398,7 @@ class TaskCore:
             self.t_geo,
             self.body,
             self.qual,
+            self.shown,
             self.P,
             self.Q,
             obs,
@@ -427,6 +429,7 @@ class TaskCore:
             self.T,
             self.t_geo,
             self.qual,
+            self.shown,
             self.P,
             self.Q,
             obs,

@@ -267,9 +267,9 @@ def _observed_point(wall, centre, xc, yc, xh, yh):  # pragma: no cover - numba
 
 @njit(inline="always")
 def _observe(
-    flags, obs, S, pos, vel, masses, body, qual, C, T, t_geo, sim_time, seq, cluster, n_steps, P
+    flags, obs, S, pos, vel, masses, body, qual, shown, C, T, t_geo, sim_time, seq, cluster, n_steps, P
 ):  # pragma: no cover - numba
-    """Write the observation (ball blocks, target slots, globals) and the kinetic energy."""
+    """Write the observation (the ``shown`` balls' blocks, target slots, globals) and the kinetic energy."""
     xc, yc, xh, yh = _centre_and_half_size(P)
     vscale = P[PARAMS.vscale]
     mscale = P[PARAMS.mscale]
@@ -285,6 +285,8 @@ def _observe(
             vx = vel[b, i, 0]
             vy = vel[b, i, 1]
             ke += 0.5 * masses[b, i] * (vx * vx + vy * vy)
+            if not shown[i]:
+                continue
             obs[b, o + BALL_OBS.x] = _clip1((pos[b, i, 0] - xc) / xh)
             obs[b, o + BALL_OBS.y] = _clip1((pos[b, i, 1] - yc) / yh)
             obs[b, o + BALL_OBS.vx] = _clip1(vx / vscale)
@@ -448,7 +450,7 @@ def _settle(flags, S, C, T, t_geo, pos, vel, radii, body, qual, seq, cluster, n_
 
 @njit(refcount=False)
 def task_kernel(
-    flags, imp, balls, sim_time, clusters, S, C, T, t_geo, body, qual, P, Q, obs
+    flags, imp, balls, sim_time, clusters, S, C, T, t_geo, body, qual, shown, P, Q, obs
 ):  # pragma: no cover - numba
     """Score a step's impacts, update target state, and write reward, flags and observation.
 
@@ -459,6 +461,7 @@ def task_kernel(
     ``_score_impacts``); at the end it is set to the engine's ``clusters``.
     Updated in place: target status, current target, step count, body, phi. Written for rows
     whose flag is not ``ROW_SKIP``: the observation, reward, energy, targets hit and the end flags.
+    ``shown`` (N,) says whose ball blocks the observation has (``TaskConfig.observed_balls``).
     """
     pos, vel, masses, _, radii, _ = ball_views(balls)  # (always a C array: one compiled version for any B, N)
     seq = Q[SWITCHES.sequential] != 0
@@ -466,7 +469,7 @@ def task_kernel(
     n_steps = Q[SWITCHES.n_steps]
     _score_impacts(flags, imp, C, T, t_geo, body, qual, seq, cluster)
     _advance_episodes(flags, sim_time, clusters, C, T, t_geo, body, cluster)
-    _observe(flags, obs, S, pos, vel, masses, body, qual, C, T, t_geo, sim_time, seq, cluster, n_steps, P)
+    _observe(flags, obs, S, pos, vel, masses, body, qual, shown, C, T, t_geo, sim_time, seq, cluster, n_steps, P)
     _settle(flags, S, C, T, t_geo, pos, vel, radii, body, qual, seq, cluster, n_steps, P, Q)
 
 
@@ -475,9 +478,9 @@ def task_kernel(
 
 
 @njit
-def predict_kernel(flags, imp, sim_time, clusters, body, S, C, T, t_geo, qual, P, Q, obs):  # pragma: no cover
-    """Each ball's predicted next wall impact: written into the observation's last
-    ``N * len(PREDICTED_OBS)`` entries (``observe_predicted``), and made the aiming potential
+def predict_kernel(flags, imp, sim_time, clusters, body, S, C, T, t_geo, qual, shown, P, Q, obs):  # pragma: no cover
+    """Each ball's predicted next wall impact: written into the observation's last entries, one
+    ``PREDICTED_OBS`` block per ``shown`` ball (``observe_predicted``), and made the aiming potential
     (``aim_predicted``), for the rows whose flag is not ``ROW_SKIP``.
 
     ``imp`` are the impacts of a copy of the engine run ahead from the scenes' current state with no
@@ -499,7 +502,16 @@ def predict_kernel(flags, imp, sim_time, clusters, body, S, C, T, t_geo, qual, P
     observe = Q[SWITCHES.observe_predicted] != 0
     aim = Q[SWITCHES.aim_predicted] != 0
     N = body.shape[1]
-    base = obs.shape[1] - N * len(PREDICTED_OBS)
+    block = np.full(N, -1)  # the observation entry where each shown ball's block starts
+    n_shown = 0
+    for i in range(N):
+        if shown[i]:
+            n_shown += 1
+    o = obs.shape[1] - n_shown * len(PREDICTED_OBS)
+    for i in range(N):
+        if shown[i]:
+            block[i] = o
+            o += len(PREDICTED_OBS)
     seen = np.zeros(body.shape, dtype=np.bool_)
     best = np.ones(body.shape[0])
     for b in range(flags.shape[0]):
@@ -507,8 +519,8 @@ def predict_kernel(flags, imp, sim_time, clusters, body, S, C, T, t_geo, qual, P
             continue
         for i in range(N):
             body[b, i] = clusters[b, i]
-            if observe:
-                o = base + i * len(PREDICTED_OBS)
+            if observe and shown[i]:
+                o = block[i]
                 obs[b, o + PREDICTED_OBS.x] = 0.0
                 obs[b, o + PREDICTED_OBS.y] = 0.0
                 obs[b, o + PREDICTED_OBS.time] = 1.0
@@ -535,8 +547,8 @@ def predict_kernel(flags, imp, sim_time, clusters, body, S, C, T, t_geo, qual, P
         t = imp[j]["time"]
         if aim and scores:
             best[b] = min(best[b], _aim_distance(x, y, b, C, T, t_geo, seq, P) / diag)
-        if observe:
-            o = base + i * len(PREDICTED_OBS)
+        if observe and shown[i]:
+            o = block[i]
             obs[b, o + PREDICTED_OBS.x] = _clip1((x - xc) / xh)
             obs[b, o + PREDICTED_OBS.y] = _clip1((y - yc) / yh)
             obs[b, o + PREDICTED_OBS.time] = _clip1((t - sim_time[b]) / tlimit)

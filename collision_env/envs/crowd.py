@@ -27,23 +27,25 @@ class CrowdEnv(CollisionTargetEnv):
 
     ## Observation Space
 
-    `Box(-1, 1, (1218,), float32)`; ball 0 is the controlled ball, balls 1-200 the gas:
+    `Box(-1, 1, (18,), float32)`: the controlled ball, its target and the time (the gas is not
+    observed, `observed_balls="controlled"`; `observed_balls="all"` adds a block per gas ball):
 
-    | Index      | Observation                                                        |
-    |------------|--------------------------------------------------------------------|
-    | 6i + 0, 1  | ball i position x / 2 m, y / 1 m (i = 0 controlled, 1-200 the gas) |
-    | 6i + 2, 3  | ball i velocity / 4 m/s                                            |
-    | 6i + 4     | ball i mass / 3 kg                                                 |
-    | 6i + 5     | 1 for ball 0 (its impacts score), 0 for the gas                    |
-    | 1206, 1207 | current target's centre point, x / 2 m, y / 1 m                    |
-    | 1208       | target half width / half length of its wall                        |
-    | 1209-1212  | target wall one-hot (left, right, bottom, top)                     |
-    | 1213       | target status: 1 pending, 0 hit                                    |
-    | 1214, 1215 | -1, 1 (no time window)                                             |
-    | 1216       | fraction of the 200 control steps left                             |
-    | 1217       | fraction of the 3 targets not yet hit                              |
+    | Index  | Observation                                                        |
+    |--------|--------------------------------------------------------------------|
+    | 0, 1   | ball 0 position x / 2 m, y / 1 m                                   |
+    | 2, 3   | ball 0 velocity vx / 4, vy / 4 (m/s)                               |
+    | 4      | ball 0 mass / 3 kg (1/3)                                           |
+    | 5      | 1 (its impacts score)                                              |
+    | 6, 7   | current target's centre point, x / 2 m, y / 1 m                    |
+    | 8      | target half width / half length of its wall                        |
+    | 9-12   | target wall one-hot (left, right, bottom, top)                     |
+    | 13     | target status: 1 pending, 0 hit                                    |
+    | 14, 15 | -1, 1 (no time window)                                             |
+    | 16     | fraction of the 200 control steps left                             |
+    | 17     | fraction of the 3 targets not yet hit                              |
 
-    With `observe="predicted"`, 4 entries per ball follow (see `CollisionTargetEnv`).
+    With `observe="predicted"`, 4 entries follow: ball 0's next wall impact as the engine predicts
+    it through the gas (see `CollisionTargetEnv`).
 
     ## Rewards
 
@@ -77,6 +79,7 @@ class CrowdEnv(CollisionTargetEnv):
             n_balls=201,
             mass_range=(1.0, 1.0),
             others_mass_range=(0.1, 0.1),
+            observed_balls="controlled",
             radius=0.04,
             speed_range=(0.3, 0.8),
             others_speed_range=(0.3, 0.9),

@@ -41,8 +41,9 @@ class CollisionTargetEnv(gym.Env):
 
     ## Observation Space
 
-    `Box(-1, 1, (D,), float32)` with a fixed layout, `D = 6 N + 10 S + 2` (N balls, S target slots:
-    1 when targets are sequential, else `n_targets`), plus `4 N` with `observe="predicted"`. Centre
+    `Box(-1, 1, (D,), float32)` with a fixed layout, `D = 6 N + 10 S + 2` (N observed balls: every
+    ball, or the controlled ones with `observed_balls="controlled"`; S target slots: 1 when targets
+    are sequential, else `n_targets`), plus `4 N` with `observe="predicted"`. Centre
     and half-size of the play area are (xc, yc), (xh, yh); `vs = 2 * max_speed`. Every entry is
     clipped to [-1, 1].
 

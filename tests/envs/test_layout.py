@@ -84,7 +84,7 @@ def _table_cells(doc: str) -> list:
 
 
 def _check_table(doc: str, cfg) -> None:
-    n, slots, dim = cfg.n_balls, cfg.target_slots, cfg.obs_dim
+    n, slots, dim = cfg.n_observed, cfg.target_slots, cfg.obs_dim
     groups = _field_groups(n, slots, cfg.observe == "predicted")
     seen = []
     for cell in _table_cells(doc):
@@ -146,14 +146,14 @@ def test_observation_entries_sit_where_the_layout_says(env_id):
     xmin, ymin, xmax, ymax = cfg.bounds
     xc, yc, xh, yh = (xmin + xmax) / 2, (ymin + ymax) / 2, (xmax - xmin) / 2, (ymax - ymin) / 2
     nb, nt = len(BALL_OBS), len(TARGET_OBS)
-    for i in range(cfg.n_balls):
-        block = obs[nb * i : nb * (i + 1)]
+    for j, i in enumerate(np.flatnonzero(cfg.shown_mask)):
+        block = obs[nb * j : nb * (j + 1)]
         assert block[BALL_OBS.x] == pytest.approx(np.clip((core.pos[0, i, 0] - xc) / xh, -1, 1), abs=1e-6)
         assert block[BALL_OBS.y] == pytest.approx(np.clip((core.pos[0, i, 1] - yc) / yh, -1, 1), abs=1e-6)
         assert block[BALL_OBS.vy] == pytest.approx(np.clip(core.vel[0, i, 1] / (2 * cfg.max_speed), -1, 1), abs=1e-6)
         assert block[BALL_OBS.mass] == pytest.approx(core.masses[0, i] / 3.0, abs=1e-6)
     for s in range(cfg.target_slots):
-        block = obs[nb * cfg.n_balls + nt * s : nb * cfg.n_balls + nt * (s + 1)]
+        block = obs[nb * cfg.n_observed + nt * s : nb * cfg.n_observed + nt * (s + 1)]
         k = min(int(core.cur[0]), cfg.n_targets - 1) if cfg.sequential else s
         wall = WALL_NAMES[int(core.t_wall[0, k])]
         assert block[getattr(TARGET_OBS, f"wall_{wall}")] == 1.0 and block[TARGET_OBS.wall_left :][:4].sum() == 1.0

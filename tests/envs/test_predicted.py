@@ -10,15 +10,15 @@ from gymnasium.utils.env_checker import check_env
 from gymnasium.vector import AutoresetMode
 
 from collision_env.envs import PRESET_IDS
-from collision_env.envs._layout import PREDICTED_OBS, SCENE_FLOATS, TARGET_GEOMETRY
+from collision_env.envs._layout import BALL_OBS, PREDICTED_OBS, SCENE_FLOATS, TARGET_GEOMETRY
 from tests.envs.test_vector import run_pair
 
 IDS = sorted(PRESET_IDS.values())
 NP = len(PREDICTED_OBS)
 
 
-def _predicted(obs, n_balls):
-    return obs[-n_balls * NP :].reshape(n_balls, NP)
+def _predicted(obs, n_blocks):
+    return obs[-n_blocks * NP :].reshape(n_blocks, NP)
 
 
 def _normalised(cfg, x, y):
@@ -32,9 +32,9 @@ def test_prediction_is_the_impact_that_happens_when_nothing_is_nudged(env_id):
     # steps grow by about a mean free path over a radius per collision, so the crowd is checked
     # over a horizon of a few collisions per ball.
     lookahead = 0.5 if "Crowd" in env_id else 10.0
-    env = gym.make(env_id, observe="predicted", lookahead=lookahead).unwrapped
+    env = gym.make(env_id, observe="predicted", observed_balls="all", lookahead=lookahead).unwrapped
     cfg = env.config
-    plain = gym.make(env_id).unwrapped.config.obs_dim
+    plain = gym.make(env_id, observed_balls="all").unwrapped.config.obs_dim
     assert env.observation_space.shape == (cfg.obs_dim,) and cfg.obs_dim == plain + NP * cfg.n_balls
     checked = 0
     for seed in range(4):
@@ -117,9 +117,24 @@ def test_checkers_and_vector_equality_with_predictions(env_id):
         assert run_pair(env_id, mode, steps=30, seed=2, max_episode_steps=10, observe="predicted", **short) >= 4
 
 
+def test_only_the_controlled_balls_can_be_observed():
+    # the crowd's gas has no blocks: ball 0's, the target's and the globals', then ball 0's prediction
+    full = gym.make("CollisionEnv/Crowd-v0", observe="predicted", observed_balls="all").unwrapped
+    few = gym.make("CollisionEnv/Crowd-v0", observe="predicted").unwrapped
+    assert few.config.observed_balls == "controlled" and few.observation_space.shape == (18 + NP,)
+    o_full, _ = full.reset(seed=5)
+    o_few, _ = few.reset(seed=5)
+    n, nb = full.config.n_balls, len(BALL_OBS)
+    assert np.array_equal(o_few[:nb], o_full[:nb])  # ball 0
+    assert np.array_equal(o_few[nb:-NP], o_full[n * nb : -n * NP])  # targets and globals
+    assert np.array_equal(o_few[-NP:], o_full[-n * NP :][:NP])  # ball 0's prediction
+
+
 def test_bad_observe_and_lookahead_are_value_errors():
     with pytest.raises(ValueError, match="observe"):
         gym.make("CollisionEnv/OneBallTarget-v0", observe="everything")
+    with pytest.raises(ValueError, match="observed_balls"):
+        gym.make("CollisionEnv/OneBallTarget-v0", observed_balls="some")
     with pytest.raises(ValueError, match="lookahead"):
         gym.make("CollisionEnv/OneBallTarget-v0", observe="predicted", lookahead=0.0)
 
