@@ -12,7 +12,7 @@ class CrowdEnv(CollisionTargetEnv):
 
     One controlled ball (ball 0, 1 kg) among 200 light balls (0.1 kg), all of radius 0.04 m, in
     PhET's 4 m x 2 m play area, elastic (e = 1) with every ball-ball collision modelled: a gas at an
-    area fraction of 13 % whose balls fly at 0.3-0.9 m/s. Three targets, 0.6 m wall segments on random
+    area fraction of 13 % whose balls fly at 1-3 m/s. Three targets, 0.6 m wall segments on random
     walls, are shown one at a time, as in `OneBallTarget`; only the controlled ball's wall impacts
     score, and the gas knocks it off course every few tenths of a metre (its mean free path is about
     0.25 m), so the agent keeps steering. Here the engine does most of a step's work: the task with
@@ -56,8 +56,8 @@ class CrowdEnv(CollisionTargetEnv):
 
     ## Starting State
 
-    Every ball at a random place without overlap; ball 0 moving at 0.3-0.8 m/s, the gas at 0.3-0.9
-    m/s, in random directions; three targets on random walls with centres uniform along the wall.
+    Every ball at a random place without overlap; ball 0 moving at 0.3-0.8 m/s, the gas at 1-3 m/s,
+    in random directions; three targets on random walls with centres uniform along the wall.
 
     ## Episode End
 
@@ -82,7 +82,7 @@ class CrowdEnv(CollisionTargetEnv):
             observed_balls="controlled",
             radius=0.04,
             speed_range=(0.3, 0.8),
-            others_speed_range=(0.3, 0.9),
+            others_speed_range=(1.0, 3.0),
             controlled=(0,),
             n_targets=3,
             sequential=True,
