@@ -1,20 +1,27 @@
 """Train cheap, evaluate exact: what the engine's fidelity mode costs and buys a PPO agent.
 
-    python -m agents.study --jobs 2 --readme README.md   # both parts, 3 seeds each (under an hour on 2 cores)
+    python -m agents.study --jobs 2 --readme README.md   # both parts, 3 seeds each (hours on 2 cores)
     python -m agents.study --part modes --envs CollisionEnv/Line1D-v0 --modes naive:1 exact:1 --seeds 0
+    python -m agents.study --part presets --presets CollisionEnv/Billiards-v0 --add --readme README.md
 
-Part **modes**: each preset of ``--envs`` (default ``OneBallTarget``, where only wall impacts
-matter, and ``Line1D``, where ball-ball impacts and time windows make timing matter) is trained
+Part **modes**: each preset of ``--envs`` (default ``Crowd``, the preset where the engine does most of
+a training step's work: a cheaper mode can only save the engine's share of the time) is trained
 with the shipped hyperparameters under each engine mode (``mode:substeps``), over several seeds;
 every policy is then evaluated deterministically in **exact** mode (and in its own training mode)
-on the same 100 episodes. The table gives success per seed, its mean and spread, and the wall-clock
-training time, so the trade is read off directly: is a policy trained on a cheaper, less exact
-engine as good when the impacts are exact, and how much training time did the cheaper engine save?
+on the same 100 episodes. The table gives success per seed, its mean and spread, the wall-clock
+training time and the engine's share of it, so the trade is read off directly: is a policy trained
+on a cheaper, less exact engine as good when the impacts are exact, and how much training time did
+the cheaper engine save?
 
 Part **presets**: every registered preset is trained in exact mode over the same seeds and set
-beside the random and the scripted (exact-aim) baselines on the same evaluation episodes.
+beside the random and the scripted (exact-aim) baselines on the same evaluation episodes; a preset
+whose shipped entry trains on the predicted observation is trained on the plain one too.
 
-Writes ``study.json`` (every figure), ``modes.md``, ``presets.md`` and ``modes.png`` into
+Every run records where its training time went (``agents.timing``); the time-split table shows it,
+and the closing rule says when a cheaper engine mode can pay. ``--add`` adds runs to an earlier
+study's ``study.json`` (a cell run again replaces its figures), so a study can be run in parts.
+
+Writes ``study.json`` (every figure), ``modes.md``, ``presets.md``, ``time_split.md`` and ``modes.png`` into
 ``--docs`` (default ``docs/agents``), and with ``--readme`` the tables into the README's
 ``agents:study`` block. Training runs go to ``--output`` (default ``runs/study``). With ``--jobs 2``
 two runs train at once (one core each), as every figure in the README was measured.
@@ -35,8 +42,8 @@ from agents.evaluate import pct
 from collision_env.bench.machine import cpus, machine, timestamp, versions
 from collision_env.engine import MODES
 
-DEFAULT_ENVS = ("CollisionEnv/OneBallTarget-v0", "CollisionEnv/Line1D-v0")
-DEFAULT_MODES = ("naive:1", "naive:4", "posteriori:1", "posteriori:4", "exact:1")
+DEFAULT_ENVS = ("CollisionEnv/Crowd-v0",)
+DEFAULT_MODES = ("naive:1", "posteriori:1", "exact:1")
 DEFAULT_SEEDS = (0, 1, 2)
 README_BLOCK = "agents:study"
 
@@ -233,8 +240,10 @@ def modes_reading(rows: list) -> str:
 
 
 def _by_preset(rows: list, base: list) -> dict:
-    """{(env_id, observation): [presets-part rows sorted by seed]}, presets in the order asked for."""
-    order = [b["env_id"] for b in base]
+    """{(env_id, observation): [presets-part rows sorted by seed]}, presets in registration order."""
+    from collision_env.envs import PRESET_IDS
+
+    order = list(PRESET_IDS.values())
     groups: dict = {}
     for r in sorted(rows, key=lambda r: order.index(r["env_id"]) if r["env_id"] in order else len(order)):
         if r["part"] == "presets":
