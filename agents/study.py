@@ -332,9 +332,11 @@ def rule(rows: list, base: list) -> str:
                 continue
             speed = _seconds(exact_rows) / _seconds(rs)
             loss = ref - statistics.fmean(r["exact"]["success_rate"] for r in rs)
+            points = round(100 * loss)
+            change = f"loses {points}" if points > 0 else f"gains {-points}" if points < 0 else "loses no"
             lines.append(
                 f"`{env_id}` ({_share(f)} of exact training in the engine): {_label(mode, k)} trains "
-                f"{speed:.2f}× as fast and loses {100 * loss:.0f} points of exact-evaluated success"
+                f"{speed:.2f}× as fast and {change} points of exact-evaluated success"
             )
     if not shares and not lines:
         return ""
