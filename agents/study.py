@@ -344,7 +344,8 @@ def rule(rows: list, base: list) -> str:
         "**Rule**: a cheaper engine mode can only save the engine's share of a training run. With the engine at "
         "a fraction f of the training time, no mode trains more than 1 / (1 − f) times faster (Amdahl's law), "
         "and a policy trained cheap must still be evaluated exact. So train cheap only where f is large and "
-        "a cheap mode's policies keep their exact-evaluated success over seeds; train exact elsewhere."
+        "a cheap mode's policies keep their exact-evaluated success over seeds; train exact elsewhere. A short "
+        "exact run tells f: every run's `config.yml` records its time split (`time_split`)."
     )
     if shares:
         text += (
