@@ -459,6 +459,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--modes", nargs="+", default=list(DEFAULT_MODES), metavar="MODE:K")
     p.add_argument("--presets", nargs="+", help="ids of the presets part (default: every preset)")
     p.add_argument("--seeds", nargs="+", type=int, default=list(DEFAULT_SEEDS))
+    p.add_argument(
+        "--observations",
+        choices=("both", "shipped", "plain"),
+        default="both",
+        help="presets part: the shipped entry, the plain observation beside a predicted one, or both",
+    )
     p.add_argument("--timesteps", type=float, help="override every entry's n_timesteps (quick looks)")
     p.add_argument("--episodes", type=int, default=100)
     p.add_argument("--jobs", type=int, default=1, help="runs trained at once (one core each)")
@@ -530,7 +536,7 @@ def main(argv: list[str] | None = None) -> dict:
                     "env_kwargs": kwargs,
                     **common,
                 }
-                for kwargs in variants(env_id)
+                for kwargs in variants(env_id, args.observations)
                 for s in seeds
                 if kwargs or not (args.part == "both" and env_id in envs and ("exact", 1) in modes)
             ]
@@ -573,11 +579,15 @@ def main(argv: list[str] | None = None) -> dict:
     return data
 
 
-def variants(env_id: str) -> list:
+def variants(env_id: str, which: str = "both") -> list:
     """The env keywords the presets part trains ``env_id`` with: the shipped entry (``{}``) and, when
-    the entry changes the observation, the plain one too (so both are reported)."""
+    the entry changes the observation, the plain one too (so both are reported); ``which`` picks
+    ``"shipped"``, ``"plain"`` (none when the entry is plain already) or ``"both"``."""
     shipped = (hyperparams_for(env_id).get("env_kwargs") or {}).get("observe", "plain")
-    return [{}] if shipped == "plain" else [{}, {"observe": "plain"}]
+    out = [{}] if which in ("both", "shipped") else []
+    if shipped != "plain" and which in ("both", "plain"):
+        out.append({"observe": "plain"})
+    return out
 
 
 def _cell(row: dict) -> tuple:
