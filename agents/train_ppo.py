@@ -372,7 +372,7 @@ def train(
     if norm is not None:
         venv.save(str(run_dir / VECNORMALIZE_FILE))
     config["train_seconds"] = round(seconds, 2)
-    config["time_split"] = {k: None if v is None else round(v, 2) for k, v in timer.split(seconds).items()}
+    config["time_split"] = {k: None if v is None else round(v, 4) for k, v in timer.split(seconds).items()}
     config["timesteps_done"] = int(model.num_timesteps)
     write_yaml(run_dir / CONFIG_FILE, config)
     venv.close()
