@@ -265,7 +265,8 @@ def presets_table(rows: list, base: list) -> str:
         "deviation over seeds, then each seed; training time: median over seeds, with the engine's share of it. "
         "Observation: the one the shipped entry trains on (marked *shipped*), and the plain one beside it where the "
         "entry changes it (`predicted`: the env's `observe=\"predicted\"`, each ball's next wall impact as the "
-        "engine predicts it).",
+        "engine predicts it; the plain row keeps the entry's other env settings, such as an aiming term taken from "
+        "the prediction).",
         "",
         "| env | observation | steps | PPO success | per seed | PPO return | random | scripted (exact aim) | "
         "training time (s) | engine's share |",
