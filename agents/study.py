@@ -290,9 +290,11 @@ def presets_table(rows: list, base: list) -> str:
 def split_table(rows: list) -> str:
     """Where the training time went, per preset, observation and mode (median shares over seeds)."""
     from agents.timing import PARTS
+    from collision_env.envs import PRESET_IDS
 
+    order = list(PRESET_IDS.values())
     groups: dict = {}
-    for r in rows:
+    for r in sorted(rows, key=lambda r: order.index(r["env_id"]) if r["env_id"] in order else len(order)):
         key = (r["env_id"], r["observe"], r["mode"], r["substeps"])
         runs = groups.setdefault(key, {})
         runs[r["run"]] = r  # a run counted in both parts is one run
