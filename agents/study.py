@@ -1,20 +1,27 @@
 """Train cheap, evaluate exact: what the engine's fidelity mode costs and buys a PPO agent.
 
-    python -m agents.study --jobs 2 --readme README.md   # both parts, 3 seeds each (under an hour on 2 cores)
+    python -m agents.study --jobs 2 --readme README.md   # both parts, 3 seeds each (hours on 2 cores)
     python -m agents.study --part modes --envs CollisionEnv/Line1D-v0 --modes naive:1 exact:1 --seeds 0
+    python -m agents.study --part presets --presets CollisionEnv/Billiards-v0 --add --readme README.md
 
-Part **modes**: each preset of ``--envs`` (default ``OneBallTarget``, where only wall impacts
-matter, and ``Line1D``, where ball-ball impacts and time windows make timing matter) is trained
+Part **modes**: each preset of ``--envs`` (default ``Crowd``, the preset where the engine does most of
+a training step's work: a cheaper mode can only save the engine's share of the time) is trained
 with the shipped hyperparameters under each engine mode (``mode:substeps``), over several seeds;
 every policy is then evaluated deterministically in **exact** mode (and in its own training mode)
-on the same 100 episodes. The table gives success per seed, its mean and spread, and the wall-clock
-training time, so the trade is read off directly: is a policy trained on a cheaper, less exact
-engine as good when the impacts are exact, and how much training time did the cheaper engine save?
+on the same 100 episodes. The table gives success per seed, its mean and spread, the wall-clock
+training time and the engine's share of it, so the trade is read off directly: is a policy trained
+on a cheaper, less exact engine as good when the impacts are exact, and how much training time did
+the cheaper engine save?
 
 Part **presets**: every registered preset is trained in exact mode over the same seeds and set
-beside the random and the scripted (exact-aim) baselines on the same evaluation episodes.
+beside the random and the scripted (exact-aim) baselines on the same evaluation episodes; a preset
+whose shipped entry trains on the predicted observation is trained on the plain one too.
 
-Writes ``study.json`` (every figure), ``modes.md``, ``presets.md`` and ``modes.png`` into
+Every run records where its training time went (``agents.timing``); the time-split table shows it,
+and the closing rule says when a cheaper engine mode can pay. ``--add`` adds runs to an earlier
+study's ``study.json`` (a cell run again replaces its figures), so a study can be run in parts.
+
+Writes ``study.json`` (every figure), ``modes.md``, ``presets.md``, ``time_split.md`` and ``modes.png`` into
 ``--docs`` (default ``docs/agents``), and with ``--readme`` the tables into the README's
 ``agents:study`` block. Training runs go to ``--output`` (default ``runs/study``). With ``--jobs 2``
 two runs train at once (one core each), as every figure in the README was measured.
@@ -35,8 +42,8 @@ from agents.evaluate import pct
 from collision_env.bench.machine import cpus, machine, timestamp, versions
 from collision_env.engine import MODES
 
-DEFAULT_ENVS = ("CollisionEnv/OneBallTarget-v0", "CollisionEnv/Line1D-v0")
-DEFAULT_MODES = ("naive:1", "naive:4", "posteriori:1", "posteriori:4", "exact:1")
+DEFAULT_ENVS = ("CollisionEnv/Crowd-v0",)
+DEFAULT_MODES = ("naive:1", "posteriori:1", "exact:1")
 DEFAULT_SEEDS = (0, 1, 2)
 README_BLOCK = "agents:study"
 
@@ -68,13 +75,16 @@ def train_and_evaluate(task: dict) -> dict:
     from agents.train_ppo import run_label, train
 
     torch.set_num_threads(1)
+    env_kwargs = task.get("env_kwargs") or {}
     name = run_label(task["env_id"], task["mode"], task["substeps"], task["seed"])
+    name += "".join(f"-{value}" for value in env_kwargs.values())
     run_dir = train(
         task["env_id"],
         timesteps=task["timesteps"],
         seed=task["seed"],
         mode=task["mode"],
         substeps=task["substeps"],
+        env_kwargs=env_kwargs,
         output=task["output"],
         run_name=name,
         eval_freq=0,
@@ -83,7 +93,14 @@ def train_and_evaluate(task: dict) -> dict:
         log=lambda *a: None,
     )
     run = read_run(run_dir)
-    out = {**task, "run": str(run_dir), "train_seconds": run["train_seconds"], "timesteps_done": run["timesteps_done"]}
+    out = {
+        **task,
+        "run": str(run_dir),
+        "train_seconds": run["train_seconds"],
+        "timesteps_done": run["timesteps_done"],
+        "time_split": run["time_split"],
+        "observe": run["env_kwargs"].get("observe", "plain"),
+    }
     exact = evaluate(run_dir, episodes=task["episodes"], mode="exact", baselines=())
     out["exact"] = exact["policies"]["ppo"]
     if task["mode"] != "exact":
@@ -140,6 +157,16 @@ def _seconds(rows: list) -> float:
     return statistics.median(r["train_seconds"] for r in rows)
 
 
+def _engine_share(rows: list) -> float | None:
+    """Median over seeds of the engine's share of the training time (None where it was not timed)."""
+    shares = [r["time_split"]["engine"] / r["train_seconds"] for r in rows if r["time_split"]["engine"] is not None]
+    return statistics.median(shares) if shares else None
+
+
+def _share(x: float | None) -> str:
+    return "n/a" if x is None else f"{100 * x:.0f} %"
+
+
 def _by_env_and_mode(rows: list) -> dict:
     """{env_id: {(mode, substeps): [rows sorted by seed]}} for the modes part, in run order."""
     out: dict = {}
@@ -163,8 +190,8 @@ def modes_table(rows: list) -> str:
             "time: median over seeds.",
             "",
             "| trained in | success, evaluated exact | per seed | success in its own mode | "
-            "training time (s) | ÷ exact's |",
-            "|---|---:|---:|---:|---:|---:|",
+            "training time (s) | ÷ exact's | engine's share of it |",
+            "|---|---:|---:|---:|---:|---:|---:|",
         ]
         exact_rows = groups.get(("exact", 1))
         exact_time = _seconds(exact_rows) if exact_rows else None
@@ -175,7 +202,7 @@ def modes_table(rows: list) -> str:
             ratio = f"{secs / exact_time:.2f}" if exact_time else "n/a"
             lines.append(
                 f"| {_label(mode, k)} | {_spread(exact)} | {' / '.join(pct(x) for x in exact)} | "
-                f"{_spread(own)} | {secs:.0f} | {ratio} |"
+                f"{_spread(own)} | {secs:.0f} | {ratio} | {_share(_engine_share(rs))} |"
             )
         tables.append("\n".join(lines))
     return "\n\n".join(tables)
@@ -212,36 +239,126 @@ def modes_reading(rows: list) -> str:
     return "\n".join(out)
 
 
+def _by_preset(rows: list, base: list) -> dict:
+    """{(env_id, observation): [presets-part rows sorted by seed]}, presets in registration order."""
+    from collision_env.envs import PRESET_IDS
+
+    order = list(PRESET_IDS.values())
+    groups: dict = {}
+    for r in sorted(rows, key=lambda r: order.index(r["env_id"]) if r["env_id"] in order else len(order)):
+        if r["part"] == "presets":
+            groups.setdefault((r["env_id"], r["observe"]), []).append(r)
+    for rs in groups.values():
+        rs.sort(key=lambda r: r["seed"])
+    return groups
+
+
 def presets_table(rows: list, base: list) -> str:
-    rows = [r for r in rows if r["part"] == "presets"]
-    if not rows:
+    groups = _by_preset(rows, base)
+    if not groups:
         return ""
     by_env = {b["env_id"]: b for b in base}
-    episodes = rows[0]["episodes"]
+    episodes = next(iter(groups.values()))[0]["episodes"]
     lines = [
         f"Every preset, PPO in exact mode with the shipped hyperparameters, beside the baselines on the same "
         f"{episodes} evaluation episodes (success rate; mean return in brackets). PPO: mean ± standard "
-        "deviation over seeds, then each seed; training time: median over seeds.",
+        "deviation over seeds, then each seed; training time: median over seeds, with the engine's share of it. "
+        "Observation: the one the shipped entry trains on (marked *shipped*), and the plain one beside it where the "
+        "entry changes it (`predicted`: the env's `observe=\"predicted\"`, each ball's next wall impact as the "
+        "engine predicts it; the plain row keeps the entry's other env settings, such as an aiming term taken from "
+        "the prediction).",
         "",
-        "| env | steps | PPO success | per seed | PPO return | random | scripted (exact aim) | training time (s) |",
-        "|---|---:|---:|---:|---:|---:|---:|---:|",
+        "| env | observation | steps | PPO success | per seed | PPO return | random | scripted (exact aim) | "
+        "training time (s) | engine's share |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
-    order = [b["env_id"] for b in base]  # the presets in the order they were asked for
-    groups: dict = {}
-    for r in sorted(rows, key=lambda r: order.index(r["env_id"]) if r["env_id"] in order else len(order)):
-        groups.setdefault(r["env_id"], []).append(r)
-    for env_id, rs in groups.items():
-        rs = sorted(rs, key=lambda r: r["seed"])
+    fmt = lambda p: "n/a" if p is None else f"{pct(p['success_rate'])} ({p['mean_return']:.2f})"  # noqa: E731
+    for (env_id, observe), rs in groups.items():
         succ = [r["exact"]["success_rate"] for r in rs]
         ret = statistics.fmean(r["exact"]["mean_return"] for r in rs)
         b = by_env.get(env_id, {})
-        fmt = lambda p: "n/a" if p is None else f"{pct(p['success_rate'])} ({p['mean_return']:.2f})"  # noqa: E731
+        shipped = not rs[0].get("env_kwargs")
+        label = f"{observe} (*shipped*)" if shipped else observe
         lines.append(
-            f"| `{env_id}` | {rs[0]['timesteps_done']:,} | {_spread(succ)} | "
+            f"| `{env_id}` | {label} | {rs[0]['timesteps_done']:,} | {_spread(succ)} | "
             f"{' / '.join(pct(x) for x in succ)} | {ret:.2f} | {fmt(b.get('random'))} | "
-            f"{fmt(b.get('scripted'))} | {_seconds(rs):.0f} |"
+            f"{fmt(b.get('scripted'))} | {_seconds(rs):.0f} | {_share(_engine_share(rs))} |"
         )
     return "\n".join(lines)
+
+
+def split_table(rows: list) -> str:
+    """Where the training time went, per preset, observation and mode (median shares over seeds)."""
+    from agents.timing import PARTS
+    from collision_env.envs import PRESET_IDS
+
+    order = list(PRESET_IDS.values())
+    groups: dict = {}
+    for r in sorted(rows, key=lambda r: order.index(r["env_id"]) if r["env_id"] in order else len(order)):
+        key = (r["env_id"], r["observe"], r["mode"], r["substeps"])
+        runs = groups.setdefault(key, {})
+        runs[r["run"]] = r  # a run counted in both parts is one run
+    if not groups:
+        return ""
+    lines = [
+        "Where the training time goes (`agents.timing`: timers around the engine's step, the env's step, the "
+        "policy's forward passes and PPO's update, in every training run above; median share over seeds):",
+        "",
+        "| env | observation | trained in | training time (s) | " + " | ".join(PARTS) + " |",
+        "|---|---|---|---:|" + "---:|" * len(PARTS),
+    ]
+    for (env_id, observe, mode, k), runs in groups.items():
+        rs = list(runs.values())
+        cells = []
+        for part in PARTS:
+            shares = [r["time_split"][part] / r["train_seconds"] for r in rs if r["time_split"][part] is not None]
+            cells.append(_share(statistics.median(shares) if shares else None))
+        lines.append(f"| `{env_id}` | {observe} | {_label(mode, k)} | {_seconds(rs):.0f} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def rule(rows: list, base: list) -> str:
+    """The rule for choosing a training mode, stated with this study's figures."""
+    shares = {
+        env: _engine_share(rs) for (env, observe), rs in _by_preset(rows, base).items() if not rs[0].get("env_kwargs")
+    }
+    shares = {env: f for env, f in shares.items() if f is not None}
+    lines = []
+    for env_id, groups in _by_env_and_mode(rows).items():
+        exact_rows = groups.get(("exact", 1))
+        if not exact_rows:
+            continue
+        ref = statistics.fmean(r["exact"]["success_rate"] for r in exact_rows)
+        f = _engine_share(exact_rows)
+        for (mode, k), rs in groups.items():
+            if (mode, k) == ("exact", 1):
+                continue
+            speed = _seconds(exact_rows) / _seconds(rs)
+            loss = ref - statistics.fmean(r["exact"]["success_rate"] for r in rs)
+            points = round(100 * loss)
+            change = f"loses {points}" if points > 0 else f"gains {-points}" if points < 0 else "loses no"
+            lines.append(
+                f"`{env_id}` ({_share(f)} of exact training in the engine): {_label(mode, k)} trains "
+                f"{speed:.2f}× as fast and {change} points of exact-evaluated success"
+            )
+    if not shares and not lines:
+        return ""
+    text = (
+        "**Rule**: a cheaper engine mode can only save the engine's share of a training run. With the engine at "
+        "a fraction f of the training time, no mode trains more than 1 / (1 − f) times faster (Amdahl's law), "
+        "and a policy trained cheap must still be evaluated exact. So train cheap only where f is large and "
+        "a cheap mode's policies keep their exact-evaluated success over seeds; train exact elsewhere. A short "
+        "exact run tells f: every run's `config.yml` records its time split (`time_split`)."
+    )
+    if shares:
+        text += (
+            " Measured here, in exact mode: "
+            + "; ".join(f"`{env}` f = {_share(f)} (at most {1 / max(1 - f, 1e-9):.1f}×)" for env, f in shares.items())
+            + "."
+        )
+    if lines:
+        text += "\n\n" + "\n".join(f"- {line}." for line in lines)
+    return text
 
 
 def plot(rows: list, path: Path) -> Path | None:
@@ -305,12 +422,16 @@ def render(data: dict, docs: Path, readme: Path | None) -> None:
     )
     modes = modes_table(data["rows"])
     presets = presets_table(data["rows"], data["baselines"])
+    split = split_table(data["rows"])
+    advice = rule(data["rows"], data["baselines"])
     png = plot(data["rows"], docs / "modes.png")
     if modes:
         reading = modes_reading(data["rows"])
         (docs / "modes.md").write_text(f"# Train cheap, evaluate exact\n\n{stamp}\n\n{modes}\n\n{reading}\n")
     if presets:
         (docs / "presets.md").write_text(f"# Every preset against the baselines\n\n{stamp}\n\n{presets}\n")
+    if split:
+        (docs / "time_split.md").write_text(f"# Where the training time goes\n\n{stamp}\n\n{split}\n")
     if readme is not None:
         parts = [stamp]
         if modes:
@@ -322,6 +443,10 @@ def render(data: dict, docs: Path, readme: Path | None) -> None:
             parts.append(f"![success and training time per training mode]({os.path.relpath(png, readme.parent)})")
         if presets:
             parts.append(presets)
+        if split:
+            parts.append(split)
+        if advice:
+            parts.append(advice)
         write_block(readme, README_BLOCK, "\n\n".join(parts))
 
 
@@ -337,6 +462,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--modes", nargs="+", default=list(DEFAULT_MODES), metavar="MODE:K")
     p.add_argument("--presets", nargs="+", help="ids of the presets part (default: every preset)")
     p.add_argument("--seeds", nargs="+", type=int, default=list(DEFAULT_SEEDS))
+    p.add_argument(
+        "--observations",
+        choices=("both", "shipped", "plain"),
+        default="both",
+        help="presets part: the shipped entry, the plain observation beside a predicted one, or both",
+    )
     p.add_argument("--timesteps", type=float, help="override every entry's n_timesteps (quick looks)")
     p.add_argument("--episodes", type=int, default=100)
     p.add_argument("--jobs", type=int, default=1, help="runs trained at once (one core each)")
@@ -344,6 +475,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--docs", default="docs/agents")
     p.add_argument("--readme", help="write the tables into this README's agents:study block")
     p.add_argument("--render", action="store_true", help="only rewrite tables and plot from <docs>/study.json")
+    p.add_argument(
+        "--add", action="store_true", help="add these runs to <docs>/study.json (a cell run again replaces its figures)"
+    )
     return p
 
 
@@ -393,9 +527,7 @@ def main(argv: list[str] | None = None) -> dict:
             for s in seeds
         ]
     if args.part in ("presets", "both"):
-        for env_id in presets:
-            if args.part == "both" and env_id in envs and ("exact", 1) in modes:
-                continue  # the modes part trains this preset in exact mode over the same seeds already
+        for env_id in presets:  # the modes part's exact runs of a preset (same seeds) count here too
             tasks += [
                 {
                     "part": "presets",
@@ -404,9 +536,12 @@ def main(argv: list[str] | None = None) -> dict:
                     "substeps": 1,
                     "seed": s,
                     "timesteps": steps(env_id),
+                    "env_kwargs": kwargs,
                     **common,
                 }
+                for kwargs in variants(env_id, args.observations)
                 for s in seeds
+                if kwargs or not (args.part == "both" and env_id in envs and ("exact", 1) in modes)
             ]
     start = time.perf_counter()
     print(f"{len(tasks)} training runs, {args.jobs} at a time ...")
@@ -421,13 +556,16 @@ def main(argv: list[str] | None = None) -> dict:
     if args.part in ("presets", "both"):
         print("baselines ...")
         base = _run_all(baselines, [{"env_id": e, "episodes": args.episodes} for e in presets], args.jobs, print)
+    minutes = (time.perf_counter() - start) / 60
+    if args.add:
+        rows, base, minutes = _added(docs / "study.json", rows, base, minutes)
     data = {
         "meta": {
             "date": timestamp(),
             "machine": machine(),
             "cpus": cpus(),
             "jobs": args.jobs,
-            "minutes": (time.perf_counter() - start) / 60,
+            "minutes": minutes,
             "versions": versions(["gymnasium", "stable_baselines3", "torch"]),
         },
         "rows": rows,
@@ -439,7 +577,40 @@ def main(argv: list[str] | None = None) -> dict:
     print(modes_table(rows))
     print()
     print(presets_table(rows, base))
+    print()
+    print(split_table(rows))
     return data
+
+
+def variants(env_id: str, which: str = "both") -> list:
+    """The env keywords the presets part trains ``env_id`` with: the shipped entry (``{}``) and, when
+    the entry changes the observation, the plain one too (so both are reported); ``which`` picks
+    ``"shipped"``, ``"plain"`` (none when the entry is plain already) or ``"both"``."""
+    shipped = (hyperparams_for(env_id).get("env_kwargs") or {}).get("observe", "plain")
+    out = [{}] if which in ("both", "shipped") else []
+    if shipped != "plain" and which in ("both", "plain"):
+        out.append({"observe": "plain"})
+    return out
+
+
+def _cell(row: dict) -> tuple:
+    return (row["part"], row["env_id"], row["mode"], row["substeps"], row["seed"], row["observe"])
+
+
+def _added(path: Path, rows: list, base: list, minutes: float) -> tuple:
+    """These runs and baselines added to an earlier study's (``--add``): a cell or preset measured again
+    replaces its earlier figures; the minutes add up."""
+    if not path.is_file():
+        raise UsageError(f"--add: {path} not found: run the study first")
+    try:
+        old = json.loads(path.read_text())
+        new_cells = {_cell(r) for r in rows}
+        new_envs = {b["env_id"] for b in base}
+        rows = [r for r in old["rows"] if _cell(r) not in new_cells] + rows
+        base = [b for b in old["baselines"] if b["env_id"] not in new_envs] + base
+        return rows, base, old["meta"]["minutes"] + minutes
+    except (ValueError, KeyError, TypeError) as err:
+        raise UsageError(f"--add: {path} is not a study result ({type(err).__name__}: {err})") from None
 
 
 if __name__ == "__main__":

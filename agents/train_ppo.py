@@ -14,7 +14,7 @@ The run folder (``--output``/``--run-name``) holds:
 
 | file | what |
 |---|---|
-| ``config.yml`` | the resolved settings: env id and kwargs, hyperparameters, seed, versions, training time |
+| ``config.yml`` | the resolved settings: env id and kwargs, hyperparameters, seed, versions, training time, its split |
 | ``model.zip`` | the final policy (``PPO.load``) |
 | ``vecnormalize.pkl`` | VecNormalize statistics (when the entry normalises) |
 | ``best_model.zip``, ``eval/evaluations.npz`` | EvalCallback's best policy and its evaluation log |
@@ -345,6 +345,10 @@ def train(
         venv.close()
         shutil.rmtree(run_dir)
         raise UsageError(f"PPO rejected the hyperparameters for {env_id}: {err}") from None
+    from agents.timing import time_split
+
+    timer = time_split(venv)
+    callbacks.append(timer)
     log(
         f"training PPO on {env_id} (mode={mode}, substeps={substeps}) for {timesteps:,} steps, "
         f"{n_envs} envs ({vec_env}), seed {seed} -> {run_dir}"
@@ -368,6 +372,7 @@ def train(
     if norm is not None:
         venv.save(str(run_dir / VECNORMALIZE_FILE))
     config["train_seconds"] = round(seconds, 2)
+    config["time_split"] = {k: None if v is None else round(v, 4) for k, v in timer.split(seconds).items()}
     config["timesteps_done"] = int(model.num_timesteps)
     write_yaml(run_dir / CONFIG_FILE, config)
     venv.close()

@@ -1,6 +1,6 @@
 """Render a PNG frame and a short GIF of every preset into docs/img/ (for the README's env table).
 
-    python scripts/render_presets.py [--out docs/img] [--seed 0] [--ppm 100] [--fps 10]
+    python scripts/render_presets.py [--out docs/img] [--seed 0] [--ppm 100] [--fps 10] [--ids ID ...]
 
 Each preset runs one episode under its scripted policy (``collision_env.envs.scripted``, which aims
 with the engine's exact prediction), with trails on. The PNG is the frame just after the first
@@ -58,11 +58,12 @@ def main(argv=None) -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--ppm", type=float, default=100.0, help="pixels per metre")
     parser.add_argument("--fps", type=int, default=10, help="GIF frame rate (the episode runs at 20 steps/s)")
+    parser.add_argument("--ids", nargs="+", default=list(PRESET_IDS.values()), help="presets (default: all)")
     args = parser.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     every = max(1, round(20 / args.fps))
-    for env_id in PRESET_IDS.values():
+    for env_id in args.ids:
         still, frames, info = render_episode(env_id, args.seed, args.ppm, every)
         name = env_id.split("/")[1].removesuffix("-v0").lower()
         iio.imwrite(out / f"{name}.png", still)

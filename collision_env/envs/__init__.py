@@ -15,6 +15,7 @@ from collision_env.envs.line_1d import Line1DEnv, Line1DVectorEnv
 from collision_env.envs.billiards import BilliardsEnv, BilliardsVectorEnv
 from collision_env.envs.inelastic_cluster import InelasticClusterEnv, InelasticClusterVectorEnv
 from collision_env.envs.multi_ball import MultiBallEnv, MultiBallVectorEnv
+from collision_env.envs.crowd import CrowdEnv, CrowdVectorEnv
 from collision_env.envs.registry import PRESET_IDS, REGISTERED, Task, register_env, register_task
 from collision_env.envs.target_env import CollisionTargetEnv
 from collision_env.envs.vector import CollisionTargetVectorEnv
@@ -37,6 +38,8 @@ __all__ = [
     "BilliardsVectorEnv",
     "CollisionTargetEnv",
     "CollisionTargetVectorEnv",
+    "CrowdEnv",
+    "CrowdVectorEnv",
     "Impacts",
     "InelasticClusterEnv",
     "InelasticClusterVectorEnv",

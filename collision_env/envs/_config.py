@@ -18,8 +18,11 @@ import numpy as np
 
 from collision_env.engine import MODES
 from collision_env.engine.scene import PLAY_AREA_1D, PLAY_AREA_2D, WALL_NAMES, radius_from_mass
-from collision_env.envs._layout import BALL_OBS, GLOBAL_OBS, TARGET_OBS
+from collision_env.envs._layout import BALL_OBS, GLOBAL_OBS, PREDICTED_OBS, TARGET_OBS
 
+OBSERVATIONS = ("plain", "predicted")
+OBSERVED_BALLS = ("all", "controlled")
+AIMS = ("straight", "predicted")
 SCORERS = ("any", "controlled", "others", "cluster")
 LAYOUTS = ("random", "rack")
 RADIUS_RULES = ("mass", "constant")
@@ -28,6 +31,7 @@ RADIUS_RULES = ("mass", "constant")
 BALL_FEATURES = len(BALL_OBS)
 TARGET_FEATURES = len(TARGET_OBS)
 GLOBAL_FEATURES = len(GLOBAL_OBS)
+PREDICTED_FEATURES = len(PREDICTED_OBS)
 
 
 def _pair(name, value, *, low=None, allow_equal=True):
@@ -71,7 +75,8 @@ class TaskConfig:
         ``dimension`` (1 or 2), ``bounds`` ((xmin, ymin, xmax, ymax); ``None`` = PhET's play area for
         the dimension), ``elasticity`` (0..1), ``inelastic`` ("slip" | "stick"), ``ball_collisions``.
     Balls:
-        ``n_balls``; ``mass_range`` (each ball's mass uniform in it, kg); ``radius`` ("mass" = PhET's
+        ``n_balls``; ``mass_range`` (each ball's mass uniform in it, kg); ``others_mass_range`` (the
+        range of the balls that are not controlled; ``None``: ``mass_range``); ``radius`` ("mass" = PhET's
         density rule, "constant" = PhET's 0.15 m, or a number in metres); ``layout`` ("random":
         anywhere without overlap, left-to-right by index in 1D; "rack": controlled balls in the left
         40 %, the others in the right half); ``speed_range`` / ``others_speed_range`` (initial speed
@@ -89,7 +94,15 @@ class TaskConfig:
     Reward:
         ``hit_reward`` per target hit, ``success_bonus`` when all are hit, ``miss_penalty`` per wall
         impact of a scoring ball that hits no target, ``action_cost`` per m/s of requested nudge,
-        ``shaping`` (weight of the potential-based aiming term, see the docs).
+        ``shaping`` (weight of the potential-based aiming term, see the docs); ``aim`` (where the aiming
+        term takes each scoring ball's next wall contact from: "straight", flying straight on, a
+        heuristic that ignores other balls; "predicted", the engine's prediction, as for ``observe``).
+    Observation:
+        ``observed_balls`` ("all": a block per ball; "controlled": the controlled balls' blocks only,
+        for scenes of many balls that the agent does not steer); ``observe`` ("plain": balls, targets
+        and the globals; "predicted": also, per observed ball, its next wall impact as the engine
+        predicts it with no further nudge, found by running a copy of the engine ``lookahead`` s
+        ahead at every step: contact point, time, and whether it hits a target).
     Episode:
         ``time_limit`` (s of simulated time; the env truncates after round(time_limit / dt) steps).
     Engine:
@@ -104,6 +117,7 @@ class TaskConfig:
     ball_collisions: bool = True
     n_balls: int = 1
     mass_range: tuple = (1.0, 1.0)
+    others_mass_range: tuple | None = None
     radius: object = "mass"
     layout: str = "random"
     speed_range: tuple = (0.3, 0.8)
@@ -123,6 +137,10 @@ class TaskConfig:
     miss_penalty: float = 0.05
     action_cost: float = 0.02
     shaping: float = 0.0
+    aim: str = "straight"
+    observed_balls: str = "all"
+    observe: str = "plain"
+    lookahead: float = 5.0
     time_limit: float = 10.0
     mode: str = "exact"
     substeps: int = 1
@@ -156,6 +174,11 @@ class TaskConfig:
         s("mass_range", _pair("mass_range", self.mass_range))
         if self.mass_range[0] <= 0:
             raise ValueError(f"mass_range: masses must be > 0, got {self.mass_range!r}")
+        if self.others_mass_range is None:
+            s("others_mass_range", self.mass_range)
+        s("others_mass_range", _pair("others_mass_range", self.others_mass_range))
+        if self.others_mass_range[0] <= 0:
+            raise ValueError(f"others_mass_range: masses must be > 0, got {self.others_mass_range!r}")
         if isinstance(self.radius, str):
             if self.radius not in RADIUS_RULES:
                 raise ValueError(f"radius: expected 'mass', 'constant' or a positive number, got {self.radius!r}")
@@ -204,6 +227,13 @@ class TaskConfig:
             raise ValueError("scorers: 'cluster' needs at least 2 balls")
         for name in ("hit_reward", "success_bonus", "miss_penalty", "action_cost", "shaping"):
             s(name, _number(name, getattr(self, name)))
+        if self.observed_balls not in OBSERVED_BALLS:
+            raise ValueError(f"observed_balls: expected one of {OBSERVED_BALLS}, got {self.observed_balls!r}")
+        if self.aim not in AIMS:
+            raise ValueError(f"aim: expected one of {AIMS}, got {self.aim!r}")
+        if self.observe not in OBSERVATIONS:
+            raise ValueError(f"observe: expected one of {OBSERVATIONS}, got {self.observe!r}")
+        s("lookahead", _number("lookahead", self.lookahead, low=0.0, strict_low=True))
         s("time_limit", _number("time_limit", self.time_limit, low=0.0, strict_low=True))
         if self.time_limit < self.dt:
             raise ValueError(f"time_limit: must be at least one control step dt={self.dt}, got {self.time_limit}")
@@ -217,9 +247,8 @@ class TaskConfig:
         s("max_events", _number("max_events", self.max_events, low=1, integer=True))
         s("n_steps", max(1, int(round(self.time_limit / self.dt))))
         # geometric feasibility: every ball must fit, and the balls must be placeable
-        r_max = float(self.radius_of(np.array([self.mass_range[1]]))[0])
-        r_min = float(self.radius_of(np.array([self.mass_range[0]]))[0])
-        r_big = max(r_max, r_min)
+        extremes = np.array([*self.mass_range, *self.others_mass_range])
+        r_big = float(self.radius_of(extremes).max())
         if 2 * r_big >= min(b[2] - b[0], b[3] - b[1]):
             raise ValueError(f"radius: a ball of radius {r_big:.4g} m does not fit in bounds {b}")
         if self.dimension == 1:
@@ -250,7 +279,23 @@ class TaskConfig:
 
     @property
     def obs_dim(self) -> int:
-        return self.n_balls * BALL_FEATURES + self.target_slots * TARGET_FEATURES + GLOBAL_FEATURES
+        shown = self.n_observed
+        plain = shown * BALL_FEATURES + self.target_slots * TARGET_FEATURES + GLOBAL_FEATURES
+        return plain + (shown * PREDICTED_FEATURES if self.observe == "predicted" else 0)
+
+    @property
+    def shown_mask(self) -> np.ndarray:
+        """(n_balls,) bool: the balls that have a block in the observation (``observed_balls``)."""
+        if self.observed_balls == "all":
+            return np.ones(self.n_balls, dtype=bool)
+        mask = np.zeros(self.n_balls, dtype=bool)
+        mask[list(self.controlled)] = True
+        return mask
+
+    @property
+    def n_observed(self) -> int:
+        """Number of ball blocks in the observation."""
+        return self.n_balls if self.observed_balls == "all" else len(self.controlled)
 
     @property
     def scoring_mask(self) -> np.ndarray:

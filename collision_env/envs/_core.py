@@ -9,6 +9,8 @@ nudges and the engine's impact records into hits, reward and observations (see `
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from collision_env.engine.scene import WALL_NAMES
@@ -181,7 +183,8 @@ class EpisodeSampler:
     def _build(self, U: np.ndarray) -> tuple:
         cfg = self.cfg
         r, n, k = U.shape[0], cfg.n_balls, cfg.n_targets
-        lo, hi = cfg.mass_range
+        lo = np.where(self.ctrl_mask, cfg.mass_range[0], cfg.others_mass_range[0])
+        hi = np.where(self.ctrl_mask, cfg.mass_range[1], cfg.others_mass_range[1])
         masses = lo + (hi - lo) * U[:, :n]
         radii = cfg.radius_of(masses)
         pos = np.zeros((r, n, 2))
@@ -270,9 +273,12 @@ class TaskCore:
             dimension=cfg.dimension,
             n_steps=cfg.n_steps,
             sticky=int(self.scene.sticky),
+            observe_predicted=int(cfg.observe == "predicted"),
+            aim_predicted=int(cfg.aim == "predicted" and cfg.shaping != 0.0),
         )
         self.ctrl = np.array(cfg.controlled, dtype=np.int64)
         self.qual = cfg.scoring_mask
+        self.shown = cfg.shown_mask
         self.obs_dim = cfg.obs_dim
         self.action_dim = cfg.action_dim
 
@@ -289,18 +295,30 @@ class TaskCore:
         self.sampler = EpisodeSampler(cfg)
         ep = self.sampler.sample([np.random.default_rng(0)])
         rep = lambda a: np.repeat(a, B, 0)  # noqa: E731
-        self.batch = BatchSimulator(
-            self.scene,
-            rep(ep.positions),
-            rep(ep.velocities),
-            rep(ep.masses),
-            radii=rep(ep.radii),
-            mode=cfg.mode,
-            substeps=cfg.substeps,
-            max_events=cfg.max_events,
-        )
+
+        def engine(substeps):
+            return BatchSimulator(
+                self.scene,
+                rep(ep.positions),
+                rep(ep.velocities),
+                rep(ep.masses),
+                radii=rep(ep.radii),
+                mode=cfg.mode,
+                substeps=substeps,
+                max_events=cfg.max_events,
+            )
+
+        self.batch = engine(cfg.substeps)
         self._write_episode(np.arange(B), Episodes(*(rep(getattr(ep, f)) for f in Episodes.__slots__)))
         self.impact_dtype = IMPACT_DTYPE
+        # observe="predicted": a second engine of the same mode, loaded with the scenes' state and run
+        # ahead at every observation (scratch: it holds no state of the task between calls). The cheap
+        # modes keep their sub-step length: the look-ahead takes as many sub-steps as the control steps
+        # it spans would.
+        self.ahead = None
+        if cfg.observe == "predicted" or self.Q[SWITCHES.aim_predicted]:
+            self.ahead = engine(1 if cfg.mode == "exact" else cfg.substeps * max(1, round(cfg.lookahead / cfg.dt)))
+        self._ahead_body = np.zeros((B, N), dtype=np.int64)
 
     # views into the packed state (writable: they share memory with it)
     t_wall = property(lambda self: self.T[..., TARGET_INTS.wall], doc="(B, K) target walls (engine wall codes).")
@@ -380,11 +398,42 @@ class TaskCore:
             self.t_geo,
             self.body,
             self.qual,
+            self.shown,
             self.P,
             self.Q,
             obs,
         )
+        if self.ahead is not None:
+            self._predict(flags, obs)
         return obs
+
+    def _predict(self, flags: np.ndarray, obs: np.ndarray) -> None:
+        """Run a copy of the engine ``lookahead`` s ahead of every scene (no nudge): each ball's
+        predicted next wall impact goes into the observation and/or the aiming potential
+        (``_kernels.predict_kernel``)."""
+        from collision_env.engine import EventCapWarning
+
+        live = self.batch.live_arrays()
+        self.ahead.set_state(self.batch.get_state())
+        with warnings.catch_warnings():  # a capped look-ahead only predicts less far
+            warnings.simplefilter("ignore", EventCapWarning)
+            imp = self.ahead.step(self.cfg.lookahead)
+        K.predict_kernel(
+            flags,
+            imp,
+            live.time,
+            live.clusters,
+            self._ahead_body,
+            self.S,
+            self.C,
+            self.T,
+            self.t_geo,
+            self.qual,
+            self.shown,
+            self.P,
+            self.Q,
+            obs,
+        )
 
     def outputs(self) -> tuple:
         """Fresh ``(reward, terminated, truncated, success, targets_hit, energy, nudge)`` arrays (B,)."""

@@ -27,6 +27,7 @@ from collision_env.envs._layout import (
     EPISODE_INTS,
     GLOBAL_OBS,
     PARAMS,
+    PREDICTED_OBS,
     ROW_OBSERVE,
     ROW_RESET,
     ROW_SKIP,
@@ -153,6 +154,40 @@ def _visible_targets(current, n_targets, seq):  # pragma: no cover - numba
 
 
 @njit(inline="always")
+def _merge(body, b, i, o):  # pragma: no cover - numba
+    """Ball-ball impact in a stick scene: the two clusters become one, under the smaller root."""
+    root = min(body[b, i], body[b, o])
+    gone = max(body[b, i], body[b, o])
+    for q in range(body.shape[1]):
+        if body[b, q] == gone:
+            body[b, q] = root
+
+
+@njit(inline="always")
+def _split(body, b, i):  # pragma: no cover - numba
+    """Wall impact in a stick scene: the cluster of ball i stops and comes apart."""
+    root = body[b, i]
+    for q in range(body.shape[1]):
+        if body[b, q] == root:
+            body[b, q] = q
+
+
+@njit(inline="always")
+def _target_at(T, t_geo, b, k0, k1, w, along, t):  # pragma: no cover - numba
+    """The first pending target among k0..k1-1 of scene b that a wall-w impact at ``along``, time t, hits; or -1."""
+    for k in range(k0, k1):
+        if (
+            T[b, k, TI.status] == TARGET_PENDING
+            and T[b, k, TI.wall] == w
+            and abs(along - t_geo[b, k, TG.centre]) <= t_geo[b, k, TG.half_width]
+            and t_geo[b, k, TG.opens] <= t
+            and t <= t_geo[b, k, TG.closes]
+        ):
+            return k
+    return -1
+
+
+@njit(inline="always")
 def _score_impacts(flags, imp, C, T, t_geo, body, qual, seq, cluster):  # pragma: no cover - numba
     """Count each stepped scene's target hits and off-target wall impacts of scoring balls.
 
@@ -161,7 +196,6 @@ def _score_impacts(flags, imp, C, T, t_geo, body, qual, seq, cluster):  # pragma
     cluster and takes it apart, as the engine does), so that a wall impact scores only if its ball
     was part of a cluster at that instant.
     """
-    N = body.shape[1]
     for b in range(flags.shape[0]):
         C[b, SI.hits] = 0
         C[b, SI.misses] = 0
@@ -174,39 +208,21 @@ def _score_impacts(flags, imp, C, T, t_geo, body, qual, seq, cluster):  # pragma
         if w < 0:
             o = imp[j]["other"]
             if cluster and o >= 0:
-                root = min(body[b, i], body[b, o])
-                gone = max(body[b, i], body[b, o])
-                for q in range(N):
-                    if body[b, q] == gone:
-                        body[b, q] = root
+                _merge(body, b, i, o)
             continue
         scores = qual[i]
         if cluster:
             scores = scores and _in_cluster(body, b, i)
-            root = body[b, i]
-            for q in range(N):
-                if body[b, q] == root:
-                    body[b, q] = q
+            _split(body, b, i)
         if not scores:
             continue
         along = imp[j]["y"] if _on_side_wall(w) else imp[j]["x"]
-        t = imp[j]["time"]
-        hit = False
         k0, k1 = _visible_targets(C[b, SI.current], T.shape[1], seq)
-        for k in range(k0, k1):
-            if (
-                T[b, k, TI.status] == TARGET_PENDING
-                and T[b, k, TI.wall] == w
-                and abs(along - t_geo[b, k, TG.centre]) <= t_geo[b, k, TG.half_width]
-                and t_geo[b, k, TG.opens] <= t
-                and t <= t_geo[b, k, TG.closes]
-            ):
-                T[b, k, TI.status] = TARGET_HIT
-                hit = True
-                if seq:
-                    C[b, SI.current] += 1
-                break
-        if hit:
+        k = _target_at(T, t_geo, b, k0, k1, w, along, imp[j]["time"])
+        if k >= 0:
+            T[b, k, TI.status] = TARGET_HIT
+            if seq:
+                C[b, SI.current] += 1
             C[b, SI.hits] += 1
         else:
             C[b, SI.misses] += 1
@@ -251,9 +267,9 @@ def _observed_point(wall, centre, xc, yc, xh, yh):  # pragma: no cover - numba
 
 @njit(inline="always")
 def _observe(
-    flags, obs, S, pos, vel, masses, body, qual, C, T, t_geo, sim_time, seq, cluster, n_steps, P
+    flags, obs, S, pos, vel, masses, body, qual, shown, C, T, t_geo, sim_time, seq, cluster, n_steps, P
 ):  # pragma: no cover - numba
-    """Write the observation (ball blocks, target slots, globals) and the kinetic energy."""
+    """Write the observation (the ``shown`` balls' blocks, target slots, globals) and the kinetic energy."""
     xc, yc, xh, yh = _centre_and_half_size(P)
     vscale = P[PARAMS.vscale]
     mscale = P[PARAMS.mscale]
@@ -269,6 +285,8 @@ def _observe(
             vx = vel[b, i, 0]
             vy = vel[b, i, 1]
             ke += 0.5 * masses[b, i] * (vx * vx + vy * vy)
+            if not shown[i]:
+                continue
             obs[b, o + BALL_OBS.x] = _clip1((pos[b, i, 0] - xc) / xh)
             obs[b, o + BALL_OBS.y] = _clip1((pos[b, i, 1] - yc) / yh)
             obs[b, o + BALL_OBS.vx] = _clip1(vx / vscale)
@@ -345,7 +363,29 @@ def _distance_to_target(cx, cy, wall, centre, hw, xmin, ymin, xmax, ymax):  # pr
 
 
 @njit(inline="always")
-def _settle(flags, S, C, T, t_geo, pos, vel, radii, body, qual, seq, cluster, n_steps, P):  # pragma: no cover
+def _aim_distance(cx, cy, b, C, T, t_geo, seq, P):  # pragma: no cover - numba
+    """Distance from a wall point (cx, cy) to the nearest visible pending target of scene b (inf if none)."""
+    best = math.inf
+    k0, k1 = _visible_targets(C[b, SI.current], T.shape[1], seq)
+    for k in range(k0, k1):
+        if T[b, k, TI.status] == TARGET_PENDING:
+            d = _distance_to_target(
+                cx,
+                cy,
+                T[b, k, TI.wall],
+                t_geo[b, k, TG.centre],
+                t_geo[b, k, TG.half_width],
+                P[PARAMS.xmin],
+                P[PARAMS.ymin],
+                P[PARAMS.xmax],
+                P[PARAMS.ymax],
+            )
+            best = min(best, d)
+    return best
+
+
+@njit(inline="always")
+def _settle(flags, S, C, T, t_geo, pos, vel, radii, body, qual, seq, cluster, n_steps, P, Q):  # pragma: no cover
     """Reward and end flags of each stepped scene (zero and False for a reset or observed one), and
     the aiming potential phi kept for the next step (unless the scene was only observed).
 
@@ -358,7 +398,10 @@ def _settle(flags, S, C, T, t_geo, pos, vel, radii, body, qual, seq, cluster, n_
     xmax = P[PARAMS.xmax]
     ymax = P[PARAMS.ymax]
     diag = math.sqrt((xmax - xmin) ** 2 + (ymax - ymin) ** 2)
-    shaping = P[PARAMS.shaping] != 0.0  # the aiming potential is only computed when it is used
+    # the straight-line aiming potential is only computed when it is used (predict_kernel computes
+    # the predicted one)
+    straight = Q[SWITCHES.aim_predicted] == 0
+    shaping = P[PARAMS.shaping] != 0.0 and straight
     K = T.shape[1]
     for b in range(flags.shape[0]):
         f = flags[b]
@@ -373,26 +416,7 @@ def _settle(flags, S, C, T, t_geo, pos, vel, radii, body, qual, seq, cluster, n_
             if vx == 0.0 and vy == 0.0:
                 continue
             cx, cy = _border_contact(pos[b, i, 0], pos[b, i, 1], vx, vy, radii[b, i], xmin, ymin, xmax, ymax)
-            k0, k1 = _visible_targets(C[b, SI.current], K, seq)
-            for k in range(k0, k1):
-                if T[b, k, TI.status] != TARGET_PENDING:
-                    continue
-                d = (
-                    _distance_to_target(
-                        cx,
-                        cy,
-                        T[b, k, TI.wall],
-                        t_geo[b, k, TG.centre],
-                        t_geo[b, k, TG.half_width],
-                        xmin,
-                        ymin,
-                        xmax,
-                        ymax,
-                    )
-                    / diag
-                )
-                if d < best:
-                    best = d
+            best = min(best, _aim_distance(cx, cy, b, C, T, t_geo, seq, P) / diag)
         phi_new = -best
 
         if f == ROW_STEPPED:
@@ -409,7 +433,7 @@ def _settle(flags, S, C, T, t_geo, pos, vel, radii, body, qual, seq, cluster, n_
             )
             if done_ok:
                 rew += P[PARAMS.success_bonus]
-            if hits == 0:
+            if hits == 0 and straight:
                 rew += P[PARAMS.shaping] * (phi_new - S[b, SF.phi])
             S[b, SF.reward] = rew
             C[b, SI.terminated] = done_ok or failed
@@ -420,13 +444,13 @@ def _settle(flags, S, C, T, t_geo, pos, vel, radii, body, qual, seq, cluster, n_
             C[b, SI.terminated] = False
             C[b, SI.truncated] = False
             C[b, SI.success] = False
-        if f != ROW_OBSERVE:
+        if f != ROW_OBSERVE and straight:
             S[b, SF.phi] = phi_new
 
 
 @njit(refcount=False)
 def task_kernel(
-    flags, imp, balls, sim_time, clusters, S, C, T, t_geo, body, qual, P, Q, obs
+    flags, imp, balls, sim_time, clusters, S, C, T, t_geo, body, qual, shown, P, Q, obs
 ):  # pragma: no cover - numba
     """Score a step's impacts, update target state, and write reward, flags and observation.
 
@@ -437,6 +461,7 @@ def task_kernel(
     ``_score_impacts``); at the end it is set to the engine's ``clusters``.
     Updated in place: target status, current target, step count, body, phi. Written for rows
     whose flag is not ``ROW_SKIP``: the observation, reward, energy, targets hit and the end flags.
+    ``shown`` (N,) says whose ball blocks the observation has (``TaskConfig.observed_balls``).
     """
     pos, vel, masses, _, radii, _ = ball_views(balls)  # (always a C array: one compiled version for any B, N)
     seq = Q[SWITCHES.sequential] != 0
@@ -444,8 +469,100 @@ def task_kernel(
     n_steps = Q[SWITCHES.n_steps]
     _score_impacts(flags, imp, C, T, t_geo, body, qual, seq, cluster)
     _advance_episodes(flags, sim_time, clusters, C, T, t_geo, body, cluster)
-    _observe(flags, obs, S, pos, vel, masses, body, qual, C, T, t_geo, sim_time, seq, cluster, n_steps, P)
-    _settle(flags, S, C, T, t_geo, pos, vel, radii, body, qual, seq, cluster, n_steps, P)
+    _observe(flags, obs, S, pos, vel, masses, body, qual, shown, C, T, t_geo, sim_time, seq, cluster, n_steps, P)
+    _settle(flags, S, C, T, t_geo, pos, vel, radii, body, qual, seq, cluster, n_steps, P, Q)
+
+
+# --------------------------------------------------------------------------------------------- #
+# the engine's prediction (observe="predicted")
+
+
+@njit
+def predict_kernel(flags, imp, sim_time, clusters, body, S, C, T, t_geo, qual, shown, P, Q, obs):  # pragma: no cover
+    """Each ball's predicted next wall impact: written into the observation's last entries, one
+    ``PREDICTED_OBS`` block per ``shown`` ball (``observe_predicted``), and made the aiming potential
+    (``aim_predicted``), for the rows whose flag is not ``ROW_SKIP``.
+
+    ``imp`` are the impacts of a copy of the engine run ahead from the scenes' current state with no
+    nudge (sorted by scene then time); ``sim_time`` is the scenes' current time and ``clusters``
+    their cluster roots, from which ``body`` (scratch, (B, N)) replays the clusters through the
+    look-ahead as the task kernel does. A ball's entry is its first wall impact: the contact point,
+    the time until it over ``time_limit``, and whether it would score on a visible pending target
+    (target status as the task kernel left it, so a target hit this step no longer counts).
+    With ``aim_predicted``, phi is minus the distance, over the play-area diagonal, from the nearest
+    of the scoring balls' predicted impact points to a visible pending target (-1 when none is
+    predicted): the task kernel's shaping term, computed here with the engine's prediction instead of
+    straight flight, added to the reward of stepped scenes without a hit.
+    """
+    xc, yc, xh, yh = _centre_and_half_size(P)
+    diag = 2.0 * math.sqrt(xh * xh + yh * yh)
+    tlimit = P[PARAMS.time_limit]
+    seq = Q[SWITCHES.sequential] != 0
+    cluster = Q[SWITCHES.cluster] != 0
+    observe = Q[SWITCHES.observe_predicted] != 0
+    aim = Q[SWITCHES.aim_predicted] != 0
+    N = body.shape[1]
+    block = np.full(N, -1)  # the observation entry where each shown ball's block starts
+    n_shown = 0
+    for i in range(N):
+        if shown[i]:
+            n_shown += 1
+    o = obs.shape[1] - n_shown * len(PREDICTED_OBS)
+    for i in range(N):
+        if shown[i]:
+            block[i] = o
+            o += len(PREDICTED_OBS)
+    seen = np.zeros(body.shape, dtype=np.bool_)
+    best = np.ones(body.shape[0])
+    for b in range(flags.shape[0]):
+        if flags[b] == ROW_SKIP:
+            continue
+        for i in range(N):
+            body[b, i] = clusters[b, i]
+            if observe and shown[i]:
+                o = block[i]
+                obs[b, o + PREDICTED_OBS.x] = 0.0
+                obs[b, o + PREDICTED_OBS.y] = 0.0
+                obs[b, o + PREDICTED_OBS.time] = 1.0
+                obs[b, o + PREDICTED_OBS.hits] = 0.0
+    for j in range(imp.shape[0]):
+        b = imp[j]["scene"]
+        if flags[b] == ROW_SKIP:
+            continue
+        i = imp[j]["ball"]
+        w = imp[j]["wall"]
+        if w < 0:
+            o = imp[j]["other"]
+            if cluster and o >= 0:
+                _merge(body, b, i, o)
+            continue
+        scores = qual[i] and (not cluster or _in_cluster(body, b, i))
+        if cluster:
+            _split(body, b, i)
+        if seen[b, i]:
+            continue
+        seen[b, i] = True
+        x = imp[j]["x"]
+        y = imp[j]["y"]
+        t = imp[j]["time"]
+        if aim and scores:
+            best[b] = min(best[b], _aim_distance(x, y, b, C, T, t_geo, seq, P) / diag)
+        if observe and shown[i]:
+            o = block[i]
+            obs[b, o + PREDICTED_OBS.x] = _clip1((x - xc) / xh)
+            obs[b, o + PREDICTED_OBS.y] = _clip1((y - yc) / yh)
+            obs[b, o + PREDICTED_OBS.time] = _clip1((t - sim_time[b]) / tlimit)
+            if scores:
+                k0, k1 = _visible_targets(C[b, SI.current], T.shape[1], seq)
+                if _target_at(T, t_geo, b, k0, k1, w, y if _on_side_wall(w) else x, t) >= 0:
+                    obs[b, o + PREDICTED_OBS.hits] = 1.0
+    if aim:
+        for b in range(flags.shape[0]):
+            f = flags[b]
+            if f == ROW_STEPPED and C[b, SI.hits] == 0:
+                S[b, SF.reward] += P[PARAMS.shaping] * (-best[b] - S[b, SF.phi])
+            if f == ROW_STEPPED or f == ROW_RESET:
+                S[b, SF.phi] = -best[b]
 
 
 # --------------------------------------------------------------------------------------------- #

@@ -63,6 +63,8 @@ SWITCHES = layout(
         ("dimension", "1 or 2"),
         ("n_steps", "control steps per episode"),
         ("sticky", "1: the engine merges colliding balls (the nudge moves whole clusters)"),
+        ("observe_predicted", "1: the observation ends with the engine's predicted impacts"),
+        ("aim_predicted", "1: the aiming potential phi uses the engine's predicted impacts"),
     ),
 )
 
@@ -177,6 +179,18 @@ GLOBAL_OBS = layout(
 )
 
 
+#: One ball's block of the engine's prediction (``TaskConfig.observe = "predicted"``), after the globals:
+#: the scene is run ahead ``lookahead`` seconds on a copy of the engine with no further nudge.
+PREDICTED_OBS = layout(
+    "PredictedObs",
+    (
+        ("x y", "ball i's predicted next wall impact (no more nudges), normalised like positions"),
+        ("time", "time until it / time_limit (1, and point 0, 0: none within the lookahead)"),
+        ("hits", "1 if it lands on a visible pending target inside its window, else 0"),
+    ),
+)
+
+
 def _index_label(base: str, first: int, last: int) -> str:
     if first == last:
         return f"{base}{first}"
@@ -184,11 +198,17 @@ def _index_label(base: str, first: int, last: int) -> str:
 
 
 def observation_table() -> str:
-    """The generic env's observation table (Markdown), generated from the observation layouts."""
+    """The generic env's observation table (Markdown), generated from the observation layouts.
+
+    N balls, S target slots; ``observe="predicted"`` appends one ``PREDICTED_OBS`` block per ball
+    after the globals.
+    """
     nb, nt, ng = len(BALL_OBS), len(TARGET_OBS), len(GLOBAL_OBS)
     rows = [(_index_label(f"{nb}i + ", a, b), m) for a, b, m in rows_of(BALL_OBS)]
     rows += [(_index_label(f"{nb}N + {nt}s + ", a, b), m) for a, b, m in rows_of(TARGET_OBS)]
-    rows += [(f"D - {ng - a}", m) for a, _, m in rows_of(GLOBAL_OBS)]
+    rows += [(_index_label(f"{nb}N + {nt}S + ", a, b), m) for a, b, m in rows_of(GLOBAL_OBS)]
+    npred = len(PREDICTED_OBS)
+    rows += [(_index_label(f"{nb}N + {nt}S + {ng} + {npred}i + ", a, b), m) for a, b, m in rows_of(PREDICTED_OBS)]
     wide = max(len("Index"), *(len(i) for i, _ in rows))
     text = max(len("Observation"), *(len(m) for _, m in rows))
     lines = [f"| {'Index':<{wide}} | {'Observation':<{text}} |", f"|{'-' * (wide + 2)}|{'-' * (text + 2)}|"]

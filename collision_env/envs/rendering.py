@@ -4,8 +4,10 @@ A frame shows the play area, the targets on the walls (pending in amber, waiting
 window in dim amber, hit in green, failed in grey), the balls (controlled ones ringed in white,
 balls whose impacts score marked with a dot, stuck clusters joined by a bar) with velocity arrows,
 a flash at the exact contact point of every impact (green on a target, red elsewhere on a wall,
-white between balls) and, optionally, ball trails. A bar on top shows the time used, the time
-windows and the targets. ``rgb_array`` frames are ``(H, W, 3)`` uint8; ``human`` opens a window.
+white between balls) and, optionally, ball trails. In a crowd (more than ``CROWD`` balls) only the
+controlled and scoring balls get arrows, trails and flashes; the others are drawn as a plain gas.
+A bar on top shows the time used, the time windows and the targets. ``rgb_array`` frames are
+``(H, W, 3)`` uint8; ``human`` opens a window.
 """
 
 from __future__ import annotations
@@ -18,6 +20,8 @@ import numpy as np
 from collision_env.engine.scene import WALL_BOTTOM, WALL_LEFT, WALL_RIGHT
 from collision_env.envs._layout import TARGET_FAILED, TARGET_GEOMETRY, TARGET_HIT, TARGET_PENDING
 
+#: Above this many balls, balls that are neither controlled nor scoring are drawn plain (a gas).
+CROWD = 16
 BG = (18, 22, 34)
 AREA = (30, 37, 56)
 WALL = (200, 204, 214)
@@ -87,7 +91,8 @@ class Renderer:
             self._trail.append(core.pos[b].copy())
             del self._trail[: -self.trail_length]
         for r in imp[imp["scene"] == b] if len(imp) else ():
-            self._flashes.append((float(r["time"]), float(r["x"]), float(r["y"]), int(r["wall"]), int(r["ball"])))
+            balls = (int(r["ball"]), int(r["other"]))
+            self._flashes.append((float(r["time"]), float(r["x"]), float(r["y"]), int(r["wall"]), balls))
         now = float(core.time[b])
         self._flashes = [f for f in self._flashes if now - f[0] <= FLASH_LIFE]
 
@@ -147,18 +152,22 @@ class Renderer:
             a, e = self._segment_px(int(core.t_wall[b, k]), c, hw)
             pg.draw.line(surf, col, a, e, 8)
 
+        pos, vel, radii = core.pos[b], core.vel[b], core.radii[b]
+        n = pos.shape[0]
+        featured = [n <= CROWD or i in cfg.controlled or bool(core.qual[i]) for i in range(n)]
+
         # trails
         if self.trails and len(self._trail) > 1:
             pts = np.array(self._trail)
             for i in range(pts.shape[1]):
+                if not featured[i]:
+                    continue
                 col = CONTROLLED if i in cfg.controlled else PALETTE[i % len(PALETTE)]
                 for j in range(1, len(pts)):
                     f = 0.15 + 0.5 * j / len(pts)
                     pg.draw.line(surf, _fade(col, f), self._px(*pts[j - 1, i]), self._px(*pts[j, i]), 2)
 
         # clusters (stick scenes): a bar between stuck balls
-        pos, vel, radii = core.pos[b], core.vel[b], core.radii[b]
-        n = pos.shape[0]
         body = core.body[b]
         for i in range(n):
             for j in range(i + 1, n):
@@ -186,7 +195,7 @@ class Renderer:
         for i in range(n):  # velocity arrows on top
             vx, vy = vel[i]
             speed = math.hypot(vx, vy)
-            if speed < 1e-9:
+            if speed < 1e-9 or not featured[i]:
                 continue
             L = 0.5 * speed * self.ppm  # where the ball will be in 0.5 s
             ux, uy = vx / speed, -vy / speed
@@ -199,9 +208,9 @@ class Renderer:
             pg.draw.polygon(surf, ARROW, [tip, left, right])
 
         # impact flashes at the exact contact points
-        for t, x, y, wall, _ball in self._flashes:
+        for t, x, y, wall, balls in self._flashes:
             age = now - t
-            if age < 0 or age > FLASH_LIFE:
+            if age < 0 or age > FLASH_LIFE or not any(i >= 0 and featured[i] for i in balls):
                 continue
             f = 1.0 - age / FLASH_LIFE
             if wall < 0:

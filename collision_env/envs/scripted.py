@@ -3,6 +3,8 @@
 * :class:`AimingPolicy` (controlled balls with nothing but walls in the way): each step it asks a copy
   of the engine (``BatchSimulator.copy()`` then ``step``) where each ball's next wall impact will land;
   if not on a target, it searches directions the same way and steers towards one that is.
+* :class:`SteeringPolicy` (one controlled ball among balls it does not control, such as ``Crowd``):
+  it steers at the target and coasts when a copy of the engine predicts a hit.
 * :class:`ShootingPolicy` (any preset): candidate plans (action sequences) are run ahead on a
   planning copy of the env (``copy.deepcopy``, no renderer) from the env's current state
   (``get_state``/``set_state``); the first whose predicted rollout hits a target is executed.
@@ -106,6 +108,33 @@ class AimingPolicy:
                 self.want[i] = want
             if want is not None:
                 action[2 * j : 2 * j + 2] = np.clip((want - v) / cfg.max_dv, -1, 1)
+        return action
+
+
+class SteeringPolicy(AimingPolicy):
+    """Steer the controlled ball straight at the current target's centre, at ``speed``, and coast
+    whenever the engine predicts that its next wall impact lands on the target.
+
+    For a controlled ball among balls it cannot steer (``Crowd``): they knock it off any aim it
+    takes, so it re-aims at every step rather than searching for a shot, and only one prediction
+    (a copy of the engine run ``lookahead`` s ahead) is made per step.
+    """
+
+    def __call__(self, obs=None) -> np.ndarray:
+        core, cfg = self.env.core, self.env.config
+        action = np.zeros(len(cfg.controlled) * 2, np.float32)
+        pending = self._pending()
+        if not pending:
+            return action
+        k = pending[0]
+        goal = _target_point(cfg, int(core.t_wall[0, k]), core.t_geo[0, k, TARGET_GEOMETRY.centre])
+        for j, i in enumerate(cfg.controlled):
+            if self.predicts_hit(i, np.zeros(2), [k]):
+                continue
+            pos, v = core.pos[0, i], core.vel[0, i]
+            heading = np.subtract(goal, pos)
+            want = self.speed * heading / max(np.linalg.norm(heading), 1e-12)
+            action[2 * j : 2 * j + 2] = np.clip((want - v) / cfg.max_dv, -1, 1)
         return action
 
 
@@ -256,6 +285,8 @@ def scripted_policy(env):
         and len(cfg.controlled) == cfg.n_balls
     ):
         return AimingPolicy(env)
+    if cfg.dimension == 2 and cfg.scorers == "controlled" and cfg.sequential and len(cfg.controlled) == 1:
+        return SteeringPolicy(env, lookahead=2.0)
     if cfg.scorers == "cluster":
 
         def ram_first(e):

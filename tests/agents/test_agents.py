@@ -13,7 +13,7 @@ pytest.importorskip("stable_baselines3")
 pytest.importorskip("yaml")
 
 import collision_env  # noqa: E402
-from agents import config, evaluate, study, train_ppo  # noqa: E402
+from agents import config, evaluate, study, timing, train_ppo  # noqa: E402
 from agents import main as main_job  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -120,6 +120,10 @@ def test_train_save_reload_evaluate_and_record(tmp_path):
     cfg = config.read_run(run)
     assert cfg["env_id"] == "CollisionEnv/OneBallTarget-v0" and cfg["timesteps_done"] >= 2048
     assert cfg["env_kwargs"] == {"time_limit": 2.0} and cfg["episode_steps"] == 40 and cfg["train_seconds"] > 0
+    split = cfg["time_split"]  # where the time went: every part measured, none negative, adding up
+    assert list(split) == list(timing.PARTS) and all(v >= 0 for v in split.values())
+    assert split["engine"] > 0 and split["policy forward, acting"] > 0 and split["backward and optimiser"] > 0
+    assert sum(split.values()) == pytest.approx(cfg["train_seconds"], abs=0.05)
 
     log = np.load(run / "eval" / "evaluations.npz")
     assert log["timesteps"].tolist() == [1024, 2048] and log["results"].shape == (2, 2)
@@ -260,6 +264,7 @@ def test_training_on_sb3_dummy_vec_env_and_other_mode(tmp_path):
     )
     cfg = config.read_run(run)
     assert cfg["env_kwargs"] == {"mode": "naive", "substeps": 2} and cfg["vec_env"] == "dummy"
+    assert cfg["time_split"]["engine"] is None  # SB3's own vector envs hide the engine
     _finite(evaluate.evaluate(run, episodes=2, mode="exact"))
 
 
@@ -310,11 +315,35 @@ def test_study_writes_tables_plot_and_readme_block(tmp_path):
     text = readme.read_text()
     assert "old" not in text and "| naive k=1 |" in text and "`CollisionEnv/Line1D-v0`" in text
     assert text.startswith("x\n") and text.endswith("y\n")
+    assert "| engine's share of it |" in text and "Where the training time goes" in text and "**Rule**" in text
+    assert (docs / "time_split.md").is_file()
     # --render rebuilds the same tables from the JSON alone
     before = (docs / "modes.md").read_text()
     (docs / "modes.md").unlink()
     study.main(["--render", "--docs", str(docs)])
     assert (docs / "modes.md").read_text() == before
+    # --add measures more cells into the same study: one more seed of one cell, a preset trained afresh
+    more = study.main(
+        [
+            "--part",
+            "presets",
+            "--presets",
+            "CollisionEnv/Line1D-v0",
+            "--seeds",
+            "1",
+            "--timesteps",
+            "1024",
+            "--episodes",
+            "2",
+            "--output",
+            str(tmp_path / "runs"),
+            "--docs",
+            str(docs),
+            "--add",
+        ]
+    )
+    assert len(more["rows"]) == len(data["rows"]) and more["meta"]["minutes"] > data["meta"]["minutes"]
+    assert {r["run"] for r in more["rows"]} == {r["run"] for r in data["rows"]}  # the same cell, replaced
 
 
 # --------------------------------------------------------------------------------------- bad input

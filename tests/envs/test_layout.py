@@ -10,7 +10,15 @@ import pytest
 import collision_env
 from collision_env.engine import WALL_NAMES
 from collision_env.envs import REGISTERED, CollisionTargetEnv
-from collision_env.envs._layout import BALL_OBS, GLOBAL_OBS, SCENE_INTS, TARGET_OBS, observation_table, rows_of
+from collision_env.envs._layout import (
+    BALL_OBS,
+    GLOBAL_OBS,
+    PREDICTED_OBS,
+    SCENE_INTS,
+    TARGET_OBS,
+    observation_table,
+    rows_of,
+)
 
 SINGLE_CLASSES = sorted({reg.single for reg in REGISTERED.values()}, key=lambda cls: cls.__name__)
 
@@ -50,19 +58,18 @@ def _index_sets(cell: str, n_balls: int, n_slots: int, dim: int) -> list:
             instances = [b + factor * s for b in instances for s in range(n_slots)]
         elif var == "N":
             instances = [b + factor * n_balls for b in instances]
+        elif var == "S":
+            instances = [b + factor * n_slots for b in instances]
         else:
             instances = [b + factor for b in instances]
     return [{b + o for o in offsets} for b in instances]
 
 
-def _field_groups(n_balls: int, n_slots: int) -> list:
+def _field_groups(n_balls: int, n_slots: int, predicted: bool = False) -> list:
     """For every observation index: (section, instance, row of its layout)."""
     out = []
-    for section, count, columns in (
-        ("ball", n_balls, BALL_OBS),
-        ("target", n_slots, TARGET_OBS),
-        ("global", 1, GLOBAL_OBS),
-    ):
+    sections = [("ball", n_balls, BALL_OBS), ("target", n_slots, TARGET_OBS), ("global", 1, GLOBAL_OBS)]
+    for section, count, columns in sections + ([("predicted", n_balls, PREDICTED_OBS)] if predicted else []):
         rows = rows_of(columns)
         for instance in range(count):
             for col in range(len(columns)):
@@ -77,11 +84,14 @@ def _table_cells(doc: str) -> list:
 
 
 def _check_table(doc: str, cfg) -> None:
-    n, slots, dim = cfg.n_balls, cfg.target_slots, cfg.obs_dim
-    groups = _field_groups(n, slots)
+    n, slots, dim = cfg.n_observed, cfg.target_slots, cfg.obs_dim
+    groups = _field_groups(n, slots, cfg.observe == "predicted")
     seen = []
     for cell in _table_cells(doc):
-        for indices in _index_sets(cell, n, slots, dim):
+        indices_of_cell = _index_sets(cell, n, slots, dim)
+        if cfg.observe == "plain" and any(i >= dim for indices in indices_of_cell for i in indices):
+            continue  # a row of the predicted block, which this config does not observe
+        for indices in indices_of_cell:
             seen += indices
             fields = {groups[i] for i in indices}
             # one row documents part of one layout row, or whole layout rows, of one ball / slot / globals
@@ -96,6 +106,14 @@ def _check_table(doc: str, cfg) -> None:
 def test_docstring_observation_table_agrees_with_the_layout(cls):
     env_id = next(i for i, r in REGISTERED.items() if r.single is cls)
     _check_table(cls.__doc__, gym.make(env_id).unwrapped.config)
+
+
+@pytest.mark.parametrize("preset", sorted(collision_env.envs.PRESETS))
+@pytest.mark.parametrize("observe", ["plain", "predicted"])
+def test_generic_table_agrees_with_the_layout_of_every_preset(preset, observe):
+    from collision_env.envs import make_config
+
+    _check_table(CollisionTargetEnv.__doc__, make_config(preset, observe=observe))
 
 
 @pytest.mark.parametrize(
@@ -128,14 +146,14 @@ def test_observation_entries_sit_where_the_layout_says(env_id):
     xmin, ymin, xmax, ymax = cfg.bounds
     xc, yc, xh, yh = (xmin + xmax) / 2, (ymin + ymax) / 2, (xmax - xmin) / 2, (ymax - ymin) / 2
     nb, nt = len(BALL_OBS), len(TARGET_OBS)
-    for i in range(cfg.n_balls):
-        block = obs[nb * i : nb * (i + 1)]
+    for j, i in enumerate(np.flatnonzero(cfg.shown_mask)):
+        block = obs[nb * j : nb * (j + 1)]
         assert block[BALL_OBS.x] == pytest.approx(np.clip((core.pos[0, i, 0] - xc) / xh, -1, 1), abs=1e-6)
         assert block[BALL_OBS.y] == pytest.approx(np.clip((core.pos[0, i, 1] - yc) / yh, -1, 1), abs=1e-6)
         assert block[BALL_OBS.vy] == pytest.approx(np.clip(core.vel[0, i, 1] / (2 * cfg.max_speed), -1, 1), abs=1e-6)
         assert block[BALL_OBS.mass] == pytest.approx(core.masses[0, i] / 3.0, abs=1e-6)
     for s in range(cfg.target_slots):
-        block = obs[nb * cfg.n_balls + nt * s : nb * cfg.n_balls + nt * (s + 1)]
+        block = obs[nb * cfg.n_observed + nt * s : nb * cfg.n_observed + nt * (s + 1)]
         k = min(int(core.cur[0]), cfg.n_targets - 1) if cfg.sequential else s
         wall = WALL_NAMES[int(core.t_wall[0, k])]
         assert block[getattr(TARGET_OBS, f"wall_{wall}")] == 1.0 and block[TARGET_OBS.wall_left :][:4].sum() == 1.0
