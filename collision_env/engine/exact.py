@@ -74,6 +74,7 @@ from .layout import (
     W_EVENTS,
     W_REMAINING,
     W_STALLED,
+    W_STALLED_AT,
 )
 from .ldp import least_distance
 
@@ -793,14 +794,14 @@ def _predict(i, now, horizon, rebuild, rot, b, cl, ph, geo, wk):
 
 # ---------------------------------------------------------------------------- begin
 @njit(inline="always")
-def _begin_whole_scene(pos, vel, radius, rec, ci, heads, geo, pending):
+def _begin_whole_scene(now, pos, vel, radius, rec, ci, heads, geo, pending):
     """Forget every prediction of a scene, take every ball's state (its radius too) into its
-    record and lay the balls into the grid; every ball is then to be predicted (listed in
-    ``pending``). Returns how many."""
+    record as of step time ``now`` and lay the balls into the grid; every ball is then to be
+    predicted (listed in ``pending``). Returns how many."""
     n = pos.shape[0]
     x0, y0, hx, hy, nx, ny = geo
     for i in range(n):
-        _load(i, 0.0, rec, pos, vel)
+        _load(i, now, rec, pos, vel)
         rec[i]["radius"] = radius[i]
         cal.set_event(i, INF, cal.EV_NONE, 0, rec, ci)
         pending[i] = i
@@ -1074,6 +1075,7 @@ def step_exact(
         for sc in range(n_scenes):
             work_i[sc, W_ACTIVE] = True
             work_f[sc, W_REMAINING] = dt_abs
+            work_f[sc, W_STALLED_AT] = 0.0
             work_i[sc, W_EVENTS] = 0
             capped[sc] = False
         n_imp[1] = 0
@@ -1089,14 +1091,14 @@ def step_exact(
         geo = grid.scene_geometry(work_f, work_i, sc)
         horizon_end = work_f[sc, W_REMAINING]
         t0 = time[sc]
-        now = 0.0
+        now = work_f[sc, W_STALLED_AT]  # (0 at a step's start)
         rot = ph.sticky and has_rotation(b.body, b.omega)
 
         # begin: everything afresh after a reset (and for rotating clusters, whose predictions reach
         # only to the end of a step), otherwise only the balls changed since the last step
         whole = not work_i[sc, W_CALENDAR_VALID] or rot
         if whole:
-            n_pending = _begin_whole_scene(b.pos, b.vel, b.radius, cl.rec, cl.ci, cl.heads, geo, wk.pending)
+            n_pending = _begin_whole_scene(now, b.pos, b.vel, b.radius, cl.rec, cl.ci, cl.heads, geo, wk.pending)
         elif fresh:
             n_pending = _begin_changed_balls(b.pos, b.vel, cl.rec, cl.ci, cl.heads, geo, wk.pending)
         else:
@@ -1143,17 +1145,18 @@ def step_exact(
             # invalidate (the changed balls are predicted afresh at the top of the loop)
             _invalidate(n_pending, now, b, cl, wk)
 
+        if work_i[sc, W_STALLED]:  # the next call goes on from here, as if nothing had stopped it
+            work_f[sc, W_STALLED_AT] = now
+            n_imp[2] += 1
+            continue
         # finish
-        stopped = capped[sc] or work_i[sc, W_STALLED]
-        t_end = now if stopped else horizon_end
+        t_end = now if capped[sc] else horizon_end
         _finish(t_end, b.pos, b.vel, b.mass, b.body, b.omega, rot, ph.sticky, cl.rec, cl.ci, cl.hp)
         time[sc] = t0 + ph.sign * t_end
         work_f[sc, W_REMAINING] = horizon_end - t_end
-        n_imp[2] += work_i[sc, W_STALLED]
         n_imp[1] += capped[sc]
-        work_i[sc, W_ACTIVE] = work_i[sc, W_STALLED]
-        if not work_i[sc, W_STALLED]:
-            finish_step(sc, not capped[sc], ph.sign * dt_abs, time, clock)
+        work_i[sc, W_ACTIVE] = False
+        finish_step(sc, not capped[sc], ph.sign * dt_abs, time, clock)
     return n_imp[0] if n_imp[1] == 0 and n_imp[2] == 0 else -1
 
 

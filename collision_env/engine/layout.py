@@ -78,10 +78,13 @@ S_XMIN, S_YMIN, S_XMAX, S_YMAX, S_ELASTICITY, S_COLLAPSE_RATIO, S_SIGN, S_COLLAP
 SCENE_I = ("has_walls", "pairs", "dim", "sticky", "max_events")
 S_HAS_WALLS, S_PAIRS, S_DIM, S_STICKY, S_MAX_EVENTS = range(5)
 
-#: Per-scene work floats: time left in the current step; start time of the current sub-step
-#: (cheap modes); the grid's origin and cell sizes (exact mode).
-WORK_F = ("remaining", "substep_start", "grid_x0", "grid_y0", "grid_hx", "grid_hy")
-W_REMAINING, W_SUBSTEP_START, W_GRID_X0, W_GRID_Y0, W_GRID_HX, W_GRID_HY = range(6)
+#: Per-scene work floats: the length of the current step, and the time left of it once it ends
+#: (more than 0 only at the event cap); how far into the step a scene that found the impact buffer
+#: full got (exact mode: the next call resumes it there, so a step's arithmetic does not depend on
+#: the buffer's size or the batch); start time of the current sub-step (cheap modes); the grid's
+#: origin and cell sizes (exact mode).
+WORK_F = ("remaining", "stalled_at", "substep_start", "grid_x0", "grid_y0", "grid_hx", "grid_hy")
+W_REMAINING, W_STALLED_AT, W_SUBSTEP_START, W_GRID_X0, W_GRID_Y0, W_GRID_HX, W_GRID_HY = range(7)
 
 #: Per-scene work ints: events in the current step; the scene still has work in this step; it
 #: stopped because the impact buffer was full; sub-steps done (cheap modes); the calendar holds

@@ -810,6 +810,30 @@ class BatchSimulator:
         """An independent copy (for planning: step it ahead without touching this one)."""
         return copy.deepcopy(self)
 
+    def load(self, other: BatchSimulator) -> None:
+        """Take ``other``'s whole state in place: balls, clusters, clocks and, in exact mode, its
+        event calendar, so that stepping this simulator on does exactly what stepping ``other``
+        would, with nothing predicted afresh. For a planning simulator that copies a running one at
+        every step (:meth:`set_state` checks its input and re-predicts every scene). ``other`` has
+        the same scene, shape and mode; its other settings (sub-steps, the event cap) may differ
+        and are this simulator's own."""
+        if not isinstance(other, BatchSimulator):
+            raise TypeError(f"other: expected a BatchSimulator, got {type(other).__name__}")
+        if (other.scene, other.mode, other._balls.shape) != (self.scene, self.mode, self._balls.shape):
+            raise ValueError(
+                f"other: a simulator of the same scene, mode and shape, got mode {other.mode!r} and shape "
+                f"{other._balls.shape[:2]} (this one: {self.mode!r}, {self._balls.shape[:2]})"
+            )
+        for name in ("_balls", "_body", "_time", "_clock", "_capped", "_work_f", "_work_i"):
+            np.copyto(getattr(self, name), getattr(other, name))
+        for field in (S_ELASTICITY, S_SIGN):  # (the direction of time the state is kept for)
+            self._fparams[field] = other._fparams[field]
+        if self.mode == "exact":
+            for name in ("_cal", "_cal_i", "_cal_heads", "_cal_heap"):
+                np.copyto(getattr(self, name), getattr(other, name))
+        self._sign = other._sign
+        self._forward = other._forward
+
     def __getstate__(self):
         state = self.__dict__.copy()
         for key in (

@@ -414,7 +414,7 @@ class TaskCore:
         from collision_env.engine import EventCapWarning
 
         live = self.batch.live_arrays()
-        self.ahead.set_state(self.batch.get_state())
+        self.ahead.load(self.batch)  # (its calendar too: nothing is predicted afresh)
         with warnings.catch_warnings():  # a capped look-ahead only predicts less far
             warnings.simplefilter("ignore", EventCapWarning)
             imp = self.ahead.step(self.cfg.lookahead)
