@@ -66,14 +66,15 @@ def vector_env_steps_per_s(venv: gym.vector.VectorEnv, seconds: float, slices: i
 
 
 def _engine_us(core, seconds: float, steps: int = 200) -> float:
-    """us per (nudge + step) call pair of the engine alone, on a copy of ``core``'s engine."""
+    """us per (nudge + step) call pair of the engine alone, on a copy of ``core``'s engine (each
+    slice starts from the same state, calendar included, as the env's engine would go on)."""
+    start = core.batch.copy()
     sim = core.batch.copy()
     dv = np.zeros_like(core.vel)
     dt = core.cfg.dt
     best, total = float("inf"), 0.0
-    state = sim.get_state()
     while total < seconds:
-        sim.set_state(state)
+        sim.load(start)
         t0 = time.perf_counter()
         for _ in range(steps):
             sim.nudge(dv, check=False)  # the impulse kernel the env applies from its own nudge kernel
