@@ -3,7 +3,7 @@
 The scheduler of the event-driven loop (Alder & Wainwright 1959; Rapaport 1980; Lubachevsky
 1991). Its parts, each with one job:
 
-- the **calendar** (:mod:`~collision_env.engine.calendar`): one pending event per ball in a 4-ary
+- the **calendar** (:mod:`~collision_env.engine.calendar`): one pending event per ball in an 8-ary
   heap, invalidated lazily; it persists from one step to the next;
 - the **broad phase** (:mod:`~collision_env.engine.grid`): a cell grid, so that a prediction looks
   only at the 3 x 3 cells around a ball, kept current by cell-crossing events (one cell, i.e. all
@@ -720,6 +720,15 @@ def _wall_event(i, now, horizon, rot, b, ph, rec, wk):
 
 
 @njit(inline="always")
+def _near_border(c, nx, ny):
+    """Cell ``c`` is one of the grid's outermost (or the only one): a ball elsewhere is at least a
+    cell's width, more than its radius, from every wall."""
+    cx = c % nx
+    cy = c // nx
+    return cx == 0 or cx == nx - 1 or cy == 0 or cy == ny - 1
+
+
+@njit(inline="always")
 def _crossing_event(i, rec, ci, geo):
     """When ball ``i`` leaves its grid cell, and for which neighbour: ``(time, code)``."""
     x0, y0, hx, hy, nx, ny = geo
@@ -777,7 +786,10 @@ def _predict(i, now, horizon, rebuild, rot, b, cl, ph, geo, wk):
     looked at, so each pair is tested once, by its lower ball (which is enough: the earliest event
     of the scene is then held by its lower ball), and the heap is ordered afterwards.
     """
-    best_t, best_code = _wall_event(i, now, horizon, rot, b, ph, cl.rec, wk)
+    if _near_border(cl.ci[i, C_CELL], geo[4], geo[5]):
+        best_t, best_code = _wall_event(i, now, horizon, rot, b, ph, cl.rec, wk)
+    else:  # (a ball in an inner cell crosses into a cell at the border before it can touch a wall)
+        best_t, best_code = INF, cal.EV_NONE
     best_stamp = 0
     if ph.pairs:
         if geo[4] * geo[5] > 1:
