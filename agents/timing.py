@@ -24,6 +24,8 @@ from __future__ import annotations
 import time
 from collections import defaultdict
 
+from collision_env.bench.timing import add_timer
+
 PARTS = (
     "engine",
     "env, besides the engine",
@@ -61,9 +63,8 @@ def time_split(venv):
             self._timed(inner, "step_wait", "env")
             core = _native_core(venv)
             if core is not None:
-                for sim in (core.batch, core.ahead):
-                    if sim is not None:
-                        self._timed(sim, "step", "engine")
+                for sim in core.engines:
+                    self._timed(sim, "step", "engine")
                 self.engine_timed = True
 
         def _lap(self, key: str) -> None:
@@ -91,18 +92,8 @@ def time_split(venv):
             return True
 
         def _timed(self, obj, name: str, key: str) -> None:
-            inner = getattr(obj, name)
-            raw = self.raw
+            add_timer(obj, name, self.raw, key)
             self._wrapped = getattr(self, "_wrapped", []) + [(obj, name)]
-
-            def timed(*args, **kwargs):
-                start = time.perf_counter()
-                try:
-                    return inner(*args, **kwargs)
-                finally:
-                    raw[key] += time.perf_counter() - start
-
-            setattr(obj, name, timed)
 
         def split(self, total: float) -> dict:
             """Seconds per part (``PARTS``) of a ``learn`` call that took ``total`` seconds."""

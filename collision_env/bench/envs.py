@@ -29,7 +29,7 @@ from collision_env.engine import MODES
 
 from .machine import cpus, machine, timestamp, versions
 from .readme import write_block
-from .timing import best_rate
+from .timing import add_timer, best_rate
 
 REPEATS = 5  # each figure is the best of this many equal slices of --seconds (robust to a busy machine)
 
@@ -90,29 +90,17 @@ def _engine_share(venv: gym.vector.VectorEnv, seconds: float) -> float:
     """The engine's share of a vector env's step time: every engine ``step`` of its core (the
     look-ahead engine's too) is timed inside the env's own run, random actions and resets
     included. (A timer costs well under a microsecond, nothing beside a step of a whole batch.)"""
-    core = venv.unwrapped.core
-    spent = [0.0]
-
-    def timed(step):
-        def run(*args, **kwargs):
-            t0 = time.perf_counter()
-            try:
-                return step(*args, **kwargs)
-            finally:
-                spent[0] += time.perf_counter() - t0
-
-        return run
-
-    engines = [sim for sim in (core.batch, core.ahead) if sim is not None]
+    engines = venv.unwrapped.core.engines
+    spent = {"engine": 0.0}
     for sim in engines:
-        sim.step = timed(sim.step)
+        add_timer(sim, "step", spent, "engine")
     try:
         t0 = time.perf_counter()
         vector_env_steps_per_s(venv, seconds, slices=1)
-        return spent[0] / (time.perf_counter() - t0)
+        return spent["engine"] / (time.perf_counter() - t0)
     finally:
         for sim in engines:
-            del sim.step  # the class's method again
+            delattr(sim, "step")  # the class's method again
 
 
 def _fmt_rate(x: float) -> str:

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import statistics
 import time
-from collections.abc import Callable
+from collections.abc import Callable, MutableMapping
 
 
 def repeat(fn: Callable[[], object], repeats: int, reset: Callable[[], object] | None = None) -> list[float]:
@@ -48,3 +48,31 @@ def best_rate(chunk: Callable[[], int], seconds: float, slices: int) -> float:
                 break
         best = max(best, done / elapsed)
     return best
+
+
+def add_timer(obj: object, name: str, totals: MutableMapping[str, float], key: str) -> None:
+    """Time every call of ``obj.name``: each adds its duration (s) to ``totals[key]``.
+
+    The timer is an instance attribute that shadows the class's method; ``delattr(obj, name)``
+    removes it. It costs a ``perf_counter`` pair per call.
+
+    >>> class Clock:
+    ...     def tick(self):
+    ...         return 1
+    >>> c, totals = Clock(), {"tick": 0.0}
+    >>> add_timer(c, "tick", totals, "tick")
+    >>> c.tick(), totals["tick"] > 0.0
+    (1, True)
+    >>> delattr(c, "tick"); "tick" in vars(c)
+    False
+    """
+    inner = getattr(obj, name)
+
+    def timed(*args, **kwargs):
+        start = time.perf_counter()
+        try:
+            return inner(*args, **kwargs)
+        finally:
+            totals[key] += time.perf_counter() - start
+
+    setattr(obj, name, timed)

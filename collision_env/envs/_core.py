@@ -320,6 +320,11 @@ class TaskCore:
             self.ahead = engine(1 if cfg.mode == "exact" else cfg.substeps * max(1, round(cfg.lookahead / cfg.dt)))
         self._ahead_body = np.zeros((B, N), dtype=np.int64)
 
+    @property
+    def engines(self) -> tuple:
+        """The engine, and its look-ahead copy when there is one (``observe="predicted"``)."""
+        return (self.batch,) if self.ahead is None else (self.batch, self.ahead)
+
     # views into the packed state (writable: they share memory with it)
     t_wall = property(lambda self: self.T[..., TARGET_INTS.wall], doc="(B, K) target walls (engine wall codes).")
     t_status = property(
