@@ -22,7 +22,7 @@ from .scene import (
     Scene,
     radius_from_mass,
 )
-from .simulator import IMPACT_DTYPE, MODES, BatchSimulator, EventCapWarning, Impact, Simulator, warm_up
+from .simulator import IMPACT_DTYPE, MODES, BatchSimulator, EventCapWarning, Frames, Impact, Simulator, warm_up
 
 __all__ = [
     "BACKEND",
@@ -39,6 +39,7 @@ __all__ = [
     "WALL_TOP",
     "BatchSimulator",
     "EventCapWarning",
+    "Frames",
     "Impact",
     "Scene",
     "Simulator",

@@ -90,6 +90,12 @@ from .tolerance import CONTACT_RTOL, contact_tolerance
 COUNTERS = ("pair_tests", "wall_tests", "events", "cluster_tests", "cell_crossings", "stale_events")
 PAIR_TESTS, WALL_TESTS, EVENTS, CLUSTER_TESTS, CELL_CROSSINGS, STALE_EVENTS = range(6)
 
+#: How a call of a stepping kernel (``step_exact``, ``substep.step_substeps``) starts: it resumes
+#: the scenes a full impact buffer stopped, starts a step (exact mode re-predicts the balls that
+#: changed since the last step), or starts the next step of a run of steps made in one compiled
+#: loop, where nothing can have changed in between (the cheap modes treat both starts alike).
+RESUME, START_STEP, START_NEXT = range(3)
+
 #: Sweeps over a contact group in one instant before the cascade is replaced by its limit (see
 #: ``_settle_contact_group``). Cascades among comparable masses end within a few dozen sweeps; the
 #: criterion is a count, so it does not depend on the masses, and the limit always ends the cascade.
@@ -1053,7 +1059,7 @@ def step_exact(
     scratch_i,
     scratch_b,
     dt_abs,
-    fresh,
+    start,
 ):
     """Advance every active scene of the batch by its remaining time (see module doc).
 
@@ -1063,8 +1069,10 @@ def step_exact(
     geometry (``layout.WORK_F``/``WORK_I``); ``cal_rec``/``cal_i``/``cal_heads``/``cal_heap`` the
     persistent calendar records, its int rows, the grid's cell heads and the event queue
     (``layout.CAL_RECORD``/``CAL_I``/``HEAP``); ``clock`` the compensated clocks
-    (:mod:`~collision_env.engine.clock`), advanced when a scene's step ends. ``fresh`` starts a step
-    of ``dt_abs`` for every scene; otherwise the call resumes the scenes flagged active.
+    (:mod:`~collision_env.engine.clock`), advanced when a scene's step ends. ``start`` is
+    :data:`START_STEP` to start a step of ``dt_abs`` for every scene, :data:`START_NEXT` to start
+    one right after a completed step of this kernel that nobody touched since (the balls need not
+    be compared with their records), or :data:`RESUME` to resume the scenes flagged active.
     Impacts go to ``imp`` rows (``layout.IMPACT_DTYPE``) from row 0, ``n_imp[0]`` rows in all; a
     scene that finds the buffer full stops where it is and is flagged stalled, so the caller can
     empty the buffer and call again for those scenes. ``n_imp[1]`` counts the scenes that reached
@@ -1083,7 +1091,7 @@ def step_exact(
     max_events = iparams[S_MAX_EVENTS]
     wk = _work(n, imp, n_imp, counters, scratch_f, scratch_i, scratch_b)
     room = impacts_per_event(n, ph.cascades)
-    if fresh:
+    if start != RESUME:
         for sc in range(n_scenes):
             work_i[sc, W_ACTIVE] = True
             work_f[sc, W_REMAINING] = dt_abs
@@ -1111,7 +1119,7 @@ def step_exact(
         whole = not work_i[sc, W_CALENDAR_VALID] or rot
         if whole:
             n_pending = _begin_whole_scene(now, b.pos, b.vel, b.radius, cl.rec, cl.ci, cl.heads, geo, wk.pending)
-        elif fresh:
+        elif start == START_STEP:
             n_pending = _begin_changed_balls(b.pos, b.vel, cl.rec, cl.ci, cl.heads, geo, wk.pending)
         else:
             n_pending = 0
@@ -1196,7 +1204,7 @@ if HAVE_NUMBA:
         )
 
     @njit
-    def step_exact_packed(h, dt_abs, fresh):
+    def step_exact_packed(h, dt_abs, start):
         """:func:`step_exact` on the arrays packed in ``h`` (:mod:`~collision_env.engine.argpack`),
         one slot per array in the order of its parameters; the call Python makes, with one array
         to check instead of nineteen."""
@@ -1210,5 +1218,5 @@ if HAVE_NUMBA:
             view1(h, 17, np.int64),
             view1(h, 18, np.bool_),
             dt_abs,
-            fresh,
+            start,
         )

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ._jit import HAVE_NUMBA, njit
 from .clock import finish_step
-from .exact import scene_params
+from .exact import RESUME, scene_params
 from .grid import CHEAP_CELLS_PER_BALL, block, cell_of, scene_geometry
 from .layout import (
     W_ACTIVE,
@@ -103,13 +103,13 @@ def step_substeps(
     clock,
     scratch,
     dt_abs,
-    fresh,
+    start,
 ):
     """Run the remaining sub-steps of every active scene.
 
-    Parameters as :func:`exact.step_exact` (``fresh`` starts a step for every scene; ``capped``
-    is not used: the cheap modes have no event cap; ``scratch`` is an int buffer of
-    :func:`scratch_size`); a scene stops between sub-steps when the impact buffer could not
+    Parameters as :func:`exact.step_exact` (a ``start`` other than ``RESUME`` starts a step for
+    every scene; ``capped`` is not used: the cheap modes have no event cap; ``scratch`` is an int
+    buffer of :func:`scratch_size`); a scene stops between sub-steps when the impact buffer could not
     hold another sub-step's worst case, and is flagged stalled. Returns as
     :func:`exact.step_exact` does: the impact rows written, or -1 when a scene stalled.
     """
@@ -122,7 +122,7 @@ def step_substeps(
     n = pos.shape[1]
     bounds, e, ratio, floor, sign, has_walls, pairs, dim, sticky, _ = scene_params(fparams, iparams)
     h = dt_abs / k_total
-    if fresh:
+    if start != RESUME:
         for sc in range(pos.shape[0]):
             active[sc] = True
             t_start[sc] = time[sc]
@@ -209,7 +209,7 @@ def step_substeps(
 if HAVE_NUMBA:
 
     @njit
-    def step_substeps_packed(mode, k_total, h, dt_abs, fresh):
+    def step_substeps_packed(mode, k_total, h, dt_abs, start):
         """:func:`step_substeps` on the arrays packed in ``h`` (:mod:`~collision_env.engine.argpack`),
         one slot per array in the order of its parameters."""
-        return step_substeps(mode, k_total, *unpack_state(h), view1(h, 12, np.int64), dt_abs, fresh)
+        return step_substeps(mode, k_total, *unpack_state(h), view1(h, 12, np.int64), dt_abs, start)

@@ -35,4 +35,8 @@ def test_the_report_renders_every_size():
         "frames": scale.bench_frames(n=20, horizon=1.0, repeats=1),
     }
     text = scale.render_markdown(results)
-    assert "| 100 |" in text and "| 200 |" in text and "frames keep" in text
+    assert "| 100 |" in text and "| 200 |" in text
+    assert "% of the one-step rate" in text and "into arrays it is given" in text
+    frames = results["frames"]
+    ratios = ("frames_over_one_step", "frames_call_over_one_step", "frames_given_over_one_step")
+    assert all(frames[key] > 0 for key in ratios)

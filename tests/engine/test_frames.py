@@ -1,0 +1,149 @@
+"""``frames``: many steps in one call are a loop of ``step`` calls, bit for bit, on every path
+(the compiled loop, the frames it hands back to Python, and the step-by-step fallback)."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from collision_env.engine import BatchSimulator, EventCapWarning, Scene, Simulator
+from tests.engine.test_calendar import gas
+
+FIELDS = ["scene", "time", "ball", "other", "wall", "x", "y", "speed"]
+
+
+def twin_batches(scene, starts, radii, **options):
+    """Two identical batches of the scenes ``starts`` ((positions, velocities) pairs)."""
+    masses = np.ones(len(radii))
+    return [
+        BatchSimulator(scene, [p for p, _ in starts], [v for _, v in starts], masses, radii=radii, **options)
+        for _ in range(2)
+    ]
+
+
+def assert_frames_are_a_step_loop(sim, loop, dt, n):
+    """``sim.frames(dt, n)`` against ``n`` calls of ``loop.step(dt)`` on a twin: every bit the same."""
+    rec = sim.frames(dt, n)
+    steps = []
+    for f in range(n):
+        steps.append(loop.step(dt))
+        np.testing.assert_array_equal(rec.time[f], loop.time)
+        np.testing.assert_array_equal(rec.positions[f], loop.positions)
+        np.testing.assert_array_equal(rec.velocities[f], loop.velocities)
+    np.testing.assert_array_equal(rec.impacts[FIELDS], np.concatenate(steps)[FIELDS])
+    np.testing.assert_array_equal(sim.positions, loop.positions)
+    np.testing.assert_array_equal(sim.time, loop.time)
+    assert sim.stats == loop.stats
+    return rec
+
+
+@pytest.mark.parametrize("mode", ["exact", "naive", "posteriori"])
+def test_frames_are_a_loop_of_steps(mode):
+    scene, pos, vel, radii = gas(60, speed=2.0)
+    starts = [(pos, vel), (pos, 0.5 * vel), (pos, -vel)]
+    sim, loop = twin_batches(scene, starts, radii, mode=mode, substeps=1 if mode == "exact" else 2)
+    rec = assert_frames_are_a_step_loop(sim, loop, 1 / 60, 40)
+    assert len(rec.impacts) > 100
+    assert set(rec.impacts["scene"]) == {0, 1, 2}
+
+
+@pytest.mark.parametrize(
+    "dt, n, max_events, capped_steps",
+    [
+        (0.0005, 60, 10_000, 0),  # a few dozen impacts a frame: the frames' own copy fills up, and grows
+        (0.05, 12, 10_000, 0),  # hundreds a frame: the kernel's buffer fills in every frame
+        (0.05, 12, 40, 12),  # and the event cap stops every frame's step early
+    ],
+)
+def test_frames_past_full_impact_buffers_and_the_event_cap(dt, n, max_events, capped_steps):
+    """A small impact buffer (300 rows) makes the kernel stall mid-step, or the frames' copy of
+    the impacts fill up; an event cap stops scenes early. Python completes those frames as step
+    completes a step."""
+    scene, pos, vel, radii = gas(150, speed=3.0)
+    starts = [(pos, vel * s) for s in (1.0, 0.5, 2.0)]
+    sim, loop = twin_batches(scene, starts, radii, max_events=max_events)
+    for b in (sim, loop):
+        b._alloc_work(300)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        rec = assert_frames_are_a_step_loop(sim, loop, dt, n)
+    assert len(rec.impacts) > 3 * 300
+    capped = [w for w in caught if issubclass(w.category, EventCapWarning)]
+    assert len(capped) == 2 * capped_steps  # a warning per step, from either
+    assert all(w.filename == __file__ for w in capped)  # (each names the caller)
+
+
+@pytest.mark.parametrize("case", ["backwards", "no border"])
+def test_frames_that_step_one_by_one(case):
+    scene, pos, vel, radii = gas(30)
+    dt = -1 / 60 if case == "backwards" else 1 / 60
+    if case == "no border":
+        scene = Scene(bounds=None)
+    sim, loop = twin_batches(scene, [(pos, vel)], radii)
+    assert_frames_are_a_step_loop(sim, loop, dt, 30)
+
+
+def test_single_simulator_frames_drop_the_batch_axis():
+    scene, pos, vel, radii = gas(20, speed=3.0)
+    sim = Simulator(scene, pos, vel, np.ones(20), radii=radii)
+    loop = Simulator(scene, pos, vel, np.ones(20), radii=radii)
+    rec = sim.frames(0.1, 5)
+    assert rec.time.shape == (5,) and rec.positions.shape == rec.velocities.shape == (5, 20, 2)
+    want = [impact for _ in range(5) for impact in loop.step(0.1)]
+    assert rec.impacts == want and len(want) > 5
+    np.testing.assert_array_equal(rec.positions[-1], loop.positions)
+
+
+def test_no_frames_and_bad_arguments_leave_the_state_alone():
+    scene, pos, vel, radii = gas(10)
+    sim = Simulator(scene, pos, vel, np.ones(10), radii=radii)
+    before = sim.get_state()
+    rec = sim.frames(0.1, 0)
+    assert rec.positions.shape == (0, 10, 2) and rec.impacts == []
+    for dt, n, match in (
+        (0.1, -1, "n: must be a whole number"),
+        (0.1, 2.0, "n: must be a whole number"),
+        (0.1, True, "n: must be a whole number"),
+        (float("nan"), 3, "dt: "),
+        ("0.1", 3, "dt: "),
+    ):
+        with pytest.raises(ValueError, match=match):
+            sim.frames(dt, n)
+    for key, value in sim.get_state().items():
+        np.testing.assert_array_equal(value, before[key])
+
+
+def test_frames_record_into_the_arrays_they_are_given():
+    scene, pos, vel, radii = gas(40, speed=2.0)
+    sim, loop = twin_batches(scene, [(pos, vel), (pos, -vel)], radii)
+    first = sim.frames(0.02, 30)
+    again = sim.frames(0.02, 30, out=first)
+    assert again.positions is first.positions and again.time is first.time
+    loop.frames(0.02, 30)
+    want = loop.frames(0.02, 30)
+    for got, expected in zip(again[:3], want[:3], strict=True):
+        np.testing.assert_array_equal(got, expected)
+    single = Simulator(scene, pos, vel, np.ones(40), radii=radii)
+    rec = single.frames(0.02, 30)
+    assert np.shares_memory(single.frames(0.02, 30, out=rec).positions, rec.positions)
+    np.testing.assert_array_equal(rec.positions, want.positions[:, 0])
+
+
+def test_frames_refuse_arrays_they_cannot_record_into():
+    scene, pos, vel, radii = gas(10)
+    sim = BatchSimulator(scene, [pos], [vel], np.ones(10), radii=radii)
+    good = (np.empty((5, 1)), np.empty((5, 1, 10, 2)), np.empty((5, 1, 10, 2)))
+    before = sim.get_state()
+    for out, match in (
+        ([good[0], good[1], good[2]], "out: expected a Frames or a tuple"),
+        (good[:2], "out: expected a Frames or a tuple"),
+        ((np.empty((4, 1)), good[1], good[2]), r"out: time must be .* shape \(5, 1\)"),
+        ((good[0], good[1].astype(np.float32), good[2]), "out: positions must be .* float64"),
+        ((good[0], good[1], np.empty((5, 1, 10, 4))[..., :2]), "out: velocities must be .* C-contiguous"),
+    ):
+        with pytest.raises(ValueError, match=match):
+            sim.frames(0.1, 5, out=out)
+    for key, value in sim.get_state().items():
+        np.testing.assert_array_equal(value, before[key])
