@@ -584,18 +584,18 @@ class BatchSimulator:
         pieces = []
         f = 0
         if HAVE_NUMBA and self._forward and 0.0 < dt <= _MAX_MAGNITUDE:
-            out = np.empty(len(self._imp), dtype=IMPACT_DTYPE)
+            buffer = np.empty(len(self._imp), dtype=IMPACT_DTYPE)  # (the loop's copy of the impacts)
             while f < n:
-                f, stepped, rows = step_frames(*self._frames_args, dt, f, n, times, positions, velocities, out, 0)
+                f, stepped, rows = step_frames(*self._frames_args, dt, f, n, times, positions, velocities, buffer, 0)
                 if rows:
-                    pieces.append(out[:rows].copy() if f < n else out[:rows])
+                    pieces.append(buffer[:rows].copy() if f < n else buffer[:rows])
                 if f == n:
                     break
                 # frame f's impacts did not fit (the next frames get a buffer twice the size), or
                 # its step needs completing, as step completes it
                 if stepped:
                     pieces.append(self._take_impacts(self._n_imp[0]))
-                    out = np.empty(2 * len(out), dtype=IMPACT_DTYPE)
+                    buffer = np.empty(2 * len(buffer), dtype=IMPACT_DTYPE)
                 else:
                     pieces.append(self._finish(self._run(dt, first_done=True), 1.0, stacklevel=3))
                 self._record(f, times, positions, velocities)
