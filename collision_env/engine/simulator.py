@@ -113,17 +113,29 @@ class Frames(NamedTuple):
     impacts: Any  #: the steps' impacts, step after step, each step's as ``step`` returns them
 
 
+def _batch_shapes(sim, n):
+    """The shapes of ``n`` frames of a batch: clocks, positions, velocities."""
+    return (n, sim._n_scenes), (n, sim._n_scenes, sim._n, 2), (n, sim._n_scenes, sim._n, 2)
+
+
 def _output_arrays(out, shapes):
     """The first three arrays of ``out`` (:class:`Frames` fields ``time``, ``positions``,
-    ``velocities``), checked to be writable C-contiguous float64 arrays of ``shapes``."""
-    arrays = tuple(out)[:3] if isinstance(out, tuple) else ()
+    ``velocities``), checked to be distinct, writable, aligned, C-contiguous float64 arrays of
+    ``shapes``."""
+    arrays = tuple(out)[:3] if isinstance(out, (tuple, list)) else ()
     if len(arrays) != 3:
         raise ValueError(f"out: expected a Frames or a tuple (time, positions, velocities), got {type(out).__name__}")
     for name, array, shape in zip(Frames._fields[:3], arrays, shapes, strict=True):
         ok = isinstance(array, np.ndarray) and array.dtype == np.float64 and array.shape == shape
-        if not (ok and array.flags.c_contiguous and array.flags.writeable):
+        if not (ok and array.flags.c_contiguous and array.flags.aligned and array.flags.writeable):
             got = f"{array.dtype} {array.shape}" if isinstance(array, np.ndarray) else type(array).__name__
-            raise ValueError(f"out: {name} must be a writable C-contiguous float64 array of shape {shape}, got {got}")
+            raise ValueError(
+                f"out: {name} must be a writable, aligned, C-contiguous float64 array of shape {shape}, got {got}"
+            )
+    for a in range(3):
+        for b in range(a + 1, 3):
+            if np.may_share_memory(arrays[a], arrays[b]):
+                raise ValueError(f"out: {Frames._fields[a]} and {Frames._fields[b]} must not share memory")
     return arrays
 
 
@@ -510,7 +522,7 @@ class BatchSimulator:
         """
         return self._step(dt, True)
 
-    def _step(self, dt, copy):
+    def _step(self, dt, copy, stacklevel=4):
         """:meth:`step`; with ``copy`` False, exact mode's impacts may come as a view of the impact
         buffer, valid until the next step (for :meth:`Simulator.step`, which converts them at once)."""
         dt = _real_number(dt, "dt")
@@ -518,7 +530,7 @@ class BatchSimulator:
             rows = self._kernel(*self._kernel_args, dt, START_STEP)
             if rows >= 0:  # no scene stalled or reached the event cap
                 return self._take_impacts(rows, copy) if rows else _NO_IMPACTS
-            return self._finish(self._run(dt, first_done=True), 1.0)
+            return self._finish(self._run(dt, first_done=True), 1.0, stacklevel)
         if not abs(dt) <= _MAX_MAGNITUDE:
             raise ValueError(f"dt: must be finite and at most {_MAX_MAGNITUDE:g} s, got {dt}")
         if self.scene.bounds is None:
@@ -547,7 +559,7 @@ class BatchSimulator:
             if sign < 0:
                 np.negative(self._vel, out=self._vel)
                 np.negative(self._omega, out=self._omega)
-        return self._finish(chunks, sign)
+        return self._finish(chunks, sign, stacklevel)
 
     def frames(self, dt: float, n: int, out: Frames | None = None) -> Frames:
         """Take ``n`` steps of ``dt`` seconds, recording every scene after each one.
@@ -560,7 +572,8 @@ class BatchSimulator:
         ``out``: the arrays to record into (a :class:`Frames` of ``n`` rows from an earlier call,
         say; its ``impacts`` are not used), instead of new ones: writing a trajectory into new
         memory costs the operating system's first touch of every page, which is more than the
-        steps of a sparse gas.
+        steps of a sparse gas. A step that raises stops the run there, as it would stop a loop
+        (after the steps before it).
 
         >>> scene = Scene(bounds=(-1.0, -1.0, 1.0, 1.0))
         >>> sim = BatchSimulator(scene, [[[0.0, 0.0]], [[0.5, 0.0]]], [[[1.0, 0.0]], [[0.0, 0.0]]], [1.0], [0.25])
@@ -570,40 +583,51 @@ class BatchSimulator:
         >>> rec.impacts[["scene", "time", "wall"]].tolist()
         [(0, 0.75, 1)]
         """
+        return self._frames(dt, n, out, _batch_shapes)
+
+    def _frames(self, dt, n, out, shapes_of):
+        """:meth:`frames`, with ``out`` checked against ``shapes_of(self, n)`` (the shapes the
+        caller documents; its arrays are then viewed with the batch axis). Called straight from
+        each public ``frames``, so that a warning names their caller."""
         dt = _real_number(dt, "dt")
         if not abs(dt) <= _MAX_MAGNITUDE:
             raise ValueError(f"dt: must be finite and at most {_MAX_MAGNITUDE:g} s, got {dt}")
         if isinstance(n, (bool, np.bool_)) or not isinstance(n, numbers.Integral) or n < 0:
             raise ValueError(f"n: must be a whole number of steps (0 or more), got {n!r}")
         n = int(n)
-        shapes = ((n, self._n_scenes), (n, self._n_scenes, self._n, 2), (n, self._n_scenes, self._n, 2))
         if out is None:
-            times, positions, velocities = (np.empty(shape) for shape in shapes)
-        else:
-            times, positions, velocities = _output_arrays(out, shapes)
+            times, positions, velocities = (np.empty(shape) for shape in _batch_shapes(self, n))
+        else:  # (a single simulator's arrays gain the batch axis as a view)
+            arrays = zip(_output_arrays(out, shapes_of(self, n)), _batch_shapes(self, n), strict=True)
+            times, positions, velocities = (a.reshape(shape) for a, shape in arrays)
         pieces = []
         f = 0
-        if HAVE_NUMBA and self._forward and 0.0 < dt <= _MAX_MAGNITUDE:
-            buffer = np.empty(len(self._imp), dtype=IMPACT_DTYPE)  # (the loop's copy of the impacts)
-            while f < n:
-                f, stepped, rows = step_frames(*self._frames_args, dt, f, n, times, positions, velocities, buffer, 0)
-                if rows:
-                    pieces.append(buffer[:rows].copy() if f < n else buffer[:rows])
-                if f == n:
-                    break
-                # frame f's impacts did not fit (the next frames get a buffer twice the size), or
-                # its step needs completing, as step completes it
-                if stepped:
-                    pieces.append(self._take_impacts(self._n_imp[0]))
-                    buffer = np.empty(2 * len(buffer), dtype=IMPACT_DTYPE)
-                else:
-                    pieces.append(self._finish(self._run(dt, first_done=True), 1.0, stacklevel=3))
+        buffer = None  # the compiled loop's copy of the impacts
+        while f < n:
+            if not (HAVE_NUMBA and self._forward and 0.0 < dt <= _MAX_MAGNITUDE):
+                # backwards, without a border, or without numba: a step as step takes it (which
+                # may make the next ones forward steps with a border)
+                pieces.append(self._step(dt, True, stacklevel=5))
                 self._record(f, times, positions, velocities)
                 f += 1
-        for rest in range(f, n):  # backwards, without a border, or without numba: step by step
-            pieces.append(self._step(dt, True))
-            self._record(rest, times, positions, velocities)
-        impacts = np.concatenate(pieces) if len(pieces) > 1 else pieces[0] if pieces else _NO_IMPACTS.copy()
+                continue
+            if buffer is None:
+                buffer = np.empty(len(self._imp), dtype=IMPACT_DTYPE)
+            f, stepped, rows = step_frames(*self._frames_args, dt, f, n, times, positions, velocities, buffer, 0)
+            if rows:
+                pieces.append(buffer[:rows].copy())
+            if f == n:
+                break
+            # frame f's impacts did not fit (the next frames get a buffer twice the size), or
+            # its step needs completing, as step completes it
+            if stepped:
+                pieces.append(self._take_impacts(self._n_imp[0]))
+                buffer = np.empty(2 * len(buffer), dtype=IMPACT_DTYPE)
+            else:
+                pieces.append(self._finish(self._run(dt, first_done=True), 1.0, stacklevel=4))
+            self._record(f, times, positions, velocities)
+            f += 1
+        impacts = np.concatenate(pieces) if pieces else _NO_IMPACTS.copy()
         return Frames(times, positions, velocities, impacts)
 
     def _record(self, f, times, positions, velocities):
@@ -611,9 +635,10 @@ class BatchSimulator:
         positions[f] = self._pos
         velocities[f] = self._vel
 
-    def _finish(self, chunks, sign, stacklevel=4):
+    def _finish(self, chunks, sign, stacklevel):
         """Warn about scenes that reached the event cap; the step's impacts as one array.
-        ``stacklevel``: how far up the caller to name is (4 from step: _finish, _step, step)."""
+        ``stacklevel`` names the caller of ``step`` or ``frames`` (4 from step: _finish, _step,
+        step; 5 from a step of frames: _finish, _step, _frames, frames)."""
         if self._n_imp[1]:
             warnings.warn(
                 f"event cap of {self.max_events} per step reached in scene(s) {np.flatnonzero(self._capped).tolist()}; "
@@ -1005,10 +1030,7 @@ class Simulator:
         >>> rec.positions.shape, float(rec.time[-1].round(12)), [(i.wall, round(i.time, 12)) for i in rec.impacts]
         ((120, 1, 2), 2.0, [('right', 0.75)])
         """
-        if out is not None:  # (the batch axis put back, as views)
-            arrays = tuple(out)[:3] if isinstance(out, tuple) else ()
-            out = tuple(a[:, None] if isinstance(a, np.ndarray) and a.ndim else a for a in arrays)
-        rec = self._batch.frames(dt, n, out)
+        rec = self._batch._frames(dt, n, out, _single_shapes)
         return Frames(rec.time[:, 0], rec.positions[:, 0], rec.velocities[:, 0], _impact_list(rec.impacts))
 
     positions = property(lambda self: self._batch._pos[0].copy(), doc="(N, 2) centres, m (a copy).")
@@ -1057,6 +1079,11 @@ class Simulator:
         return new
 
     __copy__ = copy
+
+
+def _single_shapes(sim, n):
+    """The shapes of ``n`` frames of a single simulator (a batch of one without its axis)."""
+    return (n,), (n, sim._n, 2), (n, sim._n, 2)
 
 
 def _impact_list(rows: np.ndarray) -> list[Impact]:

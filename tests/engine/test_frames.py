@@ -8,10 +8,28 @@ import warnings
 import numpy as np
 import pytest
 
+import collision_env.engine.simulator as simulator_module
 from collision_env.engine import BatchSimulator, EventCapWarning, Scene, Simulator
 from tests.engine.test_calendar import gas
 
 FIELDS = ["scene", "time", "ball", "other", "wall", "x", "y", "speed"]
+
+
+@pytest.fixture
+def loop_exits(monkeypatch):
+    """Where each call of the compiled loop stopped: ``(frame, stepped)`` (see ``frames.step_frames``)."""
+    if not simulator_module.HAVE_NUMBA:
+        pytest.skip("the compiled loop is numba's")
+    exits = []
+    compiled = simulator_module.step_frames
+
+    def spy(*args):
+        result = compiled(*args)
+        exits.append((result[0], result[1]))
+        return result
+
+    monkeypatch.setattr(simulator_module, "step_frames", spy)
+    return exits
 
 
 def twin_batches(scene, starts, radii, **options):
@@ -35,18 +53,53 @@ def assert_frames_are_a_step_loop(sim, loop, dt, n):
     np.testing.assert_array_equal(rec.impacts[FIELDS], np.concatenate(steps)[FIELDS])
     np.testing.assert_array_equal(sim.positions, loop.positions)
     np.testing.assert_array_equal(sim.time, loop.time)
+    np.testing.assert_array_equal(sim.cap_reached, loop.cap_reached)
     assert sim.stats == loop.stats
+    for name in ("_cal", "_cal_i", "_cal_heap", "_body", "_clock"):  # the calendar and clusters too
+        np.testing.assert_array_equal(getattr(sim, name), getattr(loop, name))
     return rec
 
 
 @pytest.mark.parametrize("mode", ["exact", "naive", "posteriori"])
-def test_frames_are_a_loop_of_steps(mode):
+def test_frames_are_a_loop_of_steps(mode, loop_exits):
     scene, pos, vel, radii = gas(60, speed=2.0)
     starts = [(pos, vel), (pos, 0.5 * vel), (pos, -vel)]
     sim, loop = twin_batches(scene, starts, radii, mode=mode, substeps=1 if mode == "exact" else 2)
     rec = assert_frames_are_a_step_loop(sim, loop, 1 / 60, 40)
     assert len(rec.impacts) > 100
     assert set(rec.impacts["scene"]) == {0, 1, 2}
+    # the compiled loop ran every frame (handing one back only when its copy of the impacts was full)
+    assert loop_exits[-1] == (40, True) and all(stepped for _, stepped in loop_exits)
+
+
+@pytest.mark.parametrize(
+    "scene",
+    [
+        Scene(bounds=(-0.5, -0.5, 0.5, 0.5), elasticity=0.3),  # contact groups and collapse cascades
+        Scene(bounds=(-0.5, -0.5, 0.5, 0.5), elasticity=0.0, inelastic="stick"),  # rotating clusters
+    ],
+    ids=["cascades", "stick"],
+)
+def test_frames_of_inelastic_scenes_are_a_loop_of_steps(scene, loop_exits):
+    _, pos, vel, radii = gas(12, phi=0.4, r=0.05, speed=2.0)
+    sim, loop = twin_batches(scene, [(pos, vel), (pos, 0.5 * vel)], radii)
+    assert_frames_are_a_step_loop(sim, loop, 1 / 60, 9)
+    if scene.sticky:  # clusters formed (and rotate: their scenes are predicted afresh every step)
+        assert (sim.clusters != np.arange(12)).any()
+    assert_frames_are_a_step_loop(sim, loop, 1 / 60, 80)
+    assert loop_exits[-1] == (80, True) and all(stepped for _, stepped in loop_exits)
+
+
+def test_frames_after_a_backward_step_go_back_to_the_compiled_loop(loop_exits):
+    scene, pos, vel, radii = gas(30, speed=2.0)
+    sim, loop = twin_batches(scene, [(pos, vel)], radii)
+    for b in (sim, loop):
+        b.step(0.3)
+        b.nudge(np.full((1, 30, 2), 0.1))
+    assert_frames_are_a_step_loop(sim, loop, -1 / 60, 5)  # backwards: step by step
+    assert loop_exits == []
+    assert_frames_are_a_step_loop(sim, loop, 1 / 60, 20)  # the first step turns time forward again
+    assert loop_exits == [(20, True)]
 
 
 @pytest.mark.parametrize(
@@ -57,7 +110,7 @@ def test_frames_are_a_loop_of_steps(mode):
         (0.05, 12, 40, 12),  # and the event cap stops every frame's step early
     ],
 )
-def test_frames_past_full_impact_buffers_and_the_event_cap(dt, n, max_events, capped_steps):
+def test_frames_past_full_impact_buffers_and_the_event_cap(dt, n, max_events, capped_steps, loop_exits):
     """A small impact buffer (300 rows) makes the kernel stall mid-step, or the frames' copy of
     the impacts fill up; an event cap stops scenes early. Python completes those frames as step
     completes a step."""
@@ -73,6 +126,19 @@ def test_frames_past_full_impact_buffers_and_the_event_cap(dt, n, max_events, ca
     capped = [w for w in caught if issubclass(w.category, EventCapWarning)]
     assert len(capped) == 2 * capped_steps  # a warning per step, from either
     assert all(w.filename == __file__ for w in capped)  # (each names the caller)
+    if dt < 0.01:  # the loop's own copy fills up after a few frames: it hands over a stepped frame
+        assert any(stepped for f, stepped in loop_exits if f < n) and loop_exits[-1] == (n, True)
+    else:  # the kernel's buffer fills up in every frame: Python completes each
+        assert loop_exits == [(f, False) for f in range(n)]
+
+
+@pytest.mark.parametrize("dt", [0.05, -0.05], ids=["compiled loop", "step by step"])
+def test_a_single_simulators_event_cap_warning_names_the_caller(dt):
+    scene, pos, vel, radii = gas(60, speed=3.0)
+    sim = Simulator(scene, pos, vel, np.ones(60), radii=radii, max_events=5)
+    with pytest.warns(EventCapWarning) as caught:
+        sim.frames(dt, 2)
+    assert len(caught) == 2 and all(w.filename == __file__ for w in caught)
 
 
 @pytest.mark.parametrize("case", ["backwards", "no border"])
@@ -120,7 +186,7 @@ def test_frames_record_into_the_arrays_they_are_given():
     sim, loop = twin_batches(scene, [(pos, vel), (pos, -vel)], radii)
     first = sim.frames(0.02, 30)
     again = sim.frames(0.02, 30, out=first)
-    assert again.positions is first.positions and again.time is first.time
+    assert np.shares_memory(again.positions, first.positions) and np.shares_memory(again.time, first.time)
     loop.frames(0.02, 30)
     want = loop.frames(0.02, 30)
     for got, expected in zip(again[:3], want[:3], strict=True):
@@ -137,13 +203,17 @@ def test_frames_refuse_arrays_they_cannot_record_into():
     good = (np.empty((5, 1)), np.empty((5, 1, 10, 2)), np.empty((5, 1, 10, 2)))
     before = sim.get_state()
     for out, match in (
-        ([good[0], good[1], good[2]], "out: expected a Frames or a tuple"),
+        ({"time": good[0]}, "out: expected a Frames or a tuple"),
         (good[:2], "out: expected a Frames or a tuple"),
         ((np.empty((4, 1)), good[1], good[2]), r"out: time must be .* shape \(5, 1\)"),
         ((good[0], good[1].astype(np.float32), good[2]), "out: positions must be .* float64"),
         ((good[0], good[1], np.empty((5, 1, 10, 4))[..., :2]), "out: velocities must be .* C-contiguous"),
+        ((good[0], good[1], good[1]), "out: positions and velocities must not share memory"),
     ):
         with pytest.raises(ValueError, match=match):
             sim.frames(0.1, 5, out=out)
     for key, value in sim.get_state().items():
         np.testing.assert_array_equal(value, before[key])
+    single = Simulator(scene, pos, vel, np.ones(10), radii=radii)
+    with pytest.raises(ValueError, match=r"out: time must be .* of shape \(5,\), got float64 \(5, 1\)"):
+        single.frames(0.1, 5, out=good)  # (a batch's arrays, not a single simulator's)
