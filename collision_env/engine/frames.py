@@ -37,6 +37,19 @@ def copy_impacts(buf, out, sign):
             j -= 1
 
 
+@njit(refcount=False)
+def record_frame(f, balls, time, times, positions, velocities):
+    """Frame ``f`` of the caller's arrays: every scene's clock, positions and velocities now."""
+    n_scenes, n = balls.shape[0], balls.shape[1]
+    for sc in range(n_scenes):
+        times[f, sc] = time[sc]
+        for i in range(n):
+            positions[f, sc, i, 0] = balls[sc, i, B_X]
+            positions[f, sc, i, 1] = balls[sc, i, B_X + 1]
+            velocities[f, sc, i, 0] = balls[sc, i, B_VX]
+            velocities[f, sc, i, 1] = balls[sc, i, B_VX + 1]
+
+
 if HAVE_NUMBA:
     import numpy as np
 
@@ -44,18 +57,6 @@ if HAVE_NUMBA:
     from .exact import START_NEXT, START_STEP, step_exact_packed
     from .layout import IMPACT_DTYPE
     from .substep import step_substeps_packed
-
-    @njit(refcount=False)
-    def record_frame(f, balls, time, times, positions, velocities):
-        """Frame ``f`` of the caller's arrays: every scene's clock, positions and velocities now."""
-        n_scenes, n = balls.shape[0], balls.shape[1]
-        for sc in range(n_scenes):
-            times[f, sc] = time[sc]
-            for i in range(n):
-                positions[f, sc, i, 0] = balls[sc, i, B_X]
-                positions[f, sc, i, 1] = balls[sc, i, B_X + 1]
-                velocities[f, sc, i, 0] = balls[sc, i, B_VX]
-                velocities[f, sc, i, 1] = balls[sc, i, B_VX + 1]
 
     @njit
     def step_frames(mode, k_total, h, dt, first, n_frames, times, positions, velocities, out, n_out):

@@ -21,7 +21,7 @@ from ._jit import BACKEND, HAVE_NUMBA
 from .argpack import pack
 from .calendar import heap_rows
 from .exact import COUNTERS, RESUME, START_STEP, impacts_per_event, scratch_sizes, step_exact
-from .frames import EXACT, copy_impacts
+from .frames import EXACT, copy_impacts, record_frame
 
 if HAVE_NUMBA:
     from .exact import step_exact_packed
@@ -171,6 +171,12 @@ def _real_number(value, field):
             f"{field}: expected a number (real, not a boolean or a string), got {value!r} ({type(value).__name__})"
         )
     return float(value)
+
+
+def _check_seconds(value, field):
+    """A time or a step (s), already a float: finite and at most ``_MAX_MAGNITUDE``."""
+    if not abs(value) <= _MAX_MAGNITUDE:
+        raise ValueError(f"{field}: must be finite and at most {_MAX_MAGNITUDE:g} s, got {value}")
 
 
 def _real_array(value, shapes, field, where):
@@ -531,8 +537,7 @@ class BatchSimulator:
             if rows >= 0:  # no scene stalled or reached the event cap
                 return self._take_impacts(rows, copy) if rows else _NO_IMPACTS
             return self._finish(self._run(dt, first_done=True), 1.0, stacklevel)
-        if not abs(dt) <= _MAX_MAGNITUDE:
-            raise ValueError(f"dt: must be finite and at most {_MAX_MAGNITUDE:g} s, got {dt}")
+        _check_seconds(dt, "dt")
         if self.scene.bounds is None:
             self._check_reach(dt)
         e = self.scene.elasticity
@@ -590,8 +595,7 @@ class BatchSimulator:
         caller documents; its arrays are then viewed with the batch axis). Called straight from
         each public ``frames``, so that a warning names their caller."""
         dt = _real_number(dt, "dt")
-        if not abs(dt) <= _MAX_MAGNITUDE:
-            raise ValueError(f"dt: must be finite and at most {_MAX_MAGNITUDE:g} s, got {dt}")
+        _check_seconds(dt, "dt")
         if isinstance(n, (bool, np.bool_)) or not isinstance(n, numbers.Integral) or n < 0:
             raise ValueError(f"n: must be a whole number of steps (0 or more), got {n!r}")
         n = int(n)
@@ -608,7 +612,7 @@ class BatchSimulator:
                 # backwards, without a border, or without numba: a step as step takes it (which
                 # may make the next ones forward steps with a border)
                 pieces.append(self._step(dt, True, stacklevel=5))
-                self._record(f, times, positions, velocities)
+                record_frame(f, self._balls, self._time, times, positions, velocities)
                 f += 1
                 continue
             if buffer is None:
@@ -625,15 +629,10 @@ class BatchSimulator:
                 buffer = np.empty(2 * len(buffer), dtype=IMPACT_DTYPE)
             else:
                 pieces.append(self._finish(self._run(dt, first_done=True), 1.0, stacklevel=4))
-            self._record(f, times, positions, velocities)
+            record_frame(f, self._balls, self._time, times, positions, velocities)
             f += 1
         impacts = np.concatenate(pieces) if pieces else _NO_IMPACTS.copy()
         return Frames(times, positions, velocities, impacts)
-
-    def _record(self, f, times, positions, velocities):
-        times[f] = self._time
-        positions[f] = self._pos
-        velocities[f] = self._vel
 
     def _finish(self, chunks, sign, stacklevel):
         """Warn about scenes that reached the event cap; the step's impacts as one array.
@@ -832,8 +831,7 @@ class BatchSimulator:
         nothing changes.
         """
         time = _real_number(time, "time")
-        if not abs(time) <= _MAX_MAGNITUDE:
-            raise ValueError(f"time: must be finite and at most {_MAX_MAGNITUDE:g} s, got {time}")
+        _check_seconds(time, "time")
         idx = np.arange(self._n_scenes)[index]
         idx = np.atleast_1d(idx)
         if masses is None:
