@@ -15,7 +15,8 @@ the cheaper engine save?
 
 Part **presets**: every registered preset is trained in exact mode over the same seeds and set
 beside the random and the scripted (exact-aim) baselines on the same evaluation episodes; a preset
-whose shipped entry trains on the predicted observation is trained on the plain one too.
+whose shipped entry trains on the predicted observation is trained on the plain one too, and one
+whose entry uses velocity control is trained with nudges too (``--variants``).
 
 Every run records where its training time went (``agents.timing``); the time-split table shows it,
 and the closing rule says when a cheaper engine mode can pay. ``--add`` adds runs to an earlier
@@ -100,6 +101,7 @@ def train_and_evaluate(task: dict) -> dict:
         "timesteps_done": run["timesteps_done"],
         "time_split": run["time_split"],
         "observe": run["env_kwargs"].get("observe", "plain"),
+        "control": run["env_kwargs"].get("control", "nudge"),
     }
     exact = evaluate(run_dir, episodes=task["episodes"], mode="exact", baselines=())
     out["exact"] = exact["policies"]["ppo"]
@@ -240,14 +242,14 @@ def modes_reading(rows: list) -> str:
 
 
 def _by_preset(rows: list, base: list) -> dict:
-    """{(env_id, observation): [presets-part rows sorted by seed]}, presets in registration order."""
+    """{(env_id, setting): [presets-part rows sorted by seed]}, presets in registration order."""
     from collision_env.envs import PRESET_IDS
 
     order = list(PRESET_IDS.values())
     groups: dict = {}
     for r in sorted(rows, key=lambda r: order.index(r["env_id"]) if r["env_id"] in order else len(order)):
         if r["part"] == "presets":
-            groups.setdefault((r["env_id"], r["observe"]), []).append(r)
+            groups.setdefault((r["env_id"], _setting(r)), []).append(r)
     for rs in groups.values():
         rs.sort(key=lambda r: r["seed"])
     return groups
@@ -263,22 +265,24 @@ def presets_table(rows: list, base: list) -> str:
         f"Every preset, PPO in exact mode with the shipped hyperparameters, beside the baselines on the same "
         f"{episodes} evaluation episodes (success rate; mean return in brackets). PPO: mean ± standard "
         "deviation over seeds, then each seed; training time: median over seeds, with the engine's share of it. "
-        "Observation: the one the shipped entry trains on (marked *shipped*), and the plain one beside it where the "
-        "entry changes it (`predicted`: the env's `observe=\"predicted\"`, each ball's next wall impact as the "
-        "engine predicts it; the plain row keeps the entry's other env settings, such as an aiming term taken from "
-        "the prediction).",
+        "Setting: the observation and the control the shipped entry trains with (marked *shipped*), and beside it "
+        'the plain observation where the entry changes it (`predicted`: the env\'s `observe="predicted"`, each '
+        "ball's next wall impact as the engine predicts it; the plain row keeps the entry's other env settings, "
+        "such as an aiming term taken from the prediction) and nudges where the entry uses velocity control "
+        "(`nudge`: the action is each step's velocity change; `velocity`: the env's `control=\"velocity\"`, the "
+        "velocity to steer to and an engage flag).",
         "",
-        "| env | observation | steps | PPO success | per seed | PPO return | random | scripted (exact aim) | "
+        "| env | setting | steps | PPO success | per seed | PPO return | random | scripted (exact aim) | "
         "training time (s) | engine's share |",
         "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     fmt = lambda p: "n/a" if p is None else f"{pct(p['success_rate'])} ({p['mean_return']:.2f})"  # noqa: E731
-    for (env_id, observe), rs in groups.items():
+    for (env_id, setting), rs in groups.items():
         succ = [r["exact"]["success_rate"] for r in rs]
         ret = statistics.fmean(r["exact"]["mean_return"] for r in rs)
         b = by_env.get(env_id, {})
         shipped = not rs[0].get("env_kwargs")
-        label = f"{observe} (*shipped*)" if shipped else observe
+        label = f"{setting} (*shipped*)" if shipped else setting
         lines.append(
             f"| `{env_id}` | {label} | {rs[0]['timesteps_done']:,} | {_spread(succ)} | "
             f"{' / '.join(pct(x) for x in succ)} | {ret:.2f} | {fmt(b.get('random'))} | "
@@ -288,14 +292,14 @@ def presets_table(rows: list, base: list) -> str:
 
 
 def split_table(rows: list) -> str:
-    """Where the training time went, per preset, observation and mode (median shares over seeds)."""
+    """Where the training time went, per preset, setting and mode (median shares over seeds)."""
     from agents.timing import PARTS
     from collision_env.envs import PRESET_IDS
 
     order = list(PRESET_IDS.values())
     groups: dict = {}
     for r in sorted(rows, key=lambda r: order.index(r["env_id"]) if r["env_id"] in order else len(order)):
-        key = (r["env_id"], r["observe"], r["mode"], r["substeps"])
+        key = (r["env_id"], _setting(r), r["mode"], r["substeps"])
         runs = groups.setdefault(key, {})
         runs[r["run"]] = r  # a run counted in both parts is one run
     if not groups:
@@ -304,23 +308,23 @@ def split_table(rows: list) -> str:
         "Where the training time goes (`agents.timing`: timers around the engine's step, the env's step, the "
         "policy's forward passes and PPO's update, in every training run above; median share over seeds):",
         "",
-        "| env | observation | trained in | training time (s) | " + " | ".join(PARTS) + " |",
+        "| env | setting | trained in | training time (s) | " + " | ".join(PARTS) + " |",
         "|---|---|---|---:|" + "---:|" * len(PARTS),
     ]
-    for (env_id, observe, mode, k), runs in groups.items():
+    for (env_id, setting, mode, k), runs in groups.items():
         rs = list(runs.values())
         cells = []
         for part in PARTS:
             shares = [r["time_split"][part] / r["train_seconds"] for r in rs if r["time_split"][part] is not None]
             cells.append(_share(statistics.median(shares) if shares else None))
-        lines.append(f"| `{env_id}` | {observe} | {_label(mode, k)} | {_seconds(rs):.0f} | " + " | ".join(cells) + " |")
+        lines.append(f"| `{env_id}` | {setting} | {_label(mode, k)} | {_seconds(rs):.0f} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 
 def rule(rows: list, base: list) -> str:
     """The rule for choosing a training mode, stated with this study's figures."""
     shares = {
-        env: _engine_share(rs) for (env, observe), rs in _by_preset(rows, base).items() if not rs[0].get("env_kwargs")
+        env: _engine_share(rs) for (env, setting), rs in _by_preset(rows, base).items() if not rs[0].get("env_kwargs")
     }
     shares = {env: f for env, f in shares.items() if f is not None}
     lines = []
@@ -463,10 +467,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--presets", nargs="+", help="ids of the presets part (default: every preset)")
     p.add_argument("--seeds", nargs="+", type=int, default=list(DEFAULT_SEEDS))
     p.add_argument(
-        "--observations",
-        choices=("both", "shipped", "plain"),
+        "--variants",
+        choices=("both", "shipped", "alternatives"),
         default="both",
-        help="presets part: the shipped entry, the plain observation beside a predicted one, or both",
+        help="presets part: the shipped entry, the alternatives beside it (the plain observation beside a predicted "
+        "one, nudges beside velocity control), or both",
     )
     p.add_argument("--timesteps", type=float, help="override every entry's n_timesteps (quick looks)")
     p.add_argument("--episodes", type=int, default=100)
@@ -539,7 +544,7 @@ def main(argv: list[str] | None = None) -> dict:
                     "env_kwargs": kwargs,
                     **common,
                 }
-                for kwargs in variants(env_id, args.observations)
+                for kwargs in variants(env_id, args.variants)
                 for s in seeds
                 if kwargs or not (args.part == "both" and env_id in envs and ("exact", 1) in modes)
             ]
@@ -583,18 +588,27 @@ def main(argv: list[str] | None = None) -> dict:
 
 
 def variants(env_id: str, which: str = "both") -> list:
-    """The env keywords the presets part trains ``env_id`` with: the shipped entry (``{}``) and, when
-    the entry changes the observation, the plain one too (so both are reported); ``which`` picks
-    ``"shipped"``, ``"plain"`` (none when the entry is plain already) or ``"both"``."""
-    shipped = (hyperparams_for(env_id).get("env_kwargs") or {}).get("observe", "plain")
+    """The env keywords the presets part trains ``env_id`` with: the shipped entry (``{}``) and its
+    alternatives, each changing one setting back to the env's default (so both are reported): the
+    plain observation when the entry trains on the predicted one, nudges when it uses velocity
+    control. ``which`` picks ``"shipped"``, ``"alternatives"`` or ``"both"``."""
+    entry = hyperparams_for(env_id).get("env_kwargs") or {}
     out = [{}] if which in ("both", "shipped") else []
-    if shipped != "plain" and which in ("both", "plain"):
-        out.append({"observe": "plain"})
+    if which in ("both", "alternatives"):
+        if entry.get("observe", "plain") != "plain":
+            out.append({"observe": "plain"})
+        if entry.get("control", "nudge") != "nudge":
+            out.append({"control": "nudge"})
     return out
 
 
+def _setting(row: dict) -> str:
+    """What a presets row trained on: its observation and its control."""
+    return f"{row['observe']}, {row.get('control', 'nudge')}"
+
+
 def _cell(row: dict) -> tuple:
-    return (row["part"], row["env_id"], row["mode"], row["substeps"], row["seed"], row["observe"])
+    return (row["part"], row["env_id"], row["mode"], row["substeps"], row["seed"], _setting(row))
 
 
 def _added(path: Path, rows: list, base: list, minutes: float) -> tuple:

@@ -23,6 +23,8 @@ from collision_env.envs._layout import BALL_OBS, GLOBAL_OBS, PREDICTED_OBS, TARG
 OBSERVATIONS = ("plain", "predicted")
 OBSERVED_BALLS = ("all", "controlled")
 AIMS = ("straight", "predicted")
+#: What an action component means: a velocity change, or a velocity the ball is steered to (see TaskConfig).
+CONTROLS = ("nudge", "velocity")
 SCORERS = ("any", "controlled", "others", "cluster")
 LAYOUTS = ("random", "rack")
 RADIUS_RULES = ("mass", "constant")
@@ -84,7 +86,12 @@ class TaskConfig:
     Control:
         ``controlled`` (indices of the nudged balls); ``dt`` (control step, s of simulated time);
         ``max_dv`` (largest velocity change per action component and step, m/s); ``max_speed``
-        (a nudge never pushes a ball above max(max_speed, its current speed)).
+        (a nudge never pushes a ball above max(max_speed, its current speed)); ``control`` ("nudge":
+        per controlled ball, one action component per axis, each a velocity change of up to
+        ``max_dv``; "velocity": per controlled ball, the velocity to steer it to, each component over
+        ``max_speed``, then an engage flag: while the flag is > 0 the env nudges the ball towards that
+        velocity, by at most ``max_dv`` per axis and step along the straight line to it, and while it is
+        <= 0 the ball coasts. The same nudges, limits and cost; only what the agent names differs).
     Targets:
         ``n_targets``; ``sequential`` (show and score one target at a time, else all at once);
         ``target_width`` (m); ``target_walls`` (walls targets may sit on; ``None`` = all walls of
@@ -123,6 +130,7 @@ class TaskConfig:
     speed_range: tuple = (0.3, 0.8)
     others_speed_range: tuple = (0.0, 0.0)
     controlled: tuple = (0,)
+    control: str = "nudge"
     dt: float = 0.05
     max_dv: float = 0.15
     max_speed: float = 2.0
@@ -195,6 +203,8 @@ class TaskConfig:
         if not ctrl or len(set(ctrl)) != len(ctrl) or not all(0 <= i < self.n_balls for i in ctrl):
             raise ValueError(f"controlled: need distinct ball indices in [0, {self.n_balls}), got {self.controlled!r}")
         s("controlled", ctrl)
+        if self.control not in CONTROLS:
+            raise ValueError(f"control: expected one of {CONTROLS}, got {self.control!r}")
         s("dt", _number("dt", self.dt, low=0.0, strict_low=True))
         s("max_dv", _number("max_dv", self.max_dv, low=0.0))
         s("max_speed", _number("max_speed", self.max_speed, low=0.0, strict_low=True))
@@ -271,7 +281,12 @@ class TaskConfig:
 
     @property
     def action_dim(self) -> int:
-        return len(self.controlled) * self.dimension
+        return len(self.controlled) * self.per_ball_action
+
+    @property
+    def per_ball_action(self) -> int:
+        """Action components per controlled ball: one per axis, and the engage flag with ``control="velocity"``."""
+        return self.dimension + (self.control == "velocity")
 
     @property
     def target_slots(self) -> int:

@@ -275,6 +275,7 @@ class TaskCore:
             sticky=int(self.scene.sticky),
             observe_predicted=int(cfg.observe == "predicted"),
             aim_predicted=int(cfg.aim == "predicted" and cfg.shaping != 0.0),
+            velocity_control=int(cfg.control == "velocity"),
         )
         self.ctrl = np.array(cfg.controlled, dtype=np.int64)
         self.qual = cfg.scoring_mask

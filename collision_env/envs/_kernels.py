@@ -87,17 +87,39 @@ def _capped_change(vx, vy, dx, dy, max_speed):  # pragma: no cover - numba
     return nx - vx, ny - vy
 
 
+@njit(inline="always")
+def _requested_change(a, o, dim, velocity_control, vx, vy, max_dv, max_speed):  # pragma: no cover - numba
+    """The velocity change one controlled ball's action components ``a[o:]`` ask for, each axis
+    within ``max_dv``: with nudge control the components times ``max_dv``; with velocity control the
+    step along the straight line from (vx, vy) to the named velocity (components times
+    ``max_speed``), shortened until no axis exceeds ``max_dv``, or none when the engage flag is <= 0."""
+    ax = _clip1(a[o])
+    ay = _clip1(a[o + 1]) if dim == 2 else 0.0
+    if not velocity_control:
+        return ax * max_dv, ay * max_dv
+    if not a[o + dim] > 0.0:
+        return 0.0, 0.0
+    dx = ax * max_speed - vx
+    dy = ay * max_speed - vy if dim == 2 else 0.0
+    longest = max(abs(dx), abs(dy))
+    if longest > max_dv:
+        f = max_dv / longest
+        dx *= f
+        dy *= f
+    return dx, dy
+
+
 @njit(refcount=False)
 def nudge_kernel(actions, active, balls, body, ctrl, P, Q, dv, S):  # pragma: no cover - numba
-    """Scale actions to velocity changes ``dv`` (B, N, 2) and their size ``S[:, nudge]``, and apply
+    """Turn actions into velocity changes ``dv`` (B, N, 2) and their size ``S[:, nudge]``, and apply
     them to the engine's balls with the engine's own impulse kernel.
 
     Returns -1, or the first active row holding a NaN (then nothing is written). Only the controlled
     balls' entries of ``dv`` are written (the others must be zero).
-    Each action component is clipped to [-1, 1] and multiplied by ``max_dv``. The nudge never
-    raises a ball's speed above max(max_speed, current speed). ``nudge`` is the requested |dv|
-    (after clipping), summed over the controlled balls, in m/s; the task kernel charges
-    ``action_cost`` times it.
+    Each action component is clipped to [-1, 1]; :func:`_requested_change` reads a ball's
+    components as ``TaskConfig.control`` says. The nudge never raises a ball's speed above
+    max(max_speed, current speed). ``nudge`` is the requested |dv|, summed over the controlled
+    balls, in m/s; the task kernel charges ``action_cost`` times it.
     Rows with ``active`` False get no nudge and no cost.
     """
     bad = _first_nan_row(actions, active)
@@ -105,6 +127,8 @@ def nudge_kernel(actions, active, balls, body, ctrl, P, Q, dv, S):  # pragma: no
         return bad  # reject the whole call before changing anything
     _, vel, _, _, _, _ = ball_views(balls)
     dim = Q[SWITCHES.dimension]
+    velocity_control = Q[SWITCHES.velocity_control] != 0
+    per_ball = dim + 1 if velocity_control else dim
     max_dv = P[PARAMS.max_dv]
     max_speed = P[PARAMS.max_speed]
     for b in range(actions.shape[0]):
@@ -115,10 +139,9 @@ def nudge_kernel(actions, active, balls, body, ctrl, P, Q, dv, S):  # pragma: no
                 dv[b, i, 0] = 0.0
                 dv[b, i, 1] = 0.0
                 continue
-            ax = _clip1(actions[b, c * dim])
-            ay = _clip1(actions[b, c * dim + 1]) if dim == 2 else 0.0
-            dx = ax * max_dv
-            dy = ay * max_dv
+            dx, dy = _requested_change(
+                actions[b], c * per_ball, dim, velocity_control, vel[b, i, 0], vel[b, i, 1], max_dv, max_speed
+            )
             requested += math.sqrt(dx * dx + dy * dy)
             cdx, cdy = _capped_change(vel[b, i, 0], vel[b, i, 1], dx, dy, max_speed)
             dv[b, i, 0] = cdx

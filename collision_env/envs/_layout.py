@@ -65,6 +65,7 @@ SWITCHES = layout(
         ("sticky", "1: the engine merges colliding balls (the nudge moves whole clusters)"),
         ("observe_predicted", "1: the observation ends with the engine's predicted impacts"),
         ("aim_predicted", "1: the aiming potential phi uses the engine's predicted impacts"),
+        ("velocity_control", "1: each controlled ball's action is a velocity to steer to and an engage flag"),
     ),
 )
 

@@ -141,6 +141,29 @@ class SteeringPolicy(AimingPolicy):
 # --------------------------------------------------------------------------------------------- #
 
 
+def no_nudge(env) -> np.ndarray:
+    """The nudge action that changes nothing."""
+    cfg = env.config
+    return np.zeros(len(cfg.controlled) * cfg.dimension, np.float32)
+
+
+def as_env_action(env, nudge) -> np.ndarray:
+    """A nudge action (velocity changes over ``max_dv``, as every policy here plans them) in the
+    form ``env``'s ``control`` reads: unchanged for "nudge"; for "velocity", per controlled ball
+    the velocity the nudge leads to (over ``max_speed``) and the engage flag, set when the nudge
+    is not zero. A plan and the episode that follows it convert alike, so they stay identical."""
+    cfg = env.config
+    if cfg.control == "nudge":
+        return nudge
+    dim = cfg.dimension
+    a = np.clip(np.asarray(nudge, np.float64).reshape(len(cfg.controlled), dim), -1.0, 1.0)
+    v = env.core.vel[0, list(cfg.controlled), :dim]
+    out = np.empty((len(cfg.controlled), dim + 1), np.float32)
+    out[:, :dim] = np.clip((v + a * cfg.max_dv) / cfg.max_speed, -1.0, 1.0)
+    out[:, dim] = np.where((a != 0.0).any(axis=1), 1.0, -1.0)
+    return out.ravel()
+
+
 def push(direction, steps: int, delay: int = 0) -> Plan:
     """A plan: full action along ``direction`` for ``steps`` steps after ``delay``, then nothing."""
     d = np.asarray(direction, np.float32)
@@ -168,7 +191,7 @@ def shoot(env, plans, horizon: int, planner=None):
         planner.set_state(start)
         hits = int((planner.core.t_status[0] == TARGET_HIT).sum())
         for t in range(horizon):
-            _, _, term, trunc, info = planner.step(plan(t, planner))
+            _, _, term, trunc, info = planner.step(as_env_action(planner, plan(t, planner)))
             if info["targets_hit"] > hits:
                 return plan, t, info["impacts"].records.copy()
             if term or trunc:
@@ -263,7 +286,7 @@ class ShootingPolicy:
             self.wait -= 1
             if self.fallback is not None:
                 return self.fallback(env)
-            return np.zeros(env.action_space.shape, np.float32)
+            return no_nudge(env)
         action = self.plan(self.t, env)
         self.t += 1
         if self.t > self.hit_step:
@@ -274,9 +297,17 @@ class ShootingPolicy:
 def scripted_policy(env):
     """A scripted policy for the env's preset (``None`` when there is none): ``policy(obs) -> action``.
 
-    ``env`` is a ``gym.make`` env or the bare env; the policy reads the state of the bare env.
+    ``env`` is a ``gym.make`` env or the bare env; the policy reads the state of the bare env. It
+    plans nudges and hands them over in the form the env's ``control`` reads (:func:`as_env_action`).
     """
     env = env.unwrapped
+    policy = _nudge_policy(env)
+    if policy is None or env.config.control == "nudge":
+        return policy
+    return lambda obs=None: as_env_action(env, policy(obs))
+
+
+def _nudge_policy(env):
     cfg = env.config
     if (
         cfg.dimension == 2
@@ -290,7 +321,7 @@ def scripted_policy(env):
     if cfg.scorers == "cluster":
 
         def ram_first(e):
-            return np.zeros(e.action_space.shape, np.float32) if stuck(e) else ram(e)
+            return no_nudge(e) if stuck(e) else ram(e)
 
         return ShootingPolicy(env, cluster_plans, fallback=ram_first)
     if cfg.scorers == "others":

@@ -39,6 +39,14 @@ class CollisionTargetEnv(gym.Env):
     [-1, 1]; an action containing NaN raises `ValueError`. A nudge never raises a ball's speed above
     `max(max_speed, its current speed)` (the change is scaled back along the new velocity).
 
+    With `control="velocity"` the action names, for each controlled ball, the velocity to steer it
+    to and an engage flag: `Box(-1, 1, (len(controlled) * (dimension + 1),), float32)`, per ball
+    (ux, uy, engage) in 2D or (ux, engage) in 1D. While `engage > 0` the ball is nudged towards the
+    velocity `u * max_speed`, along the straight line to it and by at most `max_dv` per axis and
+    step; while `engage <= 0` it coasts. The nudge, its limits and its cost are those of a nudge
+    action; the agent names where the velocity should go instead of each step's change, so aiming
+    a shot is one output instead of a sum of many.
+
     ## Observation Space
 
     `Box(-1, 1, (D,), float32)` with a fixed layout, `D = 6 N + 10 S + 2` (N observed balls: every

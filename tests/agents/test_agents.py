@@ -346,6 +346,15 @@ def test_study_writes_tables_plot_and_readme_block(tmp_path):
     assert {r["run"] for r in more["rows"]} == {r["run"] for r in data["rows"]}  # the same cell, replaced
 
 
+def test_study_variants_change_one_setting_of_the_entry_back_to_the_default():
+    # Billiards' entry trains on the predicted observation with velocity control
+    assert study.variants("CollisionEnv/Billiards-v0") == [{}, {"observe": "plain"}, {"control": "nudge"}]
+    assert study.variants("CollisionEnv/Billiards-v0", "alternatives") == [{"observe": "plain"}, {"control": "nudge"}]
+    assert study.variants("CollisionEnv/InelasticCluster-v0", "both") == [{}, {"observe": "plain"}]
+    assert study.variants("CollisionEnv/OneBallTarget-v0", "both") == [{}]
+    assert study.variants("CollisionEnv/OneBallTarget-v0", "alternatives") == []
+
+
 # --------------------------------------------------------------------------------------- bad input
 @pytest.mark.parametrize(
     "module, args, message",
