@@ -242,12 +242,17 @@ def modes_reading(rows: list) -> str:
 
 
 def _by_preset(rows: list, base: list) -> dict:
-    """{(env_id, setting): [presets-part rows sorted by seed]}, presets in registration order."""
+    """{(env_id, setting): [presets-part rows sorted by seed]}, presets in registration order, each
+    preset's shipped setting first."""
     from collision_env.envs import PRESET_IDS
 
     order = list(PRESET_IDS.values())
+
+    def place(r):
+        return (order.index(r["env_id"]) if r["env_id"] in order else len(order), bool(r.get("env_kwargs")))
+
     groups: dict = {}
-    for r in sorted(rows, key=lambda r: order.index(r["env_id"]) if r["env_id"] in order else len(order)):
+    for r in sorted(rows, key=place):
         if r["part"] == "presets":
             groups.setdefault((r["env_id"], _setting(r)), []).append(r)
     for rs in groups.values():
