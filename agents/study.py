@@ -241,18 +241,19 @@ def modes_reading(rows: list) -> str:
     return "\n".join(out)
 
 
-def _by_preset(rows: list, base: list) -> dict:
-    """{(env_id, setting): [presets-part rows sorted by seed]}, presets in registration order, each
-    preset's shipped setting first."""
+def _place(row: dict) -> tuple:
+    """Where a row goes in a table: presets in registration order, each preset's shipped setting first."""
     from collision_env.envs import PRESET_IDS
 
     order = list(PRESET_IDS.values())
+    return (order.index(row["env_id"]) if row["env_id"] in order else len(order), bool(row.get("env_kwargs")))
 
-    def place(r):
-        return (order.index(r["env_id"]) if r["env_id"] in order else len(order), bool(r.get("env_kwargs")))
 
+def _by_preset(rows: list, base: list) -> dict:
+    """{(env_id, setting): [presets-part rows sorted by seed]}, presets in registration order, each
+    preset's shipped setting first."""
     groups: dict = {}
-    for r in sorted(rows, key=place):
+    for r in sorted(rows, key=_place):
         if r["part"] == "presets":
             groups.setdefault((r["env_id"], _setting(r)), []).append(r)
     for rs in groups.values():
@@ -272,10 +273,11 @@ def presets_table(rows: list, base: list) -> str:
         "deviation over seeds, then each seed; training time: median over seeds, with the engine's share of it. "
         "Setting: the observation and the control the shipped entry trains with (marked *shipped*), and beside it "
         'the plain observation where the entry changes it (`predicted`: the env\'s `observe="predicted"`, each '
-        "ball's next wall impact as the engine predicts it; the plain row keeps the entry's other env settings, "
-        "such as an aiming term taken from the prediction) and nudges where the entry uses velocity control "
+        "ball's next wall impact as the engine predicts it) and nudges where the entry uses velocity control "
         "(`nudge`: the action is each step's velocity change; `velocity`: the env's `control=\"velocity\"`, the "
-        "velocity to steer to and an engage flag).",
+        "velocity to steer to and an engage flag). Every row keeps the entry's other env settings, such as an "
+        "aiming term taken from the prediction. The random and scripted baselines play the env's defaults "
+        "(plain observation, nudges; the scripted policy's shots land alike under either control).",
         "",
         "| env | setting | steps | PPO success | per seed | PPO return | random | scripted (exact aim) | "
         "training time (s) | engine's share |",
@@ -299,11 +301,9 @@ def presets_table(rows: list, base: list) -> str:
 def split_table(rows: list) -> str:
     """Where the training time went, per preset, setting and mode (median shares over seeds)."""
     from agents.timing import PARTS
-    from collision_env.envs import PRESET_IDS
 
-    order = list(PRESET_IDS.values())
     groups: dict = {}
-    for r in sorted(rows, key=lambda r: order.index(r["env_id"]) if r["env_id"] in order else len(order)):
+    for r in sorted(rows, key=_place):
         key = (r["env_id"], _setting(r), r["mode"], r["substeps"])
         runs = groups.setdefault(key, {})
         runs[r["run"]] = r  # a run counted in both parts is one run

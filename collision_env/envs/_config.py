@@ -91,7 +91,8 @@ class TaskConfig:
         ``max_dv``; "velocity": per controlled ball, the velocity to steer it to, each component over
         ``max_speed``, then an engage flag: while the flag is > 0 the env nudges the ball towards that
         velocity, by at most ``max_dv`` per axis and step along the straight line to it, and while it is
-        <= 0 the ball coasts. The same nudges, limits and cost; only what the agent names differs).
+        <= 0 the ball coasts. The same ``max_dv``, speed cap and cost per m/s; the step charged is
+        the one asked for, and a named velocity reaches at most ``max_speed`` per axis).
     Targets:
         ``n_targets``; ``sequential`` (show and score one target at a time, else all at once);
         ``target_width`` (m); ``target_walls`` (walls targets may sit on; ``None`` = all walls of

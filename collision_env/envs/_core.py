@@ -378,7 +378,7 @@ class TaskCore:
         (``nudge`` is the size, m/s). An action with NaN raises ValueError and changes nothing.
         """
         live = self.batch.live_arrays()
-        # scales the actions and nudges the engine's balls (finite values, y = 0 in 1D)
+        # turns the actions into velocity changes and applies them (finite values, y = 0 in 1D)
         bad = K.nudge_kernel(actions, active, live.balls, live.clusters, self.ctrl, self.P, self.Q, self._dv, self.S)
         if bad >= 0:
             where = f"sub-env {bad}: " if self.num_scenes > 1 else ""

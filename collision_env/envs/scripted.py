@@ -12,6 +12,8 @@
   predicted step with exactly the predicted impact. The env itself is never stepped by the
   planning, so it neither renders the look-ahead nor loses its trails.
 
+Each plans nudges (velocity changes over ``max_dv``) in :meth:`ScriptedPolicy.nudge`; called, it
+returns them in the form the env's ``control`` reads (:func:`as_env_action`).
 ``scripted_policy(env)`` picks the right one for the env's preset; ``env`` may be a ``gym.make``
 env (wrappers included) or the bare env. The policy is called each step and returns the action:
 
@@ -51,7 +53,25 @@ def first_wall_impact(records: np.ndarray, ball: int | None = None):
     return None
 
 
-class AimingPolicy:
+class ScriptedPolicy:
+    """A policy that plans nudges on the bare env it plays (``self.env``).
+
+    Subclasses implement :meth:`nudge`; calling the policy converts its result with
+    :func:`as_env_action`, so one plan serves both controls.
+    """
+
+    def __init__(self, env):
+        self.env = env.unwrapped
+
+    def nudge(self, obs=None) -> np.ndarray:
+        """The nudge action for this step (one component per axis and controlled ball)."""
+        raise NotImplementedError
+
+    def __call__(self, obs=None) -> np.ndarray:
+        return as_env_action(self.env, self.nudge(obs))
+
+
+class AimingPolicy(ScriptedPolicy):
     """Steer each controlled ball so that its next wall impact lands on a pending target.
 
     For scenes where the controlled balls score and meet nothing on the way but walls (one ball,
@@ -84,7 +104,7 @@ class AimingPolicy:
         r = first_wall_impact(sim.step(self.lookahead), ball=ball)
         return r is not None and any(on_target(core, 0, k, r["wall"], r["x"], r["y"], r["time"]) for k in targets)
 
-    def __call__(self, obs=None) -> np.ndarray:
+    def nudge(self, obs=None) -> np.ndarray:
         core, cfg = self.env.core, self.env.config
         action = np.zeros(len(cfg.controlled) * 2, np.float32)
         pending = self._pending()
@@ -120,7 +140,7 @@ class SteeringPolicy(AimingPolicy):
     (a copy of the engine run ``lookahead`` s ahead) is made per step.
     """
 
-    def __call__(self, obs=None) -> np.ndarray:
+    def nudge(self, obs=None) -> np.ndarray:
         core, cfg = self.env.core, self.env.config
         action = np.zeros(len(cfg.controlled) * 2, np.float32)
         pending = self._pending()
@@ -143,23 +163,32 @@ class SteeringPolicy(AimingPolicy):
 
 def no_nudge(env) -> np.ndarray:
     """The nudge action that changes nothing."""
-    cfg = env.config
+    cfg = env.unwrapped.config
     return np.zeros(len(cfg.controlled) * cfg.dimension, np.float32)
 
 
 def as_env_action(env, nudge) -> np.ndarray:
     """A nudge action (velocity changes over ``max_dv``, as every policy here plans them) in the
-    form ``env``'s ``control`` reads: unchanged for "nudge"; for "velocity", per controlled ball
-    the velocity the nudge leads to (over ``max_speed``) and the engage flag, set when the nudge
-    is not zero. A plan and the episode that follows it convert alike, so they stay identical."""
+    form ``env``'s ``control`` reads, as a new float32 array: the nudge itself for "nudge"; for
+    "velocity", per controlled ball the velocity the nudge leads to (over ``max_speed``, after the
+    env's speed cap) and the engage flag, set when the nudge is not zero. A plan and the episode
+    that follows it convert alike, so they stay identical.
+
+    The converted action moves the ball as the nudge does, except for a ball already faster than
+    ``max_speed`` along an axis: a named velocity cannot exceed ``max_speed`` per axis."""
+    env = env.unwrapped
     cfg = env.config
     if cfg.control == "nudge":
-        return nudge
+        return np.array(nudge, np.float32)
     dim = cfg.dimension
     a = np.clip(np.asarray(nudge, np.float64).reshape(len(cfg.controlled), dim), -1.0, 1.0)
     v = env.core.vel[0, list(cfg.controlled), :dim]
+    after = v + a * cfg.max_dv
+    # the nudge kernel's speed cap: no faster than max(max_speed, current speed)
+    speed, cap = np.linalg.norm(after, axis=1), np.maximum(cfg.max_speed, np.linalg.norm(v, axis=1))
+    after *= np.where(speed > cap, cap / np.where(speed > 0.0, speed, 1.0), 1.0)[:, None]
     out = np.empty((len(cfg.controlled), dim + 1), np.float32)
-    out[:, :dim] = np.clip((v + a * cfg.max_dv) / cfg.max_speed, -1.0, 1.0)
+    out[:, :dim] = np.clip(after / cfg.max_speed, -1.0, 1.0)
     out[:, dim] = np.where((a != 0.0).any(axis=1), 1.0, -1.0)
     return out.ravel()
 
@@ -254,7 +283,7 @@ def line_plans(env) -> list:
     return [push((s,), steps, delay) for delay in (0, 20, 40, 60, 90) for steps in (2, 6, 12) for s in (1.0, -1.0)]
 
 
-class ShootingPolicy:
+class ShootingPolicy(ScriptedPolicy):
     """Plan by shooting (see :func:`shoot`), follow the plan, re-plan after each hit.
 
     ``candidates(env)`` lists plans; ``fallback(env)`` gives the action while no plan hits
@@ -262,7 +291,7 @@ class ShootingPolicy:
     """
 
     def __init__(self, env, candidates: Callable, fallback: Callable | None = None, retry: int = 10):
-        self.env = env
+        super().__init__(env)
         self.candidates = candidates
         self.fallback = fallback
         self.retry = retry
@@ -270,9 +299,9 @@ class ShootingPolicy:
         self.t = 0
         self.hit_step = None
         self.wait = 0
-        self.planner = planning_copy(env)
+        self.planner = planning_copy(self.env)
 
-    def __call__(self, obs=None) -> np.ndarray:
+    def nudge(self, obs=None) -> np.ndarray:
         env = self.env
         if self.plan is None and self.wait <= 0:
             horizon = env.config.n_steps - int(env.core.steps[0])
@@ -294,20 +323,13 @@ class ShootingPolicy:
         return action
 
 
-def scripted_policy(env):
+def scripted_policy(env) -> ScriptedPolicy | None:
     """A scripted policy for the env's preset (``None`` when there is none): ``policy(obs) -> action``.
 
     ``env`` is a ``gym.make`` env or the bare env; the policy reads the state of the bare env. It
     plans nudges and hands them over in the form the env's ``control`` reads (:func:`as_env_action`).
     """
     env = env.unwrapped
-    policy = _nudge_policy(env)
-    if policy is None or env.config.control == "nudge":
-        return policy
-    return lambda obs=None: as_env_action(env, policy(obs))
-
-
-def _nudge_policy(env):
     cfg = env.config
     if (
         cfg.dimension == 2

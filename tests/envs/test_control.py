@@ -1,5 +1,6 @@
 """Velocity control (control="velocity"): the action names a velocity and an engage flag per
-controlled ball, and the env nudges towards it within the same limits as a nudge action.
+controlled ball, and the env nudges towards it within the same per-step limit and speed cap as a
+nudge action.
 Analytic values, the checkers, single-vs-vector equality, and the scripted policies under it."""
 
 import warnings
@@ -17,13 +18,13 @@ from tests.envs.test_vector import run_pair
 IDS = sorted(PRESET_IDS.values())
 
 
-def _resting_ball(**kwargs):
-    # one ball at rest in the middle of the box, no shaping: the reward is the nudge's cost alone
-    env = gym.make(
-        "CollisionEnv/OneBallTarget-v0", control="velocity", shaping=0.0, speed_range=(0.0, 0.0), **kwargs
-    ).unwrapped
+def _resting_ball(control="velocity", x=0.0):
+    # one ball at rest at (x, 0), no shaping: the reward is the nudge's cost alone
+    env = gym.make("CollisionEnv/OneBallTarget-v0", control=control, shaping=0.0, speed_range=(0.0, 0.0)).unwrapped
     env.reset(seed=2)
-    env.core.pos[0, 0] = (0.0, 0.0)
+    state = env.get_state()
+    state["core"]["engine"]["positions"][0, 0] = (x, 0.0)
+    env.set_state(state)
     return env
 
 
@@ -83,9 +84,32 @@ def test_velocity_control_in_1d():
     cfg = env.config
     v0 = env.core.vel[0, 0, 0]
     env.step(np.array([0.5, 1.0], np.float32))
-    want = 0.5 * cfg.max_speed
-    assert env.core.vel[0, 0, 0] == pytest.approx(v0 + np.clip(want - v0, -cfg.max_dv, cfg.max_dv), abs=1e-12)
+    v1 = v0 + np.clip(0.5 * cfg.max_speed - v0, -cfg.max_dv, cfg.max_dv)
+    assert env.core.vel[0, 0, 0] == pytest.approx(v1, abs=1e-12)
     assert env.core.vel[0, 0, 1] == 0.0
+    # a flag at or below zero coasts; a named velocity beyond 1 is clipped to max_speed
+    _, _, _, _, info = env.step(np.array([-1.0, 0.0], np.float32))
+    assert info["nudge"] == 0.0 and env.core.vel[0, 0, 0] == pytest.approx(v1, abs=1e-12)
+    _, _, _, _, info = env.step(np.array([7.0, 1.0], np.float32))
+    v2 = v1 + min(cfg.max_speed - v1, cfg.max_dv)
+    assert info["nudge"] == pytest.approx(v2 - v1, rel=1e-12)
+    assert env.core.vel[0, 0, 0] == pytest.approx(v2, abs=1e-12)
+
+
+def test_each_ball_follows_its_own_flag_and_velocity():
+    # MultiBall at rest: only ball 1 is engaged, towards (-1, 0.4) m/s; balls 0 and 2 name
+    # velocities too but their flags are off
+    env = gym.make("CollisionEnv/MultiBall-v0", control="velocity", speed_range=(0.0, 0.0)).unwrapped
+    env.reset(seed=3)
+    cfg = env.config
+    want = np.array([-1.0, 0.4])
+    action = np.array([0.9, 0.9, -1.0, *(want / cfg.max_speed), 1.0, -0.5, 0.5, 0.0], np.float32)
+    _, _, _, _, info = env.step(action)
+    named = action[3:5].astype(np.float64) * cfg.max_speed  # want, to float32 precision
+    step = named * cfg.max_dv / np.abs(named).max()  # x changes by max_dv, y in proportion
+    assert np.allclose(env.core.vel[0, 1], step, rtol=0, atol=1e-12)
+    assert np.array_equal(env.core.vel[0, [0, 2]], np.zeros((2, 2)))
+    assert info["nudge"] == pytest.approx(np.linalg.norm(step), rel=1e-12)
 
 
 def test_a_nan_in_the_flag_raises_and_an_unknown_control_is_refused():
@@ -116,33 +140,74 @@ def test_a_converted_nudge_changes_the_velocity_as_the_nudge_does(env_id):
     nudge = gym.make(env_id).unwrapped
     velocity = gym.make(env_id, control="velocity").unwrapped
     rng = np.random.default_rng(1)
-    nudge.reset(seed=5)
     velocity.reset(seed=5)
+    ctrl = list(nudge.config.controlled)
     for _ in range(12):
         a = rng.uniform(-1, 1, nudge.action_space.shape).astype(np.float32)
         a[rng.uniform(size=a.shape) < 0.2] = 0.0
-        nudge.core.vel[...] = velocity.core.vel  # the same velocities before each step
-        nudge.core.pos[...] = velocity.core.pos
+        nudge.set_state(velocity.get_state())  # the same scene before each step
         converted = as_env_action(velocity, a)
         _, _, _, _, i1 = nudge.step(a)
         _, _, _, _, i2 = velocity.step(converted)
         assert i2["nudge"] == pytest.approx(i1["nudge"], abs=1e-6)
-        ctrl = list(nudge.config.controlled)
         assert np.allclose(velocity.core.vel[0, ctrl], nudge.core.vel[0, ctrl], rtol=0, atol=1e-6)
         if i1["is_success"] or i2["is_success"]:
             break
 
 
-def test_the_scripted_billiards_policy_plays_under_velocity_control():
-    # it plans on a copy of the env with the same conversion, so each shot it fires scores
-    env = gym.make("CollisionEnv/Billiards-v0", control="velocity")
-    hits = 0
+def test_a_converted_nudge_at_the_speed_cap_turns_the_ball_as_the_nudge_does():
+    # at max_speed the cap shortens each nudge; the converted action names the capped velocity, so
+    # a 14-step push at 10 degrees off the ball's heading turns it alike under both controls
+    nudge, velocity = _resting_ball("nudge"), _resting_ball(x=-1.8)  # room to run to the right wall
+    cfg = velocity.config
+    while velocity.core.vel[0, 0, 0] < cfg.max_speed - 1e-12:  # accelerate along +x to the cap
+        velocity.step(np.array([1.0, 0.0, 1.0], np.float32))
+    nudge.set_state(velocity.get_state())
+    push = np.array([np.cos(np.radians(10)), np.sin(np.radians(10))], np.float32)
+    for k in range(14):
+        v_before = velocity.core.vel[0, 0].copy()
+        _, _, _, _, i1 = nudge.step(push)
+        _, _, _, _, i2 = velocity.step(as_env_action(velocity, push))
+        assert len(i1["impacts"]) == len(i2["impacts"]) == 0, k
+        assert np.allclose(velocity.core.vel[0, 0], nudge.core.vel[0, 0], rtol=0, atol=1e-6), k
+        # the velocity step pays for the change it makes, the nudge for the change it asked for
+        assert i2["nudge"] == pytest.approx(np.linalg.norm(velocity.core.vel[0, 0] - v_before), rel=1e-5)
+        assert i1["nudge"] == pytest.approx(cfg.max_dv, rel=1e-6)
+    assert np.linalg.norm(nudge.core.vel[0, 0]) == pytest.approx(cfg.max_speed, rel=1e-9)
+    heading = np.degrees(np.arctan2(velocity.core.vel[0, 0, 1], velocity.core.vel[0, 0, 0]))
+    assert heading == pytest.approx(np.degrees(np.arctan2(*nudge.core.vel[0, 0, ::-1])), abs=1e-4)
+    assert 0.0 < heading < 10.0
+
+
+@pytest.mark.parametrize("env_id", ["CollisionEnv/Billiards-v0", "CollisionEnv/InelasticCluster-v0"])
+def test_the_scripted_shots_under_velocity_control_score_at_the_planned_step(env_id, monkeypatch):
+    # the shooting policy plans on a copy of the env with the same conversion: each shot it fires
+    # hits its target at exactly the step the plan predicted
+    from collision_env.envs import scripted
+
+    env = gym.make(env_id, control="velocity")
+    planned = []
+
+    def recorded_shoot(played, plans, horizon, planner=None):
+        plan, hit_step, records = shoot(played, plans, horizon, planner)
+        if plan is not None:
+            planned.append(int(played.core.steps[0]) + hit_step)
+        return plan, hit_step, records
+
+    shoot = scripted.shoot
+    monkeypatch.setattr(scripted, "shoot", recorded_shoot)
+    fired = 0
     for episode in range(3):
-        obs, _ = env.reset(seed=episode)
+        obs, info = env.reset(seed=episode)
         policy = scripted_policy(env)
-        done = False
+        planned.clear()
+        scored, hits, done = [], 0, False
         while not done:
+            step = int(env.unwrapped.core.steps[0])
             obs, _, term, trunc, info = env.step(policy(obs))
-            done = term or trunc
-        hits += info["targets_hit"]
-    assert hits >= 4
+            if info["targets_hit"] > hits:
+                scored.append(step)
+            hits, done = info["targets_hit"], term or trunc
+        assert set(planned) <= set(scored), (episode, planned, scored)
+        fired += len(planned)
+    assert fired >= 3

@@ -6,15 +6,16 @@ import pytest
 
 import collision_env
 from collision_env.envs import rendering
-from collision_env.envs.scripted import ShootingPolicy, scripted_policy
+from collision_env.envs.scripted import ScriptedPolicy, ShootingPolicy, scripted_policy
 
 
+@pytest.mark.parametrize("control", ["nudge", "velocity"])
 @pytest.mark.parametrize("env_id", collision_env.ENV_IDS)
-def test_scripted_policy_plays_a_gym_make_env_as_documented(env_id):
-    env = gym.make(env_id)  # wrapped: TimeLimit, OrderEnforcing, the checker
+def test_scripted_policy_plays_a_gym_make_env_as_documented(env_id, control):
+    env = gym.make(env_id, control=control)  # wrapped: TimeLimit, OrderEnforcing, the checker
     obs, info = env.reset(seed=2)
     policy = scripted_policy(env)
-    assert policy is not None
+    assert isinstance(policy, ScriptedPolicy) and policy.env is env.unwrapped
     done, steps = False, 0
     while not done:
         action = policy(obs)
