@@ -553,6 +553,11 @@ def main(argv: list[str] | None = None) -> dict:
                 for s in seeds
                 if kwargs or not (args.part == "both" and env_id in envs and ("exact", 1) in modes)
             ]
+    # compile (or load) the kernels once here: a worker that compiled them would count the compiler's
+    # minutes in its training time
+    from collision_env.precompile import precompile
+
+    print(f"kernels ready in {precompile():.1f} s (not counted in any training time)")
     start = time.perf_counter()
     print(f"{len(tasks)} training runs, {args.jobs} at a time ...")
     rows = _run_all(train_and_evaluate, tasks, args.jobs, print)
