@@ -74,7 +74,7 @@ def _first_nan_row(actions, active):  # pragma: no cover - numba
 
 
 @njit(inline="always")
-def _capped_change(vx, vy, dx, dy, max_speed):  # pragma: no cover - numba
+def capped_change(vx, vy, dx, dy, max_speed):  # pragma: no cover - numba
     """The velocity change that applies (dx, dy) to (vx, vy) without exceeding max(max_speed, |v|)."""
     nx = vx + dx
     ny = vy + dy
@@ -92,13 +92,22 @@ def _requested_change(a, o, dim, velocity_control, vx, vy, max_dv, max_speed):  
     """The velocity change one controlled ball's action components ``a[o:]`` ask for, each axis
     within ``max_dv``: with nudge control the components times ``max_dv``; with velocity control the
     step along the straight line from (vx, vy) to the named velocity (components times
-    ``max_speed``), shortened until no axis exceeds ``max_dv``, or none when the engage flag is <= 0."""
+    ``max_speed``, scaled back to ``max_speed`` if longer), shortened until no axis exceeds
+    ``max_dv``, or none when the engage flag is <= 0.
+
+    A named velocity no longer than ``max_speed`` keeps the whole line within the speed cap of
+    :func:`capped_change` (a disc holds the segment between two of its points), so under velocity
+    control the change charged is the change made."""
     ax = _clip1(a[o])
     ay = _clip1(a[o + 1]) if dim == 2 else 0.0
     if not velocity_control:
         return ax * max_dv, ay * max_dv
     if not a[o + dim] > 0.0:
         return 0.0, 0.0
+    length = math.sqrt(ax * ax + ay * ay)
+    if length > 1.0:
+        ax /= length
+        ay /= length
     dx = ax * max_speed - vx
     dy = ay * max_speed - vy if dim == 2 else 0.0
     longest = max(abs(dx), abs(dy))
@@ -143,7 +152,7 @@ def nudge_kernel(actions, active, balls, body, ctrl, P, Q, dv, S):  # pragma: no
                 actions[b], c * per_ball, dim, velocity_control, vel[b, i, 0], vel[b, i, 1], max_dv, max_speed
             )
             requested += math.sqrt(dx * dx + dy * dy)
-            cdx, cdy = _capped_change(vel[b, i, 0], vel[b, i, 1], dx, dy, max_speed)
+            cdx, cdy = capped_change(vel[b, i, 0], vel[b, i, 1], dx, dy, max_speed)
             dv[b, i, 0] = cdx
             dv[b, i, 1] = cdy
         S[b, SF.nudge] = requested

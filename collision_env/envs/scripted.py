@@ -34,6 +34,7 @@ from collections.abc import Callable
 import numpy as np
 
 from collision_env.engine.scene import WALL_BOTTOM, WALL_LEFT, WALL_RIGHT, WALL_TOP
+from collision_env.envs._kernels import capped_change
 from collision_env.envs._layout import TARGET_GEOMETRY, TARGET_HIT, TARGET_PENDING
 
 Plan = Callable[[int, object], np.ndarray]
@@ -81,7 +82,7 @@ class AimingPolicy(ScriptedPolicy):
     """
 
     def __init__(self, env, speed: float = 1.2, lookahead: float = 6.0, directions: int = 144):
-        self.env = env
+        super().__init__(env)
         self.speed = speed
         self.lookahead = lookahead
         self.angles = np.linspace(-math.pi, math.pi, directions, endpoint=False)
@@ -106,7 +107,7 @@ class AimingPolicy(ScriptedPolicy):
 
     def nudge(self, obs=None) -> np.ndarray:
         core, cfg = self.env.core, self.env.config
-        action = np.zeros(len(cfg.controlled) * 2, np.float32)
+        action = no_nudge(self.env)
         pending = self._pending()
         if not pending:
             return action
@@ -127,7 +128,7 @@ class AimingPolicy(ScriptedPolicy):
                         break
                 self.want[i] = want
             if want is not None:
-                action[2 * j : 2 * j + 2] = np.clip((want - v) / cfg.max_dv, -1, 1)
+                action[2 * j : 2 * j + 2] = towards(self.env, want, v)
         return action
 
 
@@ -142,7 +143,7 @@ class SteeringPolicy(AimingPolicy):
 
     def nudge(self, obs=None) -> np.ndarray:
         core, cfg = self.env.core, self.env.config
-        action = np.zeros(len(cfg.controlled) * 2, np.float32)
+        action = no_nudge(self.env)
         pending = self._pending()
         if not pending:
             return action
@@ -154,7 +155,7 @@ class SteeringPolicy(AimingPolicy):
             pos, v = core.pos[0, i], core.vel[0, i]
             heading = np.subtract(goal, pos)
             want = self.speed * heading / max(np.linalg.norm(heading), 1e-12)
-            action[2 * j : 2 * j + 2] = np.clip((want - v) / cfg.max_dv, -1, 1)
+            action[2 * j : 2 * j + 2] = towards(self.env, want, v)
         return action
 
 
@@ -167,6 +168,12 @@ def no_nudge(env) -> np.ndarray:
     return np.zeros(len(cfg.controlled) * cfg.dimension, np.float32)
 
 
+def towards(env, want, v) -> np.ndarray:
+    """One ball's nudge components that change velocity ``v`` towards ``want`` (m/s), each axis by at
+    most ``max_dv``."""
+    return np.clip((np.asarray(want) - v) / env.unwrapped.config.max_dv, -1.0, 1.0).astype(np.float32)
+
+
 def as_env_action(env, nudge) -> np.ndarray:
     """A nudge action (velocity changes over ``max_dv``, as every policy here plans them) in the
     form ``env``'s ``control`` reads, as a new float32 array: the nudge itself for "nudge"; for
@@ -174,22 +181,24 @@ def as_env_action(env, nudge) -> np.ndarray:
     env's speed cap) and the engage flag, set when the nudge is not zero. A plan and the episode
     that follows it convert alike, so they stay identical.
 
-    The converted action moves the ball as the nudge does, except for a ball already faster than
-    ``max_speed`` along an axis: a named velocity cannot exceed ``max_speed`` per axis."""
+    The converted action moves the ball as the nudge does (to float32 rounding) except at the speed
+    cap, which a nudge meets as a pull back onto the cap's circle: a ball faster than ``max_speed``
+    is steered towards a velocity no longer than ``max_speed`` (a named velocity never is), and a
+    nudge that turns a ball at the cap can change one axis by more than ``max_dv``, which one
+    velocity step cannot."""
     env = env.unwrapped
     cfg = env.config
     if cfg.control == "nudge":
         return np.array(nudge, np.float32)
     dim = cfg.dimension
     a = np.clip(np.asarray(nudge, np.float64).reshape(len(cfg.controlled), dim), -1.0, 1.0)
-    v = env.core.vel[0, list(cfg.controlled), :dim]
-    after = v + a * cfg.max_dv
-    # the nudge kernel's speed cap: no faster than max(max_speed, current speed)
-    speed, cap = np.linalg.norm(after, axis=1), np.maximum(cfg.max_speed, np.linalg.norm(v, axis=1))
-    after *= np.where(speed > cap, cap / np.where(speed > 0.0, speed, 1.0), 1.0)[:, None]
     out = np.empty((len(cfg.controlled), dim + 1), np.float32)
-    out[:, :dim] = np.clip(after / cfg.max_speed, -1.0, 1.0)
-    out[:, dim] = np.where((a != 0.0).any(axis=1), 1.0, -1.0)
+    for j, i in enumerate(cfg.controlled):
+        vx, vy = env.core.vel[0, i]
+        dy = a[j, 1] * cfg.max_dv if dim == 2 else 0.0
+        dx, dy = capped_change(vx, vy, a[j, 0] * cfg.max_dv, dy, cfg.max_speed)  # as the env caps the nudge
+        out[j, :dim] = np.clip(np.array([vx + dx, vy + dy][:dim]) / cfg.max_speed, -1.0, 1.0)
+        out[j, dim] = 1.0 if (a[j] != 0.0).any() else -1.0
     return out.ravel()
 
 
@@ -275,7 +284,7 @@ def ram(env) -> np.ndarray:
     core = env.core
     d = core.pos[0, 1] - core.pos[0, 0]
     want = 0.8 * d / np.linalg.norm(d)
-    return np.clip((want - core.vel[0, 0]) / env.config.max_dv, -1, 1).astype(np.float32)
+    return towards(env, want, core.vel[0, 0])
 
 
 def line_plans(env) -> list:

@@ -18,12 +18,13 @@ from tests.envs.test_vector import run_pair
 IDS = sorted(PRESET_IDS.values())
 
 
-def _resting_ball(control="velocity", x=0.0):
-    # one ball at rest at (x, 0), no shaping: the reward is the nudge's cost alone
+def _resting_ball(control="velocity", x=0.0, v=(0.0, 0.0)):
+    # one ball at (x, 0) moving at v (at rest by default), no shaping: the reward is the nudge's cost alone
     env = gym.make("CollisionEnv/OneBallTarget-v0", control=control, shaping=0.0, speed_range=(0.0, 0.0)).unwrapped
     env.reset(seed=2)
     state = env.get_state()
     state["core"]["engine"]["positions"][0, 0] = (x, 0.0)
+    state["core"]["engine"]["velocities"][0, 0] = v
     env.set_state(state)
     return env
 
@@ -69,31 +70,48 @@ def test_a_flag_at_or_below_zero_leaves_the_ball_coasting_at_no_cost():
         assert np.array_equal(env.core.vel[0, 0], v)
 
 
-def test_the_named_velocity_is_clipped_and_the_speed_cap_holds():
-    env = _resting_ball()
+def test_the_named_velocity_is_clipped_then_kept_within_max_speed_and_each_step_costs_what_it_changes():
+    env = _resting_ball(x=-1.0)
     cfg = env.config
-    for _ in range(12):  # (the ball reaches the cap after 10 steps, before it reaches a wall)
-        _, _, _, _, info = env.step(np.array([5.0, 5.0, 1.0], np.float32))  # clipped: (2, 2) m/s, over the cap
-        assert len(info["impacts"]) == 0
-    assert np.linalg.norm(env.core.vel[0, 0]) == pytest.approx(cfg.max_speed, rel=1e-12)
+    # (5, 0.5) is clipped to (1, 0.5), then scaled back to length 1: the velocity named is
+    # max_speed * (2, 1) / sqrt(5), the only one of its direction on the cap's circle
+    named = cfg.max_speed * np.array([2.0, 1.0]) / np.sqrt(5.0)
+    for k in range(16):  # (it gets there after 12 steps, before it reaches a wall)
+        before = env.core.vel[0, 0].copy()
+        _, reward, _, _, info = env.step(np.array([5.0, 0.5, 1.0], np.float32))
+        assert len(info["impacts"]) == 0, k
+        change = np.linalg.norm(env.core.vel[0, 0] - before)
+        assert info["nudge"] == pytest.approx(change, rel=1e-9, abs=1e-12), k
+        assert reward == pytest.approx(-cfg.action_cost * info["nudge"], rel=1e-12, abs=1e-15), k
+    assert np.allclose(env.core.vel[0, 0], named, rtol=0, atol=1e-12)
+    assert info["nudge"] < 1e-12  # there: held for free
+
+
+def test_a_ball_faster_than_max_speed_is_steered_to_a_velocity_no_longer_than_max_speed():
+    env = _resting_ball(v=(2.5, 0.0))  # (after a collision, say)
+    cfg = env.config
+    _, _, _, _, info = env.step(np.array([1.0, 0.0, 1.0], np.float32))  # names (max_speed, 0)
+    assert env.core.vel[0, 0] == pytest.approx([2.5 - cfg.max_dv, 0.0], abs=1e-12)
+    assert info["nudge"] == pytest.approx(cfg.max_dv, rel=1e-12)
 
 
 def test_velocity_control_in_1d():
-    env = gym.make("CollisionEnv/Line1D-v0", control="velocity").unwrapped
+    # the first ball from rest (the others rest too, over a metre away)
+    env = gym.make("CollisionEnv/Line1D-v0", control="velocity", speed_range=(0.0, 0.0)).unwrapped
     env.reset(seed=0)
     cfg = env.config
-    v0 = env.core.vel[0, 0, 0]
+    assert env.core.pos[0, 1, 0] - env.core.pos[0, 0, 0] > 1.0
     env.step(np.array([0.5, 1.0], np.float32))
-    v1 = v0 + np.clip(0.5 * cfg.max_speed - v0, -cfg.max_dv, cfg.max_dv)
-    assert env.core.vel[0, 0, 0] == pytest.approx(v1, abs=1e-12)
+    assert env.core.vel[0, 0, 0] == pytest.approx(cfg.max_dv, abs=1e-12)
     assert env.core.vel[0, 0, 1] == 0.0
-    # a flag at or below zero coasts; a named velocity beyond 1 is clipped to max_speed
+    # a flag at or below zero coasts
     _, _, _, _, info = env.step(np.array([-1.0, 0.0], np.float32))
-    assert info["nudge"] == 0.0 and env.core.vel[0, 0, 0] == pytest.approx(v1, abs=1e-12)
-    _, _, _, _, info = env.step(np.array([7.0, 1.0], np.float32))
-    v2 = v1 + min(cfg.max_speed - v1, cfg.max_dv)
-    assert info["nudge"] == pytest.approx(v2 - v1, rel=1e-12)
-    assert env.core.vel[0, 0, 0] == pytest.approx(v2, abs=1e-12)
+    assert info["nudge"] == 0.0 and env.core.vel[0, 0, 0] == pytest.approx(cfg.max_dv, abs=1e-12)
+    # a named velocity beyond 1 is clipped: the ball is steered to max_speed and held there
+    for _ in range(int(np.ceil(cfg.max_speed / cfg.max_dv))):
+        _, _, _, _, info = env.step(np.array([7.0, 1.0], np.float32))
+        assert len(info["impacts"]) == 0
+    assert env.core.vel[0, 0, 0] == pytest.approx(cfg.max_speed, abs=1e-12) and info["nudge"] < 1e-12
 
 
 def test_each_ball_follows_its_own_flag_and_velocity():
@@ -177,6 +195,23 @@ def test_a_converted_nudge_at_the_speed_cap_turns_the_ball_as_the_nudge_does():
     heading = np.degrees(np.arctan2(velocity.core.vel[0, 0, 1], velocity.core.vel[0, 0, 0]))
     assert heading == pytest.approx(np.degrees(np.arctan2(*nudge.core.vel[0, 0, ::-1])), abs=1e-4)
     assert 0.0 < heading < 10.0
+
+
+def test_a_nudge_that_turns_a_ball_at_the_cap_converts_to_the_same_line_within_max_dv_per_axis():
+    # at the cap on the diagonal, a nudge across it is pulled back onto the cap's circle, which
+    # changes y by more than max_dv; the converted action names the same velocity, and the velocity
+    # step goes along the same line, shortened to max_dv on that axis
+    v = np.array([1.0, 1.0]) * np.sqrt(2.0)
+    nudge, velocity = _resting_ball("nudge", v=v), _resting_ball(v=v)
+    cfg = velocity.config
+    across = np.array([1.0, -1.0], np.float32)
+    converted = as_env_action(velocity, across)
+    nudge.step(across)
+    velocity.step(converted)
+    change = nudge.core.vel[0, 0] - v
+    assert np.abs(change).max() > cfg.max_dv  # the cap's pull-back
+    shortened = change * cfg.max_dv / np.abs(change).max()
+    assert np.allclose(velocity.core.vel[0, 0], v + shortened, rtol=0, atol=1e-6)
 
 
 @pytest.mark.parametrize("env_id", ["CollisionEnv/Billiards-v0", "CollisionEnv/InelasticCluster-v0"])
