@@ -241,12 +241,22 @@ def modes_reading(rows: list) -> str:
     return "\n".join(out)
 
 
+def _shipped(row: dict) -> bool:
+    """Whether a row trained the env's hyperparameter entry as it stands: no env keywords of its own,
+    and the entry's observation and control."""
+    entry = hyperparams_for(row["env_id"]).get("env_kwargs") or {}
+    setting = f"{entry.get('observe', 'plain')}, {entry.get('control', 'nudge')}"
+    return not row.get("env_kwargs") and _setting(row) == setting
+
+
 def _place(row: dict) -> tuple:
-    """Where a row goes in a table: presets in registration order, each preset's shipped setting first."""
+    """Where a row goes in a table: presets in registration order, each preset's shipped setting first,
+    then the other settings by name."""
     from collision_env.envs import PRESET_IDS
 
     order = list(PRESET_IDS.values())
-    return (order.index(row["env_id"]) if row["env_id"] in order else len(order), bool(row.get("env_kwargs")))
+    at = order.index(row["env_id"]) if row["env_id"] in order else len(order)
+    return (at, not _shipped(row), _setting(row))
 
 
 def _by_preset(rows: list, base: list) -> dict:
@@ -268,16 +278,17 @@ def presets_table(rows: list, base: list) -> str:
     by_env = {b["env_id"]: b for b in base}
     episodes = next(iter(groups.values()))[0]["episodes"]
     lines = [
-        f"Every preset, PPO in exact mode with the shipped hyperparameters, beside the baselines on the same "
+        f"Every preset, PPO in exact mode, beside the baselines on the same "
         f"{episodes} evaluation episodes (success rate; mean return in brackets). PPO: mean ± standard "
         "deviation over seeds, then each seed; training time: median over seeds, with the engine's share of it. "
-        "Setting: the observation and the control the shipped entry trains with (marked *shipped*), and beside it "
-        'the plain observation where the entry changes it (`predicted`: the env\'s `observe="predicted"`, each '
-        "ball's next wall impact as the engine predicts it) and nudges where the entry uses velocity control "
-        "(`nudge`: the action is each step's velocity change; `velocity`: the env's `control=\"velocity\"`, the "
-        "velocity to steer to and an engage flag). Every row keeps the entry's other env settings, such as an "
-        "aiming term taken from the prediction. The random and scripted baselines play the env's defaults "
-        "(plain observation, nudges; the scripted policy's shots land alike under either control).",
+        "Setting: the observation and the control of the shipped hyperparameter entry (marked *shipped*), and "
+        "beside it the plain observation where the entry changes it (`predicted`: the env's "
+        '`observe="predicted"`, each ball\'s next wall impact as the engine predicts it) and nudges where the '
+        "entry uses velocity control (`nudge`: the action is each step's velocity change; `velocity`: the env's "
+        '`control="velocity"`, the velocity to steer to and an engage flag). The other rows keep the rest of '
+        "the entry as it stood when they were trained (such as an aiming term taken from the prediction; the "
+        "steps column gives their length). The random and scripted baselines play the env's defaults (plain "
+        "observation, nudges; the scripted policy plays alike under either control).",
         "",
         "| env | setting | steps | PPO success | per seed | PPO return | random | scripted (exact aim) | "
         "training time (s) | engine's share |",
@@ -288,8 +299,7 @@ def presets_table(rows: list, base: list) -> str:
         succ = [r["exact"]["success_rate"] for r in rs]
         ret = statistics.fmean(r["exact"]["mean_return"] for r in rs)
         b = by_env.get(env_id, {})
-        shipped = not rs[0].get("env_kwargs")
-        label = f"{setting} (*shipped*)" if shipped else setting
+        label = f"{setting} (*shipped*)" if _shipped(rs[0]) else setting
         lines.append(
             f"| `{env_id}` | {label} | {rs[0]['timesteps_done']:,} | {_spread(succ)} | "
             f"{' / '.join(pct(x) for x in succ)} | {ret:.2f} | {fmt(b.get('random'))} | "
@@ -328,9 +338,7 @@ def split_table(rows: list) -> str:
 
 def rule(rows: list, base: list) -> str:
     """The rule for choosing a training mode, stated with this study's figures."""
-    shares = {
-        env: _engine_share(rs) for (env, setting), rs in _by_preset(rows, base).items() if not rs[0].get("env_kwargs")
-    }
+    shares = {env: _engine_share(rs) for (env, setting), rs in _by_preset(rows, base).items() if _shipped(rs[0])}
     shares = {env: f for env, f in shares.items() if f is not None}
     lines = []
     for env_id, groups in _by_env_and_mode(rows).items():

@@ -91,8 +91,9 @@ class TaskConfig:
         ``max_dv``; "velocity": per controlled ball, the velocity to steer it to, each component over
         ``max_speed``, then an engage flag: while the flag is > 0 the env nudges the ball towards that
         velocity, by at most ``max_dv`` per axis and step along the straight line to it, and while it is
-        <= 0 the ball coasts. The same ``max_dv``, speed cap and cost per m/s; the step charged is
-        the one asked for, and a named velocity reaches at most ``max_speed`` per axis).
+        <= 0 the ball coasts; a named velocity longer than ``max_speed`` is scaled back to it. The
+        same ``max_dv`` and cost per m/s of change; the line to the named velocity stays within the
+        speed cap, so the change charged is the change made).
     Targets:
         ``n_targets``; ``sequential`` (show and score one target at a time, else all at once);
         ``target_width`` (m); ``target_walls`` (walls targets may sit on; ``None`` = all walls of

@@ -22,8 +22,8 @@ class BilliardsEnv(CollisionTargetEnv):
     Out-of-range values are clipped; NaN raises `ValueError`. A nudge cannot push the cue ball
     above 2 m/s (or above its current speed, if that is higher). With `control="velocity"` (the
     shipped PPO agent's setting): `Box(-1, 1, (3,), float32)`, the cue ball's wanted velocity
-    (ux, uy) * 2 m/s and an engage flag; while the flag is > 0 the cue ball is nudged towards that
-    velocity by at most 0.2 m/s per axis and step, else it coasts.
+    (ux, uy) * 2 m/s (at most 2 m/s long) and an engage flag; while the flag is > 0 the cue ball is
+    nudged towards that velocity by at most 0.2 m/s per axis and step, else it coasts.
 
     ## Observation Space
 

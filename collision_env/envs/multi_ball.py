@@ -22,9 +22,9 @@ class MultiBallEnv(CollisionTargetEnv):
     change of up to 0.15 m/s per component for this 0.05 s step. Out-of-range values are clipped;
     NaN raises `ValueError`. A nudge cannot push a ball above 2 m/s (or above its current speed,
     if that is higher). With `control="velocity"` (the shipped PPO agent's setting):
-    `Box(-1, 1, (9,), float32)`, per ball its wanted velocity (ux, uy) * 2 m/s and an engage flag;
-    while a ball's flag is > 0 it is nudged towards that velocity by at most 0.15 m/s per axis and
-    step, else it coasts.
+    `Box(-1, 1, (9,), float32)`, per ball its wanted velocity (ux, uy) * 2 m/s (at most 2 m/s long)
+    and an engage flag; while a ball's flag is > 0 it is nudged towards that velocity by at most
+    0.15 m/s per axis and step, else it coasts.
 
     ## Observation Space
 

@@ -37,6 +37,8 @@ from collision_env.engine.scene import WALL_BOTTOM, WALL_LEFT, WALL_RIGHT, WALL_
 from collision_env.envs._kernels import capped_change
 from collision_env.envs._layout import TARGET_GEOMETRY, TARGET_HIT, TARGET_PENDING
 
+#: A plan: ``plan(t, env)`` is the nudge action for step ``t`` of the plan (converted for the env's
+#: control by :func:`as_env_action` when it is played).
 Plan = Callable[[int, object], np.ndarray]
 
 
@@ -203,7 +205,7 @@ def as_env_action(env, nudge) -> np.ndarray:
 
 
 def push(direction, steps: int, delay: int = 0) -> Plan:
-    """A plan: full action along ``direction`` for ``steps`` steps after ``delay``, then nothing."""
+    """A plan: a full nudge along ``direction`` for ``steps`` steps after ``delay``, then nothing."""
     d = np.asarray(direction, np.float32)
     zero = np.zeros_like(d)
     return lambda t, env: d if delay <= t < delay + steps else zero
@@ -219,9 +221,9 @@ def planning_copy(env):
 def shoot(env, plans, horizon: int, planner=None):
     """The first plan whose predicted rollout hits a target within ``horizon`` steps.
 
-    Each plan runs on ``planner`` (default: a fresh :func:`planning_copy` of ``env``) from the
-    current state of ``env``, which is left untouched. Returns ``(plan, hit_step, impacts of that
-    step)`` or ``(None, None, None)``.
+    Each plan (of nudges, each converted by :func:`as_env_action`) runs on ``planner`` (default: a
+    fresh :func:`planning_copy` of ``env``) from the current state of ``env``, which is left
+    untouched. Returns ``(plan, hit_step, impacts of that step)`` or ``(None, None, None)``.
     """
     planner = planning_copy(env) if planner is None else planner
     start = env.get_state()
@@ -295,8 +297,9 @@ def line_plans(env) -> list:
 class ShootingPolicy(ScriptedPolicy):
     """Plan by shooting (see :func:`shoot`), follow the plan, re-plan after each hit.
 
-    ``candidates(env)`` lists plans; ``fallback(env)`` gives the action while no plan hits
-    (default: no nudge); planning is retried every ``retry`` steps.
+    ``candidates(env)`` lists plans; ``fallback(env)`` gives the nudge while no plan hits
+    (default: no nudge); planning is retried every ``retry`` steps. :meth:`nudge` moves the plan
+    on by a step: call it (or the policy) once per env step.
     """
 
     def __init__(self, env, candidates: Callable, fallback: Callable | None = None, retry: int = 10):

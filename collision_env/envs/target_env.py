@@ -42,13 +42,13 @@ class CollisionTargetEnv(gym.Env):
     With `control="velocity"` the action names, for each controlled ball, the velocity to steer it
     to and an engage flag: `Box(-1, 1, (len(controlled) * (dimension + 1),), float32)`, per ball
     (ux, uy, engage) in 2D or (ux, engage) in 1D. While `engage > 0` the ball is nudged towards the
-    velocity `u * max_speed`, along the straight line to it and by at most `max_dv` per axis and
-    step; while `engage <= 0` it coasts. The step obeys the same speed cap and costs the same per
-    m/s as a nudge; the agent names where the velocity should go instead of each step's change, so
-    aiming a shot is one output instead of a sum of many. Two differences: a nudge pays for the
-    change it asks for, the velocity step for the step along the line (so where the speed cap
-    shortens a nudge, the same change costs less here); and a ball moving faster than `max_speed`
-    along an axis cannot be steered without slowing it on that axis.
+    velocity `u * max_speed` (scaled back to `max_speed` if longer), along the straight line to it
+    and by at most `max_dv` per axis and step; while `engage <= 0` it coasts. The agent names where
+    the velocity should go instead of each step's change, so aiming a shot is one output instead of
+    a sum of many. A step costs what a nudge costs per m/s of change; since the line to the named
+    velocity never leaves the speed cap, the change charged is always the change made (a nudge pays
+    for the change it asks for, even where the cap shortens it). A ball faster than `max_speed` (after
+    a collision) can only be steered towards a slower velocity.
 
     ## Observation Space
 

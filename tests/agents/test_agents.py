@@ -355,6 +355,39 @@ def test_study_variants_change_one_setting_of_the_entry_back_to_the_default():
     assert study.variants("CollisionEnv/OneBallTarget-v0", "alternatives") == []
 
 
+def test_study_marks_the_entry_as_it_stands_shipped_and_lists_it_first():
+    # three settings of Billiards, in the order a study file could hold them: a row trained when the
+    # entry used nudges (no "control" field yet), a plain alternative, and the entry as it stands
+    def row(seed, observe, control, env_kwargs, success):
+        out = {
+            "part": "presets",
+            "env_id": "CollisionEnv/Billiards-v0",
+            "mode": "exact",
+            "substeps": 1,
+            "seed": seed,
+            "episodes": 100,
+            "run": f"runs/{observe}-{control}-{seed}",
+            "train_seconds": 10.0,
+            "timesteps_done": 1000,
+            "time_split": {part: 1.0 for part in timing.PARTS},
+            "observe": observe,
+            "env_kwargs": env_kwargs,
+            "exact": {"success_rate": success, "mean_return": 1.0},
+        }
+        if control is not None:
+            out["control"] = control
+        return out
+
+    rows = [row(0, "predicted", None, {}, 0.4), row(0, "plain", "velocity", {"observe": "plain"}, 0.3)]
+    rows += [row(0, "predicted", "velocity", {}, 0.5), row(1, "predicted", "velocity", {}, 0.7)]
+    table = study.presets_table(rows, [])
+    settings = [line.split(" | ")[1] for line in table.splitlines() if line.startswith("| `")]
+    assert settings == ["predicted, velocity (*shipped*)", "plain, velocity", "predicted, nudge"]
+    assert "| 60 % ± 14 | 50 % / 70 % |" in table
+    shipped = study._by_preset(rows, [])[("CollisionEnv/Billiards-v0", "predicted, velocity")]
+    assert [r["seed"] for r in shipped] == [0, 1]
+
+
 # --------------------------------------------------------------------------------------- bad input
 @pytest.mark.parametrize(
     "module, args, message",
