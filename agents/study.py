@@ -31,6 +31,7 @@ two runs train at once (one core each), as every figure in the README was measur
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import os
 import statistics
@@ -241,12 +242,20 @@ def modes_reading(rows: list) -> str:
     return "\n".join(out)
 
 
+@functools.cache
+def _entry_setting(env_id: str) -> str | None:
+    """The observation and control of the env's hyperparameter entry (None: no entry)."""
+    try:
+        entry = hyperparams_for(env_id).get("env_kwargs") or {}
+    except UsageError:
+        return None
+    return f"{entry.get('observe', 'plain')}, {entry.get('control', 'nudge')}"
+
+
 def _shipped(row: dict) -> bool:
-    """Whether a row trained the env's hyperparameter entry as it stands: no env keywords of its own,
-    and the entry's observation and control."""
-    entry = hyperparams_for(row["env_id"]).get("env_kwargs") or {}
-    setting = f"{entry.get('observe', 'plain')}, {entry.get('control', 'nudge')}"
-    return not row.get("env_kwargs") and _setting(row) == setting
+    """Whether a row trained the env's hyperparameter entry with its current observation and control,
+    and no env keywords of its own (its length is the table's steps column)."""
+    return not row.get("env_kwargs") and _setting(row) == _entry_setting(row["env_id"])
 
 
 def _place(row: dict) -> tuple:
@@ -288,7 +297,8 @@ def presets_table(rows: list, base: list) -> str:
         '`control="velocity"`, the velocity to steer to and an engage flag). The other rows keep the rest of '
         "the entry as it stood when they were trained (such as an aiming term taken from the prediction; the "
         "steps column gives their length). The random and scripted baselines play the env's defaults (plain "
-        "observation, nudges; the scripted policy plays alike under either control).",
+        "observation, nudges; in the presets trained with velocity control the scripted policy plays alike "
+        "under either control).",
         "",
         "| env | setting | steps | PPO success | per seed | PPO return | random | scripted (exact aim) | "
         "training time (s) | engine's share |",

@@ -14,8 +14,8 @@ from __future__ import annotations
 import sys
 import time
 
-#: The env options that run kernels of their own, tried beside each env's defaults: the predicted
-#: observation (with its aiming term) and velocity control.
+#: The env options tried beside each env's defaults: the predicted observation (with its aiming
+#: term), which runs kernels of its own, and velocity control, a branch of the nudge kernel.
 OPTIONS = ({}, {"observe": "predicted", "aim": "predicted", "control": "velocity"})
 
 

@@ -85,7 +85,8 @@ class TaskConfig:
         of controlled / other balls, m/s, random direction).
     Control:
         ``controlled`` (indices of the nudged balls); ``dt`` (control step, s of simulated time);
-        ``max_dv`` (largest velocity change per action component and step, m/s); ``max_speed``
+        ``max_dv`` (the velocity change a full nudge component asks for, and the most a velocity
+        step changes an axis, m/s); ``max_speed``
         (a nudge never pushes a ball above max(max_speed, its current speed)); ``control`` ("nudge":
         per controlled ball, one action component per axis, each a velocity change of up to
         ``max_dv``; "velocity": per controlled ball, the velocity to steer it to, each component over

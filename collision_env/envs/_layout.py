@@ -48,7 +48,7 @@ PARAMS = layout(
         ("vscale", "velocity scale of the observation (2 max_speed), m/s"),
         ("mscale", "mass scale of the observation, kg"),
         ("time_limit", "episode length, s (window observation scale)"),
-        ("max_dv", "largest velocity change per axis and control step, m/s"),
+        ("max_dv", "velocity change of a full nudge component, the most a velocity step changes an axis; m/s"),
         ("max_speed", "speed a nudge never pushes a ball above, m/s"),
         ("action_cost", "reward cost per m/s of requested nudge"),
     ),

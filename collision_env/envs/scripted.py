@@ -198,8 +198,11 @@ def as_env_action(env, nudge) -> np.ndarray:
     for j, i in enumerate(cfg.controlled):
         vx, vy = env.core.vel[0, i]
         dy = a[j, 1] * cfg.max_dv if dim == 2 else 0.0
-        dx, dy = capped_change(vx, vy, a[j, 0] * cfg.max_dv, dy, cfg.max_speed)  # as the env caps the nudge
-        out[j, :dim] = np.clip(np.array([vx + dx, vy + dy][:dim]) / cfg.max_speed, -1.0, 1.0)
+        max_speed = float(cfg.max_speed)
+        dx, dy = capped_change(float(vx), float(vy), a[j, 0] * cfg.max_dv, float(dy), max_speed)  # as the env caps it
+        named = np.array([vx + dx, vy + dy][:dim]) / max_speed
+        named /= max(1.0, float(np.linalg.norm(named)))  # no longer than max_speed, in the nudge's direction
+        out[j, :dim] = np.clip(named, -1.0, 1.0)  # (float rounding)
         out[j, dim] = 1.0 if (a[j] != 0.0).any() else -1.0
     return out.ravel()
 

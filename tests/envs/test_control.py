@@ -88,11 +88,15 @@ def test_the_named_velocity_is_clipped_then_kept_within_max_speed_and_each_step_
 
 
 def test_a_ball_faster_than_max_speed_is_steered_to_a_velocity_no_longer_than_max_speed():
-    env = _resting_ball(v=(2.5, 0.0))  # (after a collision, say)
+    v = np.array([2.5, 0.0])  # (after a collision, say)
+    env = _resting_ball(v=v)
     cfg = env.config
-    _, _, _, _, info = env.step(np.array([1.0, 0.0, 1.0], np.float32))  # names (max_speed, 0)
-    assert env.core.vel[0, 0] == pytest.approx([2.5 - cfg.max_dv, 0.0], abs=1e-12)
-    assert info["nudge"] == pytest.approx(cfg.max_dv, rel=1e-12)
+    _, _, _, _, info = env.step(np.array([1.0, 1.0, 1.0], np.float32))  # (1, 1): scaled back to length 1
+    named = cfg.max_speed * np.array([1.0, 1.0]) / np.sqrt(2.0)
+    step = (named - v) * cfg.max_dv / np.abs(named - v).max()  # y changes by max_dv, x in proportion
+    assert env.core.vel[0, 0] == pytest.approx(v + step, abs=1e-12)
+    assert np.linalg.norm(env.core.vel[0, 0]) < np.linalg.norm(v)  # slower: the named velocity is
+    assert info["nudge"] == pytest.approx(np.linalg.norm(step), rel=1e-12)
 
 
 def test_velocity_control_in_1d():
@@ -208,6 +212,7 @@ def test_a_nudge_that_turns_a_ball_at_the_cap_converts_to_the_same_line_within_m
     converted = as_env_action(velocity, across)
     nudge.step(across)
     velocity.step(converted)
+    assert np.allclose(converted[:2] * cfg.max_speed, nudge.core.vel[0, 0], rtol=0, atol=1e-6)  # on the circle
     change = nudge.core.vel[0, 0] - v
     assert np.abs(change).max() > cfg.max_dv  # the cap's pull-back
     shortened = change * cfg.max_dv / np.abs(change).max()
