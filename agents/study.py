@@ -249,7 +249,7 @@ def _entry_setting(env_id: str) -> str | None:
         entry = hyperparams_for(env_id).get("env_kwargs") or {}
     except UsageError:
         return None
-    return f"{entry.get('observe', 'plain')}, {entry.get('control', 'nudge')}"
+    return _setting({"observe": entry.get("observe", "plain"), **entry})
 
 
 def _shipped(row: dict) -> bool:

@@ -195,11 +195,11 @@ def as_env_action(env, nudge) -> np.ndarray:
     dim = cfg.dimension
     a = np.clip(np.asarray(nudge, np.float64).reshape(len(cfg.controlled), dim), -1.0, 1.0)
     out = np.empty((len(cfg.controlled), dim + 1), np.float32)
+    max_dv, max_speed = float(cfg.max_dv), float(cfg.max_speed)
     for j, i in enumerate(cfg.controlled):
-        vx, vy = env.core.vel[0, i]
-        dy = a[j, 1] * cfg.max_dv if dim == 2 else 0.0
-        max_speed = float(cfg.max_speed)
-        dx, dy = capped_change(float(vx), float(vy), a[j, 0] * cfg.max_dv, float(dy), max_speed)  # as the env caps it
+        vx, vy = (float(x) for x in env.core.vel[0, i])
+        dy = float(a[j, 1]) * max_dv if dim == 2 else 0.0
+        dx, dy = capped_change(vx, vy, float(a[j, 0]) * max_dv, dy, max_speed)  # as the env caps the nudge
         named = np.array([vx + dx, vy + dy][:dim]) / max_speed
         named /= max(1.0, float(np.linalg.norm(named)))  # no longer than max_speed, in the nudge's direction
         out[j, :dim] = np.clip(named, -1.0, 1.0)  # (float rounding)

@@ -95,7 +95,7 @@ def test_a_ball_faster_than_max_speed_is_steered_to_a_velocity_no_longer_than_ma
     named = cfg.max_speed * np.array([1.0, 1.0]) / np.sqrt(2.0)
     step = (named - v) * cfg.max_dv / np.abs(named - v).max()  # y changes by max_dv, x in proportion
     assert env.core.vel[0, 0] == pytest.approx(v + step, abs=1e-12)
-    assert np.linalg.norm(env.core.vel[0, 0]) < np.linalg.norm(v)  # slower: the named velocity is
+    assert np.linalg.norm(env.core.vel[0, 0]) < np.linalg.norm(v)  # slower: it can name no more than max_speed
     assert info["nudge"] == pytest.approx(np.linalg.norm(step), rel=1e-12)
 
 
