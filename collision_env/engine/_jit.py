@@ -16,7 +16,8 @@ ways:
   The folder is ``collision_env/__pycache__/kernels-<hash>`` when the package folder is writable,
   else ``~/.cache/collision_env/kernels-<hash>`` (``$XDG_CACHE_HOME``), or under numba's own
   ``NUMBA_CACHE_DIR`` when that is set. Folders of earlier sources are removed when a new one is
-  made.
+  made. A kernel outside the package (a test's, which inlines the package's kernels) is cached in
+  the same folder, keyed on its own file as well.
 * **One compiled version per kernel.** numba compiles a separate version of a called kernel for
   every distinct literal argument (``f(i, -1)`` and ``f(i, j)`` are two compilations); here a
   kernel called from another kernel is compiled for the arguments' plain types only.
@@ -136,6 +137,7 @@ if HAVE_NUMBA:
 
         def __init__(self, py_func, py_file):
             self._py_file = py_file  # numba names it in its warning about an uncachable kernel
+            self._own_file = None if _in_package(py_func) else py_file
             self._path = cache_dir()
             self._name = f"{py_func.__module__}-{py_func.__code__.co_firstlineno}"
 
@@ -151,7 +153,10 @@ if HAVE_NUMBA:
             return str(self._path)
 
         def get_source_stamp(self):
-            return SOURCE_HASH  # the folder is already keyed on every source file
+            if self._own_file is None:
+                return SOURCE_HASH  # the folder is already keyed on every source file
+            stat = os.stat(self._own_file)
+            return SOURCE_HASH, stat.st_mtime, stat.st_size
 
         def get_disambiguator(self):
             return self._name
@@ -195,8 +200,7 @@ def njit(func=None, *, refcount=True, **options):
     """Compile ``func`` with numba in nopython mode (cached), or return it unchanged.
 
     Use bare (``@njit``) or with extra numba options (``@njit(inline="always")``);
-    ``refcount=False``: see the module docstring. Kernels outside the package (a test's, say) get
-    numba's own per-file cache.
+    ``refcount=False``: see the module docstring.
     """
     if func is None:
         return lambda f: njit(f, refcount=refcount, **options)
@@ -204,8 +208,6 @@ def njit(func=None, *, refcount=True, **options):
         return func
     # set explicitly, so that a kernel called from a ``refcount=False`` one does not inherit it
     options["_nrt"] = bool(refcount)
-    if not _in_package(func):
-        return _numba.njit(cache=True, nogil=True, **options)(func)
     dispatcher = _KernelDispatcher(
         py_func=func,
         locals=options.pop("locals", {}),

@@ -1,17 +1,18 @@
-"""Exact mode's event calendar: one pending event per ball, in an 8-ary heap of balls.
+"""Exact mode's event calendar: one pending event per ball, in a two-level event queue.
 
 This is the sorter of an event-driven simulation (the scheduler is ``exact.step_exact``, the
 neighbour search is :mod:`collision_env.engine.grid`). Following Lubachevsky (1991) and
 Smallenburg (2022, "Efficient event-driven simulations of hard spheres", EPJE 45:22), each ball
 holds only its earliest known event: a wall, a partner ball, or the crossing of a grid-cell
-boundary. An 8-ary heap orders balls by event time, and simultaneous events as a scan of the balls in
-index order would meet them (:func:`order_key`); finding, updating or removing an event is
-O(log N).
+boundary. The queue orders balls by event time, and simultaneous events as a scan of the balls in
+index order would meet them (:func:`order_key`). It is an 8-ary heap of every ball in small
+scenes (O(log N) per event); in large ones, a heap of the near future and time buckets for the
+rest (Paul 2007: O(1) per event, see the section below).
 
 Invalidation is lazy (Sedgewick & Wayne, *Algorithms*, 4th ed., 6.1): every ball counts the
 changes of its trajectory, and a pair event stores its partner's count when it was predicted. An
-event whose partner has changed since is stale; when it comes to the top of the heap the ball is
-simply predicted afresh. A pair event is held only by the ball whose prediction found it (as in
+event whose partner has changed since is stale; when it comes to the front of the queue the ball
+is simply predicted afresh. A pair event is held only by the ball whose prediction found it (as in
 Smallenburg's code): the earliest pending event is always held, because the ball of the pair that
 changed last looked at the other when it was predicted, and every event of a ball before that
 time would have changed it.
@@ -21,15 +22,34 @@ when a step ends), so no large absolute time enters it.
 
 The per-ball fields live in one scene's calendar records ``rec`` (``layout.CAL_RECORD``: the event
 time and the change counter) and its int32 rows ``ci`` (``layout.CAL_I``: what the event is, the
-partner's count, the heap slot); the heap itself in ``hp`` (``layout.HEAP``).
+partner's count, where it is queued); the queue itself in an :class:`EventQueue`.
 """
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from ._jit import njit
-from .layout import C_EVENT_OTHER, C_EVENT_STAMP, C_HEAP_SLOT, H_BALL, H_TIME
+from .layout import (
+    C_EVENT_OTHER,
+    C_EVENT_STAMP,
+    C_QUEUE_NEXT,
+    C_QUEUE_PREV,
+    C_QUEUE_SLOT,
+    H_BALL,
+    H_TIME,
+    W_QUEUE_BASE,
+    W_QUEUE_BUCKET,
+    W_QUEUE_FAR,
+    W_QUEUE_HEAP,
+    W_QUEUE_RELEASE,
+    W_QUEUE_RING,
+    W_QUEUE_WIDTH,
+)
+
+INF = np.inf
 
 #: ``event_other`` codes below zero. A ball's wall events are ``EV_WALL - wall`` (wall codes 0..3
 #: as in ``scene.WALL_NAMES``); its grid-cell crossings are ``EV_CROSS - direction`` (0: -x,
@@ -95,6 +115,47 @@ def _before(ta, a, tb, b, ci):
     return a < b
 
 
+# ---------------------------------------------------------------------------- the event queue
+# Paul's two-level queue (Paul 2007, "A complexity O(1) priority queue for event driven molecular
+# dynamics simulations", J. Comput. Phys. 221:615; as in Smallenburg 2022): the near future is
+# a heap, ordered by ``_before``; later events wait in unsorted time buckets ``width`` seconds
+# wide, in a ring, and events beyond the ring in a far list. When the heap runs empty, the next
+# bucket is moved into it. A pop then sifts through a heap of a few events, which stays in the
+# cache, instead of through a heap of every ball, whose lower levels do not at 10^5 balls; moving
+# an event between buckets touches its list neighbours, and moving it within a bucket nothing.
+#
+# Bucket ``k`` holds the events at step times ``t`` with ``floor((t - base) / width) = k``; the heap
+# holds every event of ``k <= bucket`` (the bucket last moved into it), the ring every event of
+# ``bucket < k <= bucket + R`` (at position ``k % R``), the far list the rest. The bucket of a time
+# is a monotonic function of it in floating point, so every heap event comes strictly before
+# every other: the heap's first event is the queue's. Each list is doubly linked through the
+# balls' int rows (``layout.CAL_I``), so an event leaves its list in O(1).
+#
+#: Scenes with fewer balls keep every event in the heap (no buckets): below this size the heap of
+#: every ball stays in the cache, and the buckets' bookkeeping costs more than the levels it saves
+#: (measured by the scale benchmark).
+QUEUE_MIN_BALLS = 4096
+#: Buckets in the ring per ball, and the events a bucket holds on average: the width is set from
+#: the mean time to the balls' next events when the queue is built, so that the heap stays small
+#: and the ring reaches some ``BUCKETS_PER_BALL * EVENTS_PER_BUCKET`` such times ahead.
+BUCKETS_PER_BALL = 0.5
+EVENTS_PER_BUCKET = 16
+
+
+def bucket_count(n):
+    """Buckets in the ring of a scene of ``n`` balls (0: every event in the heap)."""
+    return int(BUCKETS_PER_BALL * n) if n >= QUEUE_MIN_BALLS else 0
+
+
+class EventQueue(NamedTuple):
+    """One scene's event queue: views of the arrays that hold it."""
+
+    hp: np.ndarray  #: (rows, len(HEAP)) float64, the heap (slot s in row ``s + HEAP_OFFSET``)
+    buckets: np.ndarray  #: (R + 1,) int32: the first ball of each bucket's list, then the far list's
+    qf: np.ndarray  #: the scene's ``layout.WORK_F`` row (the buckets' base and width)
+    qi: np.ndarray  #: the scene's ``layout.WORK_I`` row (the queue's counts, its bucket)
+
+
 #: Children per node of the heap: an 8-ary heap is a third as deep as a binary one, and a node's
 #: children lie side by side in ``hp``, in two adjacent cache lines (measured against a 4-ary heap
 #: by the scale benchmark's gas: faster at 10^4 balls, the same at 10^5).
@@ -115,7 +176,7 @@ def heap_rows(n):
 def _place(slot, ball, t, ci, hp):
     hp[slot + HEAP_OFFSET, H_TIME] = t
     hp[slot + HEAP_OFFSET, H_BALL] = ball
-    ci[ball, C_HEAP_SLOT] = slot
+    ci[ball, C_QUEUE_SLOT] = slot
 
 
 @njit(inline="always")
@@ -185,9 +246,9 @@ def _first_child(first, n, ci, hp):
 
 @njit(inline="always")
 def _sift_down(slot, n, ci, hp):
-    """Move the ball at ``slot`` down to its place (its time is the one held in the heap; a ball
-    already in place is not written again, so ordering a heap that is in order reads only the
-    heap)."""
+    """Move the ball at ``slot`` down to its place in a heap of ``n`` (its time is the one held in
+    the heap; a ball already in place is not written again, so ordering a heap that is in order
+    reads only the heap)."""
     ball = _ball_at(slot, hp)
     t = _time_at(slot, hp)
     start = slot
@@ -206,48 +267,235 @@ def _sift_down(slot, n, ci, hp):
 
 
 @njit(inline="always")
-def reschedule(ball, n, rec, ci, hp):
-    """Restore the heap order after ``ball``'s event time changed (either way)."""
-    slot = _sift_up(ci[ball, C_HEAP_SLOT], rec, ci, hp)
-    _sift_down(slot, n, ci, hp)
-
-
-@njit(inline="always")
-def heapify(n, ci, hp):
-    """Order the heap from scratch (Floyd's O(N) construction), from the event times it holds."""
+def _heapify(n, ci, hp):
+    """Order a heap of ``n`` from scratch (Floyd's O(n) construction), from the times it holds."""
     for slot in range((n - 2) // ARITY, -1, -1):
         _sift_down(slot, n, ci, hp)
 
 
 @njit(inline="always")
-def reset_heap(n, rec, ci, hp):
-    """Put every ball in the heap (slot = index) and order it."""
+def _heap_push(ball, t, rec, ci, q):
+    size = q.qi[W_QUEUE_HEAP]
+    _place(size, ball, t, ci, q.hp)
+    q.qi[W_QUEUE_HEAP] = size + 1
+    _sift_up(size, rec, ci, q.hp)
+
+
+@njit(inline="always")
+def _ring_size(q):
+    return q.buckets.shape[0] - 1
+
+
+@njit(inline="always")
+def _position(t, q):
+    """Where an event at step time ``t`` is queued: -1 the heap, ``0 .. R - 1`` a bucket of the
+    ring, ``R`` the far list (R = 0: no buckets, always the heap)."""
+    ring = _ring_size(q)
+    if ring == 0:
+        return -1
+    x = (t - q.qf[W_QUEUE_BASE]) / q.qf[W_QUEUE_WIDTH]
+    bucket = q.qi[W_QUEUE_BUCKET]
+    if x < bucket + 1:
+        return -1
+    if x < bucket + ring + 1:
+        return int(x) % ring
+    return ring  # (also an event that never comes, t = inf)
+
+
+@njit(inline="always")
+def _link(ball, p, ci, q):
+    """Put ``ball``'s event at the front of list ``p`` (a bucket, or the far list)."""
+    head = q.buckets[p]
+    ci[ball, C_QUEUE_SLOT] = -1 - p
+    ci[ball, C_QUEUE_NEXT] = head
+    ci[ball, C_QUEUE_PREV] = -1
+    if head >= 0:
+        ci[head, C_QUEUE_PREV] = ball
+    q.buckets[p] = ball
+    q.qi[W_QUEUE_FAR if p == _ring_size(q) else W_QUEUE_RING] += 1
+
+
+@njit(inline="always")
+def _unlink(ball, ci, q):
+    """Take ``ball``'s event out of its list."""
+    p = -1 - ci[ball, C_QUEUE_SLOT]
+    prev = ci[ball, C_QUEUE_PREV]
+    nxt = ci[ball, C_QUEUE_NEXT]
+    if prev >= 0:
+        ci[prev, C_QUEUE_NEXT] = nxt
+    else:
+        q.buckets[p] = nxt
+    if nxt >= 0:
+        ci[nxt, C_QUEUE_PREV] = prev
+    q.qi[W_QUEUE_FAR if p == _ring_size(q) else W_QUEUE_RING] -= 1
+
+
+@njit(inline="always")
+def _file(ball, p, rec, ci, q):
+    """Queue ``ball``'s event (in no list yet) at position ``p`` (see :func:`_position`)."""
+    if p < 0:
+        _heap_push(ball, rec[ball]["event_time"], rec, ci, q)
+    else:
+        _link(ball, p, ci, q)
+
+
+@njit(inline="always")
+def schedule(ball, rec, ci, q):
+    """Move ``ball``'s event to its place in the queue after its time changed (either way)."""
+    t = rec[ball]["event_time"]
+    slot = ci[ball, C_QUEUE_SLOT]
+    p = _position(t, q)
+    if slot < 0:
+        if p != -1 - slot:  # (a move within a bucket costs nothing: buckets are not sorted)
+            _unlink(ball, ci, q)
+            _file(ball, p, rec, ci, q)
+        return
+    size = q.qi[W_QUEUE_HEAP]
+    if p >= 0:  # out of the heap: the last event fills its slot, and is sifted instead
+        size -= 1
+        q.qi[W_QUEUE_HEAP] = size
+        _link(ball, p, ci, q)
+        if slot == size:
+            return
+        _place(slot, _ball_at(size, q.hp), _time_at(size, q.hp), ci, q.hp)
+    _sift_down(_sift_up(slot, rec, ci, q.hp), size, ci, q.hp)
+
+
+@njit(inline="always")
+def _release_far(rec, ci, q):
+    """Sort the far list's events that the ring now reaches into the ring (or the heap), and note
+    the bucket at which to do so next (before any event left in the far list is due)."""
+    ring = _ring_size(q)
+    q.qi[W_QUEUE_RELEASE] = q.qi[W_QUEUE_BUCKET] + ring
+    ball = q.buckets[ring]
+    while ball >= 0:
+        nxt = ci[ball, C_QUEUE_NEXT]
+        p = _position(rec[ball]["event_time"], q)
+        if p != ring:
+            _unlink(ball, ci, q)
+            _file(ball, p, rec, ci, q)
+        ball = nxt
+
+
+@njit(inline="always")
+def _open_next_bucket(rec, ci, q):
+    """Move the next bucket's events into the heap; when the ring is empty, start the buckets anew
+    at the far list's first event instead of stepping through empty ones. Returns False if
+    nothing is queued that will ever come."""
+    ring = _ring_size(q)
+    if q.qi[W_QUEUE_RING] == 0:
+        t_first = INF
+        ball = q.buckets[ring]
+        while ball >= 0:
+            t_first = min(t_first, rec[ball]["event_time"])
+            ball = ci[ball, C_QUEUE_NEXT]
+        if t_first == INF:
+            return False
+        q.qf[W_QUEUE_BASE] = t_first
+        q.qi[W_QUEUE_BUCKET] = -1
+        q.qi[W_QUEUE_RELEASE] = -1
+    q.qi[W_QUEUE_BUCKET] += 1
+    bucket = q.qi[W_QUEUE_BUCKET]
+    p = bucket % ring
+    ball = q.buckets[p]
+    q.buckets[p] = -1
+    while ball >= 0:
+        nxt = ci[ball, C_QUEUE_NEXT]
+        q.qi[W_QUEUE_RING] -= 1
+        _heap_push(ball, rec[ball]["event_time"], rec, ci, q)
+        ball = nxt
+    if bucket >= q.qi[W_QUEUE_RELEASE]:  # (after the bucket is emptied: the far list may refill it)
+        _release_far(rec, ci, q)
+    return True
+
+
+@njit(inline="always")
+def next_ball(rec, ci, q):
+    """The ball whose event comes first (-1: none is queued but events that never come)."""
+    while q.qi[W_QUEUE_HEAP] == 0:
+        if _ring_size(q) == 0 or not _open_next_bucket(rec, ci, q):
+            return -1
+    return _ball_at(0, q.hp)
+
+
+@njit(inline="always")
+def bucket_width(n, now, rec):
+    """A bucket width for a scene's events: about :data:`EVENTS_PER_BUCKET` events per bucket, if
+    each ball's next event is as far from ``now`` as their mean (inf: no finite event)."""
+    total = 0.0
+    finite = 0
     for i in range(n):
-        _place(i, i, rec[i]["event_time"], ci, hp)
-    heapify(n, ci, hp)
+        t = rec[i]["event_time"]
+        if t < INF:
+            total += t - now
+            finite += 1
+    width = EVENTS_PER_BUCKET * total / max(finite, 1) / n
+    return width if 0.0 < width < INF else INF  # (inf: every finite time in the heap)
 
 
 @njit(inline="always")
-def next_ball(hp):
-    """The ball whose event comes first."""
-    return _ball_at(0, hp)
+def reset_queue(n, now, width, rec, ci, q):
+    """Queue every ball's event afresh (their times are set), in buckets of ``width`` seconds
+    from step time ``now`` (a ring-less queue ignores it)."""
+    ring = _ring_size(q)
+    q.qi[W_QUEUE_HEAP] = 0
+    q.qi[W_QUEUE_RING] = 0
+    q.qi[W_QUEUE_FAR] = 0
+    q.qi[W_QUEUE_BUCKET] = 0
+    q.qi[W_QUEUE_RELEASE] = ring
+    q.qf[W_QUEUE_BASE] = now
+    q.qf[W_QUEUE_WIDTH] = width
+    q.buckets[:] = -1
+    size = 0
+    for i in range(n):
+        p = _position(rec[i]["event_time"], q)
+        if p < 0:
+            _place(size, i, rec[i]["event_time"], ci, q.hp)
+            size += 1
+        else:
+            _link(i, p, ci, q)
+    q.qi[W_QUEUE_HEAP] = size
+    _heapify(size, ci, q.hp)
 
 
 @njit(inline="always")
-def rebase(n, t, hp):
-    """Subtract ``t`` from every event time in the heap (the balls' own times are the caller's),
-    and restore the heap order if that rounded a node's and its parent's times into a tie (which
-    the tie rule, :func:`order_key`, may order the other way). Subtracting the same number keeps
-    every other pair in order, so the heap is re-ordered only then (or when finite times were tied
-    already, which is rare)."""
-    tie = False
-    for slot in range(n):
-        row = slot + HEAP_OFFSET
-        hp[row, H_TIME] -= t
-        if slot > 0:
-            above = _time_at((slot - 1) // ARITY, hp)
-            tie = tie or (hp[row, H_TIME] == above and above < np.inf)
-    return tie
+def rebase_queue(n, t, rec, ci, q):
+    """Make the queue's times relative to step time ``t``, after every ball's event time was (the
+    caller's): the heap's times and the buckets' base are rebased the same way. Round-off can move
+    a time across a bucket boundary, or round a heap node's and its parent's times into a tie
+    (which the tie rule, :func:`order_key`, may order the other way): such events are moved and
+    the heap is re-ordered, which is rare. Subtracting the same number keeps every other pair in
+    order."""
+    size = q.qi[W_QUEUE_HEAP]
+    hp = q.hp
+    for slot in range(size):
+        hp[slot + HEAP_OFFSET, H_TIME] -= t
+    q.qf[W_QUEUE_BASE] -= t
+    disorder = False
+    if _ring_size(q) > 0:
+        for i in range(n):
+            p = _position(rec[i]["event_time"], q)
+            slot = ci[i, C_QUEUE_SLOT]
+            if slot >= 0 and p >= 0:
+                size -= 1  # (the heap is re-ordered below)
+                if slot < size:
+                    _place(slot, _ball_at(size, hp), _time_at(size, hp), ci, hp)
+                _link(i, p, ci, q)
+                disorder = True
+            elif slot < 0 and p != -1 - slot:
+                _unlink(i, ci, q)
+                if p < 0:
+                    _place(size, i, rec[i]["event_time"], ci, hp)
+                    size += 1
+                    disorder = True
+                else:
+                    _link(i, p, ci, q)
+        q.qi[W_QUEUE_HEAP] = size
+    for slot in range(1, size):
+        above = _time_at((slot - 1) // ARITY, hp)
+        disorder = disorder or (_time_at(slot, hp) == above and above < INF)
+    if disorder:
+        _heapify(size, ci, hp)
 
 
 @njit(inline="always")

@@ -3,8 +3,9 @@
 The scheduler of the event-driven loop (Alder & Wainwright 1959; Rapaport 1980; Lubachevsky
 1991). Its parts, each with one job:
 
-- the **calendar** (:mod:`~collision_env.engine.calendar`): one pending event per ball in an 8-ary
-  heap, invalidated lazily; it persists from one step to the next;
+- the **calendar** (:mod:`~collision_env.engine.calendar`): one pending event per ball, invalidated
+  lazily, in an event queue (a heap, and time buckets in large scenes); it persists from one step
+  to the next;
 - the **broad phase** (:mod:`~collision_env.engine.grid`): a cell grid, so that a prediction looks
   only at the 3 x 3 cells around a ball, kept current by cell-crossing events (one cell, i.e. all
   pairs, in small scenes);
@@ -138,7 +139,7 @@ class SceneCalendar(NamedTuple):
     rec: np.ndarray  #: (N,) ``layout.CAL_RECORD``
     ci: np.ndarray  #: (N, len(CAL_I)) int32
     heads: np.ndarray  #: (cells,) int32, the first ball of each grid cell
-    hp: np.ndarray  #: the event queue (``layout.HEAP``)
+    q: cal.EventQueue  #: the event queue
 
 
 class Physics(NamedTuple):
@@ -807,7 +808,7 @@ def _predict(i, now, horizon, rebuild, rot, b, cl, ph, geo, wk):
         )
     cal.set_event(i, best_t, best_code, best_stamp, cl.rec, cl.ci)
     if not rebuild:
-        cal.reschedule(i, cl.rec.shape[0], cl.rec, cl.ci, cl.hp)
+        cal.schedule(i, cl.rec, cl.ci, cl.q)
 
 
 # ---------------------------------------------------------------------------- begin
@@ -866,7 +867,7 @@ def _verified_time(i, code, bounds, dim, rec):
 
 # ---------------------------------------------------------------------------- finish
 @njit(inline="always")
-def _finish(t_end, pos, vel, mass, body, omega, rot, sticky, rec, ci, hp):
+def _finish(t_end, pos, vel, mass, body, omega, rot, sticky, rec, ci, q):
     """End the step at step time ``t_end``: every ball there (records and ball state), and the
     calendar's times made relative to it (the next step starts at 0)."""
     n = pos.shape[0]
@@ -882,8 +883,7 @@ def _finish(t_end, pos, vel, mass, body, omega, rot, sticky, rec, ci, hp):
             pos[i, 1] = r["y"]
         r["ref_time"] = 0.0
         r["event_time"] -= t_end
-    if cal.rebase(n, t_end, hp):  # the same times, rebased the same way
-        cal.heapify(n, ci, hp)
+    cal.rebase_queue(n, t_end, rec, ci, q)  # (the same times, rebased the same way)
 
 
 # ---------------------------------------------------------------------------- resolve
@@ -1008,7 +1008,7 @@ def _screen(bi, t, now, ph, cl, geo, wk):
         wk.pending[0] = bi
         return 1, t, now
     cl.rec[bi]["event_time"] = t_check
-    cal.reschedule(bi, cl.rec.shape[0], cl.rec, cl.ci, cl.hp)
+    cal.schedule(bi, cl.rec, cl.ci, cl.q)
     return 0, t, now
 
 
@@ -1055,6 +1055,7 @@ def step_exact(
     cal_i,
     cal_heads,
     cal_heap,
+    cal_buckets,
     scratch_f,
     scratch_i,
     scratch_b,
@@ -1066,10 +1067,12 @@ def step_exact(
     ``balls`` is the (B, N, 8) per-ball state (``layout.BALL``), ``body_all`` the (B, N) cluster
     roots, ``time`` the (B,) clocks; ``fparams``/``iparams`` the scene parameters
     (``layout.SCENE_F``/``SCENE_I``); ``work_f``/``work_i`` the per-scene bookkeeping and grid
-    geometry (``layout.WORK_F``/``WORK_I``); ``cal_rec``/``cal_i``/``cal_heads``/``cal_heap`` the
-    persistent calendar records, its int rows, the grid's cell heads and the event queue
-    (``layout.CAL_RECORD``/``CAL_I``/``HEAP``); ``clock`` the compensated clocks
-    (:mod:`~collision_env.engine.clock`), advanced when a scene's step ends. ``start`` is
+    geometry (``layout.WORK_F``/``WORK_I``, which also hold the event queue's counts);
+    ``cal_rec``/``cal_i``/``cal_heads``/``cal_heap``/``cal_buckets`` the persistent calendar records,
+    its int rows, the grid's cell heads, and the event queue's heap and buckets
+    (``layout.CAL_RECORD``/``CAL_I``/``HEAP``, :class:`~collision_env.engine.calendar.EventQueue`);
+    ``clock`` the compensated clocks (:mod:`~collision_env.engine.clock`), advanced when a scene's
+    step ends. ``start`` is
     :data:`START_STEP` to start a step of ``dt_abs`` for every scene, :data:`START_NEXT` to start
     one right after a completed step of this kernel that nobody touched since (the balls need not
     be compared with their records), or :data:`RESUME` to resume the scenes flagged active.
@@ -1107,7 +1110,8 @@ def step_exact(
         b = SceneBalls(
             pos_all[sc], vel_all[sc], mass_all[sc], inv_mass_all[sc], radius_all[sc], body_all[sc], omega_all[sc]
         )
-        cl = SceneCalendar(cal_rec[sc], cal_i[sc], cal_heads[sc], cal_heap[sc])
+        q = cal.EventQueue(cal_heap[sc], cal_buckets[sc], work_f[sc], work_i[sc])
+        cl = SceneCalendar(cal_rec[sc], cal_i[sc], cal_heads[sc], q)
         geo = grid.scene_geometry(work_f, work_i, sc)
         horizon_end = work_f[sc, W_REMAINING]
         t0 = time[sc]
@@ -1129,11 +1133,14 @@ def step_exact(
             for q in range(n_pending):
                 _predict(wk.pending[q], now, horizon_end - now, whole, rot, b, cl, ph, geo, wk)
             if whole:
-                cal.reset_heap(n, cl.rec, cl.ci, cl.hp)
+                width = cal.bucket_width(n, now, cl.rec) if cl.q.buckets.shape[0] > 1 else INF
+                cal.reset_queue(n, now, width, cl.rec, cl.ci, cl.q)
                 work_i[sc, W_CALENDAR_VALID] = True
                 whole = False
             # pop
-            bi = cal.next_ball(cl.hp)
+            bi = cal.next_ball(cl.rec, cl.ci, cl.q)
+            if bi < 0:
+                break
             t = cl.rec[bi]["event_time"]
             if not t <= horizon_end:
                 break
@@ -1171,7 +1178,7 @@ def step_exact(
             continue
         # finish
         t_end = now if capped[sc] else horizon_end
-        _finish(t_end, b.pos, b.vel, b.mass, b.body, b.omega, rot, ph.sticky, cl.rec, cl.ci, cl.hp)
+        _finish(t_end, b.pos, b.vel, b.mass, b.body, b.omega, rot, ph.sticky, cl.rec, cl.ci, cl.q)
         time[sc] = t0 + ph.sign * t_end
         work_f[sc, W_REMAINING] = horizon_end - t_end
         n_imp[1] += capped[sc]
@@ -1207,16 +1214,17 @@ if HAVE_NUMBA:
     def step_exact_packed(h, dt_abs, start):
         """:func:`step_exact` on the arrays packed in ``h`` (:mod:`~collision_env.engine.argpack`),
         one slot per array in the order of its parameters; the call Python makes, with one array
-        to check instead of nineteen."""
+        to check instead of twenty."""
         return step_exact(
             *unpack_state(h),
             view2(h, 12, CAL_RECORD),
             view3(h, 13, np.int32),
             view2(h, 14, np.int32),
             view3(h, 15, np.float64),
-            view1(h, 16, np.float64),
-            view1(h, 17, np.int64),
-            view1(h, 18, np.bool_),
+            view2(h, 16, np.int32),
+            view1(h, 17, np.float64),
+            view1(h, 18, np.int64),
+            view1(h, 19, np.bool_),
             dt_abs,
             start,
         )

@@ -11,7 +11,8 @@ Per ball, ``(B, N, len(fields))``:
 - :data:`BALL` (float64): the physical state, see :mod:`collision_env.engine.motion`.
 - :data:`CAL_RECORD` (a structured dtype, ``(B, N)``) and :data:`CAL_I` (int32): exact mode's
   persistent event calendar and cell grid, see :mod:`collision_env.engine.calendar` and
-  :mod:`collision_env.engine.grid`; :data:`HEAP` (float64): the calendar's event queue.
+  :mod:`collision_env.engine.grid`; :data:`HEAP` (float64): the heap of the calendar's event
+  queue (its time buckets are an int32 array of list heads, ``(B, buckets + 1)``).
 
 Per scene:
 
@@ -54,13 +55,15 @@ CAL_RECORD = np.dtype(
     align=True,
 )
 
-#: Per-ball calendar ints (int32), read only for the ball's own event or when it moves between
-#: cells: what the next event is (a partner ball >= 0, or a ``calendar.EV_*`` code); the partner's
-#: change counter when it was predicted; the ball's slot in the event queue's heap; its grid cell
-#: and the previous ball in that cell's list. (The first ball of each cell is in a (B, cells) int32
-#: array of its own, so that the heads of neighbouring cells share cache lines.)
-CAL_I = ("event_other", "event_stamp", "heap_slot", "cell", "cell_prev")
-C_EVENT_OTHER, C_EVENT_STAMP, C_HEAP_SLOT, C_CELL, C_CELL_PREV = range(5)
+#: Per-ball calendar ints (int32), read only for the ball's own event, when it moves between
+#: cells, or when a neighbour in its queue list moves: what the next event is (a partner ball >= 0,
+#: or a ``calendar.EV_*`` code); the partner's change counter when it was predicted; where the
+#: event is queued (a heap slot >= 0, or ``-1 - bucket``) and, in a bucket, the next and previous
+#: ball of that bucket's list; its grid cell and the previous ball in that cell's list. (The first
+#: ball of each cell is in a (B, cells) int32 array of its own, so that the heads of neighbouring
+#: cells share cache lines.)
+CAL_I = ("event_other", "event_stamp", "queue_slot", "queue_next", "queue_prev", "cell", "cell_prev")
+C_EVENT_OTHER, C_EVENT_STAMP, C_QUEUE_SLOT, C_QUEUE_NEXT, C_QUEUE_PREV, C_CELL, C_CELL_PREV = range(7)
 
 #: The event queue's heap, one row per slot (float64): the event time held there and the ball
 #: (an integer stored as a float, so that a node and its children share cache lines).
@@ -82,16 +85,31 @@ S_HAS_WALLS, S_PAIRS, S_DIM, S_STICKY, S_MAX_EVENTS = range(5)
 #: (more than 0 only at the event cap); how far into the step a scene that found the impact buffer
 #: full got (exact mode: the next call resumes it there, so a step's arithmetic does not depend on
 #: the buffer's size or the batch); start time of the current sub-step (cheap modes); the grid's
-#: origin and cell sizes (exact mode).
-WORK_F = ("remaining", "stalled_at", "substep_start", "grid_x0", "grid_y0", "grid_hx", "grid_hy")
-W_REMAINING, W_STALLED_AT, W_SUBSTEP_START, W_GRID_X0, W_GRID_Y0, W_GRID_HX, W_GRID_HY = range(7)
+#: origin and cell sizes (exact mode); the event queue's time buckets: the step time where bucket 0
+#: starts, and their width (s).
+WORK_F = (
+    "remaining", "stalled_at", "substep_start", "grid_x0", "grid_y0", "grid_hx", "grid_hy", "queue_base",
+    "queue_width",
+)  # fmt: skip
+(
+    W_REMAINING, W_STALLED_AT, W_SUBSTEP_START, W_GRID_X0, W_GRID_Y0, W_GRID_HX, W_GRID_HY, W_QUEUE_BASE,
+    W_QUEUE_WIDTH,
+) = range(9)  # fmt: skip
 
 #: Per-scene work ints: events in the current step; the scene still has work in this step; it
 #: stopped because the impact buffer was full; sub-steps done (cheap modes); the calendar holds
 #: valid predictions (0 after anything that changes a scene wholesale: a reset, ``set_state``);
-#: the grid's cells along x and y.
-WORK_I = ("events", "active", "stalled", "substeps_done", "calendar_valid", "grid_nx", "grid_ny")
-W_EVENTS, W_ACTIVE, W_STALLED, W_SUBSTEPS_DONE, W_CALENDAR_VALID, W_GRID_NX, W_GRID_NY = range(7)
+#: the grid's cells along x and y; the event queue: the bucket last moved into its heap, the bucket
+#: at which its far list is next sorted into buckets, and how many events its heap, its buckets
+#: and its far list hold.
+WORK_I = (
+    "events", "active", "stalled", "substeps_done", "calendar_valid", "grid_nx", "grid_ny", "queue_bucket",
+    "queue_release", "queue_heap", "queue_ring", "queue_far",
+)  # fmt: skip
+(
+    W_EVENTS, W_ACTIVE, W_STALLED, W_SUBSTEPS_DONE, W_CALENDAR_VALID, W_GRID_NX, W_GRID_NY, W_QUEUE_BUCKET,
+    W_QUEUE_RELEASE, W_QUEUE_HEAP, W_QUEUE_RING, W_QUEUE_FAR,
+) = range(12)  # fmt: skip
 
 #: One row per impact, as ``BatchSimulator.step`` returns them (the kernels write them).
 IMPACT_DTYPE = np.dtype(

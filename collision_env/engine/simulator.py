@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike
 from . import grid
 from ._jit import BACKEND, HAVE_NUMBA
 from .argpack import pack
-from .calendar import heap_rows
+from .calendar import bucket_count, heap_rows
 from .exact import COUNTERS, RESUME, START_STEP, impacts_per_event, scratch_sizes, step_exact
 from .frames import EXACT, copy_impacts, record_frame
 
@@ -329,6 +329,7 @@ class BatchSimulator:
         self._cal_i = np.zeros((n_scenes, n, len(CAL_I)), dtype=np.int32)
         self._cal_heads = np.zeros((n_scenes, grid.EXACT_CELLS_PER_BALL * n), dtype=np.int32)
         self._cal_heap = _aligned_zeros((n_scenes, heap_rows(n), len(HEAP)), np.float64)
+        self._cal_buckets = np.full((n_scenes, bucket_count(n) + 1), -1, dtype=np.int32)
         self._invalidate(np.arange(n_scenes))
         self._alloc_work()
 
@@ -496,9 +497,9 @@ class BatchSimulator:
         if self.mode == "exact":
             nf, ni, nb = scratch_sizes(self._n)
             scratch = (np.empty(nf), np.empty(ni, dtype=np.int64), np.zeros(nb, dtype=np.bool_))
-            arrays = state + (self._cal, self._cal_i, self._cal_heads, self._cal_heap) + scratch
+            arrays = state + (self._cal, self._cal_i, self._cal_heads, self._cal_heap, self._cal_buckets) + scratch
             self._kernel, self._kernel_args = step_exact, arrays
-            if HAVE_NUMBA:  # one packed array per call instead of nineteen (see argpack)
+            if HAVE_NUMBA:  # one packed array per call instead of twenty (see argpack)
                 self._kernel, self._kernel_args = step_exact_packed, (pack(arrays),)
                 self._frames_args = (EXACT, 0) + self._kernel_args
         else:
@@ -926,7 +927,7 @@ class BatchSimulator:
         for field in (S_ELASTICITY, S_SIGN):  # (the direction of time the state is kept for)
             self._fparams[field] = other._fparams[field]
         if self.mode == "exact":
-            for name in ("_cal", "_cal_i", "_cal_heads", "_cal_heap"):
+            for name in ("_cal", "_cal_i", "_cal_heads", "_cal_heap", "_cal_buckets"):
                 np.copyto(getattr(self, name), getattr(other, name))
         self._sign = other._sign
         self._forward = other._forward

@@ -1,8 +1,9 @@
 """Exact mode's persistent calendar and the grid broad phase.
 
 Every invalidation path is checked against a simulator built afresh from the same state (which
-predicts everything from scratch): a nudge between steps, ``set_state``, a reversal of time, a
-ball crossing many grid cells in one step, and a batch of 1024 scenes. The grid is checked
+predicts everything from scratch): a nudge between steps, ``set_state``, a reversal of time (in
+small scenes, and in one large enough for the event queue's time buckets), a ball crossing many
+grid cells in one step, and a batch of 1024 scenes. The grid is checked
 against all pairs, in exact mode and in the cheap modes.
 """
 
@@ -13,7 +14,9 @@ import pytest
 
 import collision_env.engine.simulator as simulator_module
 from collision_env.engine import BatchSimulator, Scene, Simulator
+from collision_env.engine.calendar import QUEUE_MIN_BALLS
 from collision_env.engine.grid import GRID_MIN_BALLS
+from collision_env.engine.layout import W_QUEUE_FAR, W_QUEUE_HEAP, W_QUEUE_RING
 
 
 def gas(n, phi=0.3, r=0.01, seed=0, speed=1.0):
@@ -25,6 +28,10 @@ def gas(n, phi=0.3, r=0.01, seed=0, speed=1.0):
     pos = np.stack([xx.ravel(), yy.ravel()], 1)[:n]
     vel = np.random.default_rng(seed).normal(size=(n, 2)) * speed / np.sqrt(2)
     return Scene(bounds=(-side / 2, -side / 2, side / 2, side / 2)), pos, vel, np.full(n, r)
+
+
+#: A scene large enough for the event queue's time buckets (and a grid).
+LARGE = QUEUE_MIN_BALLS + 500
 
 
 def fresh_copy(sim):
@@ -60,7 +67,7 @@ def step_both(sim, other, dt, steps):
     np.testing.assert_allclose(sim.velocities, other.velocities, rtol=0, atol=1e-12)
 
 
-@pytest.mark.parametrize("n", [6, 120])
+@pytest.mark.parametrize("n", [6, 120, LARGE])
 def test_nudge_between_steps_matches_a_fresh_simulator(n):
     scene, pos, vel, radii = gas(n)
     sim = Simulator(scene, pos, vel, np.ones(n), radii=radii)
@@ -72,7 +79,7 @@ def test_nudge_between_steps_matches_a_fresh_simulator(n):
     step_both(sim, fresh_copy(sim), 1 / 60, 20)
 
 
-@pytest.mark.parametrize("n", [6, 120])
+@pytest.mark.parametrize("n", [6, 120, LARGE])
 def test_set_state_matches_a_fresh_simulator(n):
     scene, pos, vel, radii = gas(n)
     sim = Simulator(scene, pos, vel, np.ones(n), radii=radii)
@@ -84,7 +91,7 @@ def test_set_state_matches_a_fresh_simulator(n):
     step_both(sim, reference, 1 / 60, 20)
 
 
-@pytest.mark.parametrize("n", [6, 120])
+@pytest.mark.parametrize("n", [6, 120, LARGE])
 def test_reversal_of_time_matches_a_fresh_simulator(n):
     scene, pos, vel, radii = gas(n)
     sim = Simulator(scene, pos, vel, np.ones(n), radii=radii)
@@ -92,6 +99,17 @@ def test_reversal_of_time_matches_a_fresh_simulator(n):
         sim.step(1 / 60)
     step_both(sim, fresh_copy(sim), -1 / 60, 5)
     step_both(sim, fresh_copy(sim), 1 / 60, 5)
+
+
+def test_a_large_scene_queues_most_events_in_time_buckets():
+    scene, pos, vel, radii = gas(LARGE)
+    sim = Simulator(scene, pos, vel, np.ones(LARGE), radii=radii)
+    for _ in range(3):
+        sim.step(1 / 60)
+    queue = sim.batch._work_i[0]
+    assert queue[W_QUEUE_HEAP] + queue[W_QUEUE_RING] + queue[W_QUEUE_FAR] == LARGE
+    assert queue[W_QUEUE_HEAP] < LARGE / 20 < queue[W_QUEUE_RING]
+    assert sim.batch._cal_buckets.shape == (1, LARGE // 2 + 1)
 
 
 def test_forward_then_back_returns_to_the_start_with_the_calendar_kept():

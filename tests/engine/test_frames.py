@@ -55,7 +55,7 @@ def assert_frames_are_a_step_loop(sim, loop, dt, n):
     np.testing.assert_array_equal(sim.time, loop.time)
     np.testing.assert_array_equal(sim.cap_reached, loop.cap_reached)
     assert sim.stats == loop.stats
-    for name in ("_cal", "_cal_i", "_cal_heap", "_body", "_clock"):  # the calendar and clusters too
+    for name in ("_cal", "_cal_i", "_cal_heap", "_cal_buckets", "_body", "_clock"):  # the calendar and clusters too
         np.testing.assert_array_equal(getattr(sim, name), getattr(loop, name))
     return rec
 

@@ -1,0 +1,143 @@
+"""Exact mode's event queue (a heap, and time buckets in large scenes) against a sorted list.
+
+Random sequences of the calendar's operations (pop and re-queue the first event, move any
+event earlier or later, rebase every time as a step's end does) on rings of 0 to 7 buckets of
+several widths, with times drawn from a coarse set so that ties and bucket boundaries are
+frequent: the queue's first ball is always the one a sort by time and the tie rule names.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from collision_env.engine import calendar as cal
+from collision_env.engine._jit import njit
+from collision_env.engine.layout import (
+    C_EVENT_OTHER,
+    CAL_I,
+    CAL_RECORD,
+    W_QUEUE_FAR,
+    W_QUEUE_HEAP,
+    W_QUEUE_RING,
+    WORK_F,
+    WORK_I,
+)
+
+POP, MOVE, REBASE = range(3)
+
+
+@njit
+def run_queue(width, rec, ci, hp, buckets, qf, qi, kinds, balls, times):
+    """Queue the events of ``rec``, then apply the operations, each after noting the queue's
+    first ball (-1: none): pop the first event and queue the ball's next ``times[k]`` later, move
+    ball ``balls[k]``'s event to ``times[k]``, or rebase every time by ``times[k]``. Returns the
+    first ball before each operation, and the queue's count of events after it."""
+    n = rec.shape[0]
+    q = cal.EventQueue(hp, buckets, qf, qi)
+    cal.reset_queue(n, 0.0, width, rec, ci, q)
+    firsts = np.empty(kinds.shape[0], dtype=np.int64)
+    counts = np.empty(kinds.shape[0], dtype=np.int64)
+    for k in range(kinds.shape[0]):
+        first = cal.next_ball(rec, ci, q)
+        firsts[k] = first
+        if kinds[k] == REBASE:
+            for i in range(n):
+                rec[i]["event_time"] -= times[k]
+            cal.rebase_queue(n, times[k], rec, ci, q)
+        elif kinds[k] == MOVE or first >= 0:
+            ball = balls[k] if kinds[k] == MOVE else first
+            rec[ball]["event_time"] = times[k] + (rec[ball]["event_time"] if kinds[k] == POP else 0.0)
+            cal.schedule(ball, rec, ci, q)
+        counts[k] = qi[W_QUEUE_HEAP] + qi[W_QUEUE_RING] + qi[W_QUEUE_FAR]
+    return firsts, counts
+
+
+def check_queue(ring, width, times, codes, kinds, balls, steps):
+    """Run the operations on a queue and on a sorted list of times alike; the queue's first ball
+    must always be the list's."""
+    n = len(times)
+    rec = np.zeros(n, dtype=CAL_RECORD)
+    rec["event_time"] = times
+    ci = np.zeros((n, len(CAL_I)), dtype=np.int32)
+    ci[:, C_EVENT_OTHER] = codes
+    qi = np.zeros(len(WORK_I), dtype=np.int64)
+    heap, buckets, qf = np.zeros((cal.heap_rows(n), 2)), np.full(ring + 1, -1, dtype=np.int32), np.zeros(len(WORK_F))
+    firsts, counts = run_queue(width, rec, ci, heap, buckets, qf, qi, kinds, balls, steps)
+    assert np.all(counts == n)
+
+    keys = np.array([cal.order_key(i, codes[i]) for i in range(n)])  # the tie rule, per ball
+    t = np.array(times, dtype=np.float64)
+    for k, (kind, ball, step) in enumerate(zip(kinds, balls, steps, strict=True)):
+        order = np.lexsort((np.arange(n), keys[:, 1], keys[:, 0], t))
+        if t[order[0]] == np.inf:  # (the heap of a ring-less queue holds events that never come, too)
+            assert firsts[k] == -1 or t[firsts[k]] == np.inf
+        else:
+            assert firsts[k] == order[0], k
+            if kind == POP:
+                t[order[0]] += step
+        if kind == MOVE:
+            t[ball] = step
+        elif kind == REBASE:
+            t -= step
+    np.testing.assert_array_equal(rec["event_time"], t)
+
+
+def tie_codes(n, codes):
+    """Partners, walls, cell crossings and nothing pending: the tie rule's every case."""
+    code = np.array([c % n if c >= 0 else c for c in codes[:n]], dtype=np.int32)
+    code[code == np.arange(n)] = cal.EV_NONE
+    return code
+
+
+@pytest.fixture(scope="module", autouse=True)
+def compiled_first():
+    """Compile (or load) the driver before any example runs: hypothesis traces the code its
+    examples run, which makes numba's compiler several times slower."""
+    check_queue(1, 0.5, [0.0, 1.0], tie_codes(2, [-1, -1]), np.array([POP]), np.array([0]), np.array([1.0]))
+
+
+TIMES = st.sampled_from([0.0, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 8.0, 40.0, np.inf])
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    ring=st.sampled_from([0, 1, 2, 3, 7]),
+    width=st.sampled_from([0.1, 0.25, 0.3, 1.0, np.inf]),
+    times=st.lists(TIMES, min_size=1, max_size=24),
+    codes=st.lists(st.integers(-9, 23), min_size=24, max_size=24),
+    ops=st.lists(
+        st.tuples(st.sampled_from([POP, POP, MOVE, REBASE]), st.integers(0, 23), TIMES), min_size=1, max_size=200
+    ),
+)
+def test_the_queue_always_names_the_first_event(ring, width, times, codes, ops):
+    n = len(times)
+    kinds = np.array([k for k, _, _ in ops])
+    balls = np.array([b % n for _, b, _ in ops])
+    steps = np.array([t if k != REBASE else min(t, 1.0) for k, _, t in ops])
+    check_queue(ring, width, times, tie_codes(n, codes), kinds, balls, steps)
+
+
+@pytest.mark.parametrize("ring", [1, 2, 5, 16])
+def test_a_long_run_of_a_gas_like_queue(ring):
+    """Events a mean time of 1 ahead, on times rounded to eighths of a bucket (many ties, many
+    boundaries): 20,000 operations, mostly pops, with moves earlier and later and a rebase now
+    and then, as a gas's calendar sees them."""
+    rng = np.random.default_rng(ring)
+    n, width, ops = 40, 0.1, 20_000
+    grain = width / 8
+
+    def ahead(size):
+        return np.round(rng.exponential(1.0, size) / grain) * grain
+
+    kinds = rng.choice([POP, MOVE, REBASE], size=ops, p=[0.7, 0.29, 0.01])
+    balls = rng.integers(0, n, ops)
+    rebase = np.round(rng.uniform(0, 0.5, ops) / grain) * grain
+    # a move goes to a time around the current one (roughly: each pop advances it by 1/n)
+    now = np.cumsum(np.where(kinds == POP, 1.0 / n, 0.0) - np.where(kinds == REBASE, rebase, 0.0))
+    steps = np.select(
+        [kinds == MOVE, kinds == REBASE], [np.round(now / grain) * grain + ahead(ops), rebase], ahead(ops)
+    )
+    check_queue(ring, width, ahead(n), tie_codes(n, rng.integers(-9, n, n)), kinds, balls, steps)
