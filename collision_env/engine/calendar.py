@@ -287,6 +287,12 @@ def _ring_size(q):
 
 
 @njit(inline="always")
+def _heap_size(rec, q):
+    """Events in the heap: every ball's without buckets (read without touching the counts)."""
+    return rec.shape[0] if _ring_size(q) == 0 else q.qi[W_QUEUE_HEAP]
+
+
+@njit(inline="always")
 def _position(t, q):
     """Where an event at step time ``t`` is queued: -1 the heap, ``0 .. R - 1`` a bucket of the
     ring, ``R`` the far list (R = 0: no buckets, always the heap)."""
@@ -350,7 +356,7 @@ def schedule(ball, rec, ci, q):
             _unlink(ball, ci, q)
             _file(ball, p, rec, ci, q)
         return
-    size = q.qi[W_QUEUE_HEAP]
+    size = _heap_size(rec, q)
     if p >= 0:  # out of the heap: the last event fills its slot, and is sifted instead
         size -= 1
         q.qi[W_QUEUE_HEAP] = size
@@ -409,12 +415,22 @@ def _open_next_bucket(rec, ci, q):
     return True
 
 
+# Called where the heap ran empty, once per bucket (and never without buckets): a call of its own,
+# so that the event loop that inlines ``next_ball`` stays small.
+@njit(refcount=False)
+def _refill_heap(rec, ci, q):
+    """Open buckets until the heap holds an event; False if none will ever come."""
+    while q.qi[W_QUEUE_HEAP] == 0:
+        if _ring_size(q) == 0 or not _open_next_bucket(rec, ci, q):
+            return False
+    return True
+
+
 @njit(inline="always")
 def next_ball(rec, ci, q):
     """The ball whose event comes first (-1: none is queued but events that never come)."""
-    while q.qi[W_QUEUE_HEAP] == 0:
-        if _ring_size(q) == 0 or not _open_next_bucket(rec, ci, q):
-            return -1
+    if _heap_size(rec, q) == 0 and not _refill_heap(rec, ci, q):
+        return -1
     return _ball_at(0, q.hp)
 
 
@@ -458,6 +474,36 @@ def reset_queue(n, now, width, rec, ci, q):
     _heapify(size, ci, q.hp)
 
 
+# Called once per step in scenes with buckets: a call of its own, so that small scenes do not
+# carry its code.
+@njit(refcount=False)
+def _refile(n, rec, ci, q):
+    """After a rebase: move every event whose rebased time fell into another bucket, or into or
+    out of the heap (the heap is left out of order: returns True if it changed)."""
+    size = q.qi[W_QUEUE_HEAP]
+    hp = q.hp
+    moved = False
+    for i in range(n):
+        p = _position(rec[i]["event_time"], q)
+        slot = ci[i, C_QUEUE_SLOT]
+        if slot >= 0 and p >= 0:
+            size -= 1
+            if slot < size:
+                _place(slot, _ball_at(size, hp), _time_at(size, hp), ci, hp)
+            _link(i, p, ci, q)
+            moved = True
+        elif slot < 0 and p != -1 - slot:
+            _unlink(i, ci, q)
+            if p < 0:
+                _place(size, i, rec[i]["event_time"], ci, hp)
+                size += 1
+                moved = True
+            else:
+                _link(i, p, ci, q)
+    q.qi[W_QUEUE_HEAP] = size
+    return moved
+
+
 @njit(inline="always")
 def rebase_queue(n, t, rec, ci, q):
     """Make the queue's times relative to step time ``t``, after every ball's event time was (the
@@ -466,36 +512,19 @@ def rebase_queue(n, t, rec, ci, q):
     (which the tie rule, :func:`order_key`, may order the other way): such events are moved and
     the heap is re-ordered, which is rare. Subtracting the same number keeps every other pair in
     order."""
-    size = q.qi[W_QUEUE_HEAP]
     hp = q.hp
-    for slot in range(size):
-        hp[slot + HEAP_OFFSET, H_TIME] -= t
-    q.qf[W_QUEUE_BASE] -= t
     disorder = False
+    for slot in range(_heap_size(rec, q)):
+        row = slot + HEAP_OFFSET
+        hp[row, H_TIME] -= t
+        if slot > 0:
+            above = _time_at((slot - 1) // ARITY, hp)
+            disorder = disorder or (hp[row, H_TIME] == above and above < INF)
     if _ring_size(q) > 0:
-        for i in range(n):
-            p = _position(rec[i]["event_time"], q)
-            slot = ci[i, C_QUEUE_SLOT]
-            if slot >= 0 and p >= 0:
-                size -= 1  # (the heap is re-ordered below)
-                if slot < size:
-                    _place(slot, _ball_at(size, hp), _time_at(size, hp), ci, hp)
-                _link(i, p, ci, q)
-                disorder = True
-            elif slot < 0 and p != -1 - slot:
-                _unlink(i, ci, q)
-                if p < 0:
-                    _place(size, i, rec[i]["event_time"], ci, hp)
-                    size += 1
-                    disorder = True
-                else:
-                    _link(i, p, ci, q)
-        q.qi[W_QUEUE_HEAP] = size
-    for slot in range(1, size):
-        above = _time_at((slot - 1) // ARITY, hp)
-        disorder = disorder or (_time_at(slot, hp) == above and above < INF)
+        q.qf[W_QUEUE_BASE] -= t
+        disorder = _refile(n, rec, ci, q) or disorder
     if disorder:
-        _heapify(size, ci, hp)
+        _heapify(_heap_size(rec, q), ci, hp)
 
 
 @njit(inline="always")
