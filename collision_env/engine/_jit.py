@@ -17,7 +17,7 @@ ways:
   else ``~/.cache/collision_env/kernels-<hash>`` (``$XDG_CACHE_HOME``), or under numba's own
   ``NUMBA_CACHE_DIR`` when that is set. Folders of earlier sources are removed when a new one is
   made. A kernel outside the package (a test's, which inlines the package's kernels) is cached in
-  the same folder, keyed on its own file as well.
+  the same folder, keyed on its own file's contents as well (one that has no file is not cached).
 * **One compiled version per kernel.** numba compiles a separate version of a called kernel for
   every distinct literal argument (``f(i, -1)`` and ``f(i, j)`` are two compilations); here a
   kernel called from another kernel is compiled for the arguments' plain types only.
@@ -155,8 +155,7 @@ if HAVE_NUMBA:
         def get_source_stamp(self):
             if self._own_file is None:
                 return SOURCE_HASH  # the folder is already keyed on every source file
-            stat = os.stat(self._own_file)
-            return SOURCE_HASH, stat.st_mtime, stat.st_size
+            return SOURCE_HASH, hashlib.sha256(Path(self._own_file).read_bytes()).hexdigest()
 
         def get_disambiguator(self):
             return self._name
@@ -208,6 +207,8 @@ def njit(func=None, *, refcount=True, **options):
         return func
     # set explicitly, so that a kernel called from a ``refcount=False`` one does not inherit it
     options["_nrt"] = bool(refcount)
+    if not (_in_package(func) or Path(func.__code__.co_filename).is_file()):
+        return _numba.njit(nogil=True, **options)(func)  # (no file to key a cache on: ``python -c``)
     dispatcher = _KernelDispatcher(
         py_func=func,
         locals=options.pop("locals", {}),

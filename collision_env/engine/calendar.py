@@ -125,11 +125,13 @@ def _before(ta, a, tb, b, ci):
 # an event between buckets touches its list neighbours, and moving it within a bucket nothing.
 #
 # Bucket ``k`` holds the events at step times ``t`` with ``floor((t - base) / width) = k``; the heap
-# holds every event of ``k <= bucket`` (the bucket last moved into it), the ring every event of
-# ``bucket < k <= bucket + R`` (at position ``k % R``), the far list the rest. The bucket of a time
-# is a monotonic function of it in floating point, so every heap event comes strictly before
-# every other: the heap's first event is the queue's. Each list is doubly linked through the
-# balls' int rows (``layout.CAL_I``), so an event leaves its list in O(1).
+# holds every event of ``k <= bucket`` (the bucket last moved into it), the ring events of
+# ``bucket < k <= bucket + R`` (at position ``k % R``), the far list events of ``k > release``
+# (``release >= bucket``; when the buckets reach ``release``, the far list's events the ring
+# reaches by then are sorted into it, and ``release`` moves R buckets on). The bucket of a time is
+# a monotonic function of it in floating point, so every heap event comes strictly before every
+# other: the heap's first event is the queue's. Each list is doubly linked through the balls' int
+# rows (``layout.CAL_I``), so an event leaves its list in O(1).
 #
 #: Scenes with fewer balls keep every event in the heap (no buckets): below this size the heap of
 #: every ball stays in the cache, and the buckets' bookkeeping costs more than the levels it saves
@@ -390,13 +392,24 @@ def _open_next_bucket(rec, ci, q):
     nothing is queued that will ever come."""
     ring = _ring_size(q)
     if q.qi[W_QUEUE_RING] == 0:
+        # (every event is in the far list: its times also give a new width, for a scene whose
+        # events have grown sparser or denser since the width was set)
         t_first = INF
+        total = 0.0
+        finite = 0
         ball = q.buckets[ring]
         while ball >= 0:
-            t_first = min(t_first, rec[ball]["event_time"])
+            t = rec[ball]["event_time"]
+            if t < INF:
+                t_first = min(t_first, t)
+                total += t
+                finite += 1
             ball = ci[ball, C_QUEUE_NEXT]
-        if t_first == INF:
+        if finite == 0:
             return False
+        width = _width(total - finite * t_first, finite)
+        if width < INF:
+            q.qf[W_QUEUE_WIDTH] = width
         q.qf[W_QUEUE_BASE] = t_first
         q.qi[W_QUEUE_BUCKET] = -1
         q.qi[W_QUEUE_RELEASE] = -1
@@ -435,9 +448,18 @@ def next_ball(rec, ci, q):
 
 
 @njit(inline="always")
+def _width(total, finite):
+    """A bucket width for ``finite`` events whose times lie ``total`` seconds ahead in all: about
+    :data:`EVENTS_PER_BUCKET` events per bucket, if each ball's next event is as far ahead as their
+    mean (``finite / mean`` events per second). Inf when that is not a positive number."""
+    width = EVENTS_PER_BUCKET * total / max(finite, 1) ** 2
+    return width if 0.0 < width < INF else INF
+
+
+@njit(inline="always")
 def bucket_width(n, now, rec):
-    """A bucket width for a scene's events: about :data:`EVENTS_PER_BUCKET` events per bucket, if
-    each ball's next event is as far from ``now`` as their mean (inf: no finite event)."""
+    """A bucket width for a scene's events from step time ``now`` (inf, every finite time in the
+    heap, when no finite event lies ahead)."""
     total = 0.0
     finite = 0
     for i in range(n):
@@ -445,8 +467,7 @@ def bucket_width(n, now, rec):
         if t < INF:
             total += t - now
             finite += 1
-    width = EVENTS_PER_BUCKET * total / max(finite, 1) / n
-    return width if 0.0 < width < INF else INF  # (inf: every finite time in the heap)
+    return _width(total, finite)
 
 
 @njit(inline="always")
@@ -530,7 +551,7 @@ def rebase_queue(n, t, rec, ci, q):
 @njit(inline="always")
 def set_event(ball, t, code, stamp, rec, ci):
     """Give ``ball`` the pending event ``(t, code)`` (``stamp``: the partner's change count);
-    the caller restores the heap order."""
+    the caller queues it (:func:`schedule`, or :func:`reset_queue` for every ball)."""
     rec[ball]["event_time"] = t
     ci[ball, C_EVENT_OTHER] = code
     ci[ball, C_EVENT_STAMP] = stamp

@@ -791,7 +791,8 @@ def _predict(i, now, horizon, rebuild, rot, b, cl, ph, geo, wk):
 
     ``rebuild`` is the first prediction of a whole scene: only partners of higher index are
     looked at, so each pair is tested once, by its lower ball (which is enough: the earliest event
-    of the scene is then held by its lower ball), and the heap is ordered afterwards.
+    of the scene is then held by its lower ball), and the queue is built afterwards
+    (``calendar.reset_queue``).
     """
     if _near_border(cl.ci[i, C_CELL], geo[4], geo[5]):
         best_t, best_code = _wall_event(i, now, horizon, rot, b, ph, cl.rec, wk)
@@ -1110,8 +1111,8 @@ def step_exact(
         b = SceneBalls(
             pos_all[sc], vel_all[sc], mass_all[sc], inv_mass_all[sc], radius_all[sc], body_all[sc], omega_all[sc]
         )
-        q = cal.EventQueue(cal_heap[sc], cal_buckets[sc], work_f[sc], work_i[sc])
-        cl = SceneCalendar(cal_rec[sc], cal_i[sc], cal_heads[sc], q)
+        queue = cal.EventQueue(cal_heap[sc], cal_buckets[sc], work_f[sc], work_i[sc])
+        cl = SceneCalendar(cal_rec[sc], cal_i[sc], cal_heads[sc], queue)
         geo = grid.scene_geometry(work_f, work_i, sc)
         horizon_end = work_f[sc, W_REMAINING]
         t0 = time[sc]

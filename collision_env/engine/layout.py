@@ -58,10 +58,10 @@ CAL_RECORD = np.dtype(
 #: Per-ball calendar ints (int32), read only for the ball's own event, when it moves between
 #: cells, or when a neighbour in its queue list moves: what the next event is (a partner ball >= 0,
 #: or a ``calendar.EV_*`` code); the partner's change counter when it was predicted; where the
-#: event is queued (a heap slot >= 0, or ``-1 - bucket``) and, in a bucket, the next and previous
-#: ball of that bucket's list; its grid cell and the previous ball in that cell's list. (The first
-#: ball of each cell is in a (B, cells) int32 array of its own, so that the heads of neighbouring
-#: cells share cache lines.)
+#: event is queued (a heap slot >= 0; ``-1 - p`` in bucket p of the ring, p = R in the far list)
+#: and, in a list, the next and previous ball of that list; its grid cell and the previous ball in
+#: that cell's list. (The first ball of each cell is in a (B, cells) int32 array of its own, so
+#: that the heads of neighbouring cells share cache lines.)
 CAL_I = ("event_other", "event_stamp", "queue_slot", "queue_next", "queue_prev", "cell", "cell_prev")
 C_EVENT_OTHER, C_EVENT_STAMP, C_QUEUE_SLOT, C_QUEUE_NEXT, C_QUEUE_PREV, C_CELL, C_CELL_PREV = range(7)
 

@@ -112,6 +112,24 @@ def test_a_large_scene_queues_most_events_in_time_buckets():
     assert sim.batch._cal_buckets.shape == (1, LARGE // 2 + 1)
 
 
+def test_a_large_scene_steps_bit_for_bit_as_with_a_heap_of_every_ball(monkeypatch):
+    """The time buckets change where events wait, never the order they come in."""
+    scene, pos, vel, radii = gas(LARGE)
+    sim = Simulator(scene, pos, vel, np.ones(LARGE), radii=radii)
+    monkeypatch.setattr(simulator_module, "bucket_count", lambda n: 0)
+    heap = Simulator(scene, pos, vel, np.ones(LARGE), radii=radii)
+    assert heap.batch._cal_buckets.shape == (1, 1) and sim.batch._cal_buckets.shape[1] > 1
+    dv = np.zeros((LARGE, 2))
+    dv[:: LARGE // 7] = (0.4, -0.9)
+    for frame in range(12):
+        if frame == 5:
+            sim.nudge(dv)
+            heap.nudge(dv)
+        assert sim.step(1 / 60) == heap.step(1 / 60)
+    np.testing.assert_array_equal(sim.positions, heap.positions)
+    np.testing.assert_array_equal(sim.velocities, heap.velocities)
+
+
 def test_forward_then_back_returns_to_the_start_with_the_calendar_kept():
     scene, pos, vel, radii = gas(150, phi=0.1)
     sim = Simulator(scene, pos, vel, np.ones(150), radii=radii)

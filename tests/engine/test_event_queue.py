@@ -1,9 +1,10 @@
 """Exact mode's event queue (a heap, and time buckets in large scenes) against a sorted list.
 
 Random sequences of the calendar's operations (pop and re-queue the first event, move any
-event earlier or later, rebase every time as a step's end does) on rings of 0 to 7 buckets of
+event earlier or later, rebase every time as a step's end does) on rings of 0 to 16 buckets of
 several widths, with times drawn from a coarse set so that ties and bucket boundaries are
-frequent: the queue's first ball is always the one a sort by time and the tie rule names.
+frequent: the queue's first ball is always the one a sort by time and the tie rule names, and
+after every operation its structure is intact (heap order, lists, counts, each event's bucket).
 """
 
 from __future__ import annotations
@@ -17,11 +18,20 @@ from collision_env.engine import calendar as cal
 from collision_env.engine._jit import njit
 from collision_env.engine.layout import (
     C_EVENT_OTHER,
+    C_QUEUE_NEXT,
+    C_QUEUE_PREV,
+    C_QUEUE_SLOT,
     CAL_I,
     CAL_RECORD,
+    H_BALL,
+    H_TIME,
+    W_QUEUE_BASE,
+    W_QUEUE_BUCKET,
     W_QUEUE_FAR,
     W_QUEUE_HEAP,
+    W_QUEUE_RELEASE,
     W_QUEUE_RING,
+    W_QUEUE_WIDTH,
     WORK_F,
     WORK_I,
 )
@@ -30,16 +40,66 @@ POP, MOVE, REBASE = range(3)
 
 
 @njit
+def queue_intact(n, rec, ci, q):
+    """The queue's structure: the heap in order under the tie rule and holding the balls' times,
+    each list doubly linked and holding the events of its buckets, the counts those of the lists,
+    every ball queued once."""
+    ring = q.buckets.shape[0] - 1
+    size = q.qi[W_QUEUE_HEAP] if ring > 0 else n
+    base, width = q.qf[W_QUEUE_BASE], q.qf[W_QUEUE_WIDTH]
+    bucket, release = q.qi[W_QUEUE_BUCKET], q.qi[W_QUEUE_RELEASE]
+    if not bucket <= release <= bucket + ring:
+        return False
+    seen = 0
+    for slot in range(size):
+        ball = int(q.hp[slot + cal.HEAP_OFFSET, H_BALL])
+        t = q.hp[slot + cal.HEAP_OFFSET, H_TIME]
+        if ci[ball, C_QUEUE_SLOT] != slot or t != rec[ball]["event_time"]:
+            return False
+        if ring > 0 and not (t - base) / width < bucket + 1:
+            return False
+        if slot > 0:
+            above = int(q.hp[(slot - 1) // cal.ARITY + cal.HEAP_OFFSET, H_BALL])
+            if cal._before(t, ball, rec[above]["event_time"], above, ci):
+                return False
+        seen += 1
+    in_ring = 0
+    for p in range(ring + 1):
+        ball = q.buckets[p]
+        prev = -1
+        length = 0
+        while ball >= 0 and length <= n:
+            x = (rec[ball]["event_time"] - base) / width
+            if ci[ball, C_QUEUE_SLOT] != -1 - p or ci[ball, C_QUEUE_PREV] != prev:
+                return False
+            if p < ring and not (bucket + 1 <= x < bucket + ring + 1 and int(x) % ring == p):
+                return False
+            if p == ring and x < release + 1:  # (an event that never comes: x is inf or nan)
+                return False
+            prev = ball
+            ball = ci[ball, C_QUEUE_NEXT]
+            length += 1
+        if p < ring:
+            in_ring += length
+        elif length != q.qi[W_QUEUE_FAR]:
+            return False
+        seen += length
+    return seen == n and (ring == 0 or in_ring == q.qi[W_QUEUE_RING])
+
+
+@njit
 def run_queue(width, rec, ci, hp, buckets, qf, qi, kinds, balls, times):
     """Queue the events of ``rec``, then apply the operations, each after noting the queue's
     first ball (-1: none): pop the first event and queue the ball's next ``times[k]`` later, move
     ball ``balls[k]``'s event to ``times[k]``, or rebase every time by ``times[k]``. Returns the
-    first ball before each operation, and the queue's count of events after it."""
+    first ball before each operation, and how many operations left the queue intact (it stops at
+    the first that does not)."""
     n = rec.shape[0]
     q = cal.EventQueue(hp, buckets, qf, qi)
     cal.reset_queue(n, 0.0, width, rec, ci, q)
-    firsts = np.empty(kinds.shape[0], dtype=np.int64)
-    counts = np.empty(kinds.shape[0], dtype=np.int64)
+    firsts = np.full(kinds.shape[0], -2, dtype=np.int64)
+    if not queue_intact(n, rec, ci, q):
+        return firsts, -1
     for k in range(kinds.shape[0]):
         first = cal.next_ball(rec, ci, q)
         firsts[k] = first
@@ -51,8 +111,9 @@ def run_queue(width, rec, ci, hp, buckets, qf, qi, kinds, balls, times):
             ball = balls[k] if kinds[k] == MOVE else first
             rec[ball]["event_time"] = times[k] + (rec[ball]["event_time"] if kinds[k] == POP else 0.0)
             cal.schedule(ball, rec, ci, q)
-        counts[k] = qi[W_QUEUE_HEAP] + qi[W_QUEUE_RING] + qi[W_QUEUE_FAR]
-    return firsts, counts
+        if not queue_intact(n, rec, ci, q):
+            return firsts, k
+    return firsts, kinds.shape[0]
 
 
 def check_queue(ring, width, times, codes, kinds, balls, steps):
@@ -65,8 +126,8 @@ def check_queue(ring, width, times, codes, kinds, balls, steps):
     ci[:, C_EVENT_OTHER] = codes
     qi = np.zeros(len(WORK_I), dtype=np.int64)
     heap, buckets, qf = np.zeros((cal.heap_rows(n), 2)), np.full(ring + 1, -1, dtype=np.int32), np.zeros(len(WORK_F))
-    firsts, counts = run_queue(width, rec, ci, heap, buckets, qf, qi, kinds, balls, steps)
-    assert np.all(counts == n)
+    firsts, intact = run_queue(width, rec, ci, heap, buckets, qf, qi, kinds, balls, steps)
+    assert intact == len(kinds), f"the queue broke at operation {intact}"
 
     keys = np.array([cal.order_key(i, codes[i]) for i in range(n)])  # the tie rule, per ball
     t = np.array(times, dtype=np.float64)
@@ -99,13 +160,15 @@ def compiled_first():
     check_queue(1, 0.5, [0.0, 1.0], tie_codes(2, [-1, -1]), np.array([POP]), np.array([0]), np.array([1.0]))
 
 
-TIMES = st.sampled_from([0.0, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 8.0, 40.0, np.inf])
+#: Times of binary fractions (exact sums) and of tenths and thirds (whose sums and differences
+#: round, so rebasing moves events across bucket boundaries and into ties).
+TIMES = st.sampled_from([0.0, 0.1, 0.25, 0.3, 1 / 3, 0.5, 0.7, 1.0, 1.5, 2.0, 2.1, 3.0, 8.0, 40.0, np.inf])
 
 
 @settings(max_examples=200, deadline=None)
 @given(
-    ring=st.sampled_from([0, 1, 2, 3, 7]),
-    width=st.sampled_from([0.1, 0.25, 0.3, 1.0, np.inf]),
+    ring=st.sampled_from([0, 1, 2, 3, 7, 16]),
+    width=st.sampled_from([0.1, 0.25, 0.3, 1 / 3, 1.0, np.inf]),
     times=st.lists(TIMES, min_size=1, max_size=24),
     codes=st.lists(st.integers(-9, 23), min_size=24, max_size=24),
     ops=st.lists(
@@ -134,10 +197,19 @@ def test_a_long_run_of_a_gas_like_queue(ring):
 
     kinds = rng.choice([POP, MOVE, REBASE], size=ops, p=[0.7, 0.29, 0.01])
     balls = rng.integers(0, n, ops)
-    rebase = np.round(rng.uniform(0, 0.5, ops) / grain) * grain
+    rebase = rng.uniform(0, 0.5, ops)  # (off the grain: rebased times round)
     # a move goes to a time around the current one (roughly: each pop advances it by 1/n)
     now = np.cumsum(np.where(kinds == POP, 1.0 / n, 0.0) - np.where(kinds == REBASE, rebase, 0.0))
     steps = np.select(
         [kinds == MOVE, kinds == REBASE], [np.round(now / grain) * grain + ahead(ops), rebase], ahead(ops)
     )
     check_queue(ring, width, ahead(n), tie_codes(n, rng.integers(-9, n, n)), kinds, balls, steps)
+
+
+@pytest.mark.parametrize("ring", [0, 2])
+def test_a_rebase_that_rounds_two_times_into_a_tie_reorders_the_heap(ring):
+    """1e-17 s and 2e-17 s, rebased by 1 s, both round to -1 s: the tie rule then puts ball 1
+    (lower index) before ball 5, which was first until then."""
+    times = [np.inf, 2e-17, np.inf, np.inf, np.inf, 1e-17]
+    kinds, balls, steps = np.array([REBASE, POP, POP]), np.zeros(3, dtype=np.int64), np.array([1.0, 5.0, 5.0])
+    check_queue(ring, 0.1, times, np.full(6, cal.EV_NONE, dtype=np.int32), kinds, balls, steps)

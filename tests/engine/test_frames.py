@@ -200,7 +200,7 @@ def test_frames_record_into_the_arrays_they_are_given():
 def test_frames_refuse_arrays_they_cannot_record_into():
     scene, pos, vel, radii = gas(10)
     sim = BatchSimulator(scene, [pos], [vel], np.ones(10), radii=radii)
-    good = (np.empty((5, 1)), np.empty((5, 1, 10, 2)), np.empty((5, 1, 10, 2)))
+    good = (np.zeros((5, 1)), np.zeros((5, 1, 10, 2)), np.zeros((5, 1, 10, 2)))
     before = sim.get_state()
     for out, match in (
         ({"time": good[0]}, "out: expected a Frames or a tuple"),
