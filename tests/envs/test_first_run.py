@@ -105,3 +105,27 @@ def test_compiling_says_so_once_on_stderr_and_a_cached_run_says_nothing(tmp_path
     assert _jit.COMPILE_NOTICE not in runs[1].stderr
     assert runs[0].stdout == runs[1].stdout
     assert list((tmp_path / "collision_env").glob(f"{_jit.CACHE_PREFIX}*/*.nbi"))
+
+
+@needs_numba
+def test_a_kernel_outside_the_package_is_cached_by_its_contents(tmp_path):
+    """A test's kernel is cached with the package's; editing its file (even to the same size, with
+    the same modification time) recompiles it, and a kernel with no file is compiled uncached."""
+    script = tmp_path / "outside.py"
+    source = "from collision_env.engine._jit import njit\n@njit\ndef k(x):\n    return x + {}\nprint(k(1))\n"
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+
+    def run(*args):
+        done = subprocess.run([sys.executable, *args], capture_output=True, text=True, env=env, timeout=300)
+        assert done.returncode == 0, done.stderr
+        return done.stdout.strip(), _jit.COMPILE_NOTICE in done.stderr
+
+    script.write_text(source.format(1))
+    stamp = script.stat().st_mtime_ns
+    assert run(str(script)) == ("2", True)
+    assert run(str(script)) == ("2", False)  # from the cache
+    script.write_text(source.format(2))
+    os.utime(script, ns=(stamp, stamp))
+    assert run(str(script)) == ("3", True)
+    assert list((tmp_path / "cache" / "collision_env").glob(f"{_jit.CACHE_PREFIX}*/outside*.nbi"))
+    assert run("-c", source.format(4))[0] == "5"
