@@ -395,19 +395,22 @@ def _open_next_bucket(rec, ci, q):
         # (every event is in the far list: its times also give a new width, for a scene whose
         # events have grown sparser or denser since the width was set)
         t_first = INF
+        ball = q.buckets[ring]
+        while ball >= 0:
+            t_first = min(t_first, rec[ball]["event_time"])
+            ball = ci[ball, C_QUEUE_NEXT]
+        if t_first == INF:
+            return False
         total = 0.0
         finite = 0
         ball = q.buckets[ring]
         while ball >= 0:
             t = rec[ball]["event_time"]
             if t < INF:
-                t_first = min(t_first, t)
-                total += t
+                total += t - t_first
                 finite += 1
             ball = ci[ball, C_QUEUE_NEXT]
-        if finite == 0:
-            return False
-        width = _width(total - finite * t_first, finite)
+        width = _width(total, finite)
         if width < INF:
             q.qf[W_QUEUE_WIDTH] = width
         q.qf[W_QUEUE_BASE] = t_first
