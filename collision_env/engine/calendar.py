@@ -284,6 +284,16 @@ def _heap_push(ball, t, rec, ci, q):
 
 
 @njit(inline="always")
+def _vacate(slot, size, ci, hp):
+    """Take the event at ``slot`` out of a heap of ``size``: the last event fills its place, out of
+    order until the caller sifts it or re-orders the heap. Returns the new size."""
+    size -= 1
+    if slot < size:
+        _place(slot, _ball_at(size, hp), _time_at(size, hp), ci, hp)
+    return size
+
+
+@njit(inline="always")
 def _ring_size(q):
     return q.buckets.shape[0] - 1
 
@@ -360,12 +370,11 @@ def schedule(ball, rec, ci, q):
         return
     size = _heap_size(rec, q)
     if p >= 0:  # out of the heap: the last event fills its slot, and is sifted instead
-        size -= 1
+        size = _vacate(slot, size, ci, q.hp)
         q.qi[W_QUEUE_HEAP] = size
         _link(ball, p, ci, q)
         if slot == size:
             return
-        _place(slot, _ball_at(size, q.hp), _time_at(size, q.hp), ci, q.hp)
     _sift_down(_sift_up(slot, rec, ci, q.hp), size, ci, q.hp)
 
 
@@ -511,9 +520,7 @@ def _refile(n, rec, ci, q):
         p = _position(rec[i]["event_time"], q)
         slot = ci[i, C_QUEUE_SLOT]
         if slot >= 0 and p >= 0:
-            size -= 1
-            if slot < size:
-                _place(slot, _ball_at(size, hp), _time_at(size, hp), ci, hp)
+            size = _vacate(slot, size, ci, hp)
             _link(i, p, ci, q)
             moved = True
         elif slot < 0 and p != -1 - slot:

@@ -1134,8 +1134,7 @@ def step_exact(
             for q in range(n_pending):
                 _predict(wk.pending[q], now, horizon_end - now, whole, rot, b, cl, ph, geo, wk)
             if whole:
-                width = cal.bucket_width(n, now, cl.rec) if cl.q.buckets.shape[0] > 1 else INF
-                cal.reset_queue(n, now, width, cl.rec, cl.ci, cl.q)
+                cal.reset_queue(n, now, cal.bucket_width(n, now, cl.rec), cl.rec, cl.ci, cl.q)
                 work_i[sc, W_CALENDAR_VALID] = True
                 whole = False
             # pop
