@@ -101,7 +101,7 @@ def train_and_evaluate(task: dict) -> dict:
         "train_seconds": run["train_seconds"],
         "timesteps_done": run["timesteps_done"],
         "time_split": run["time_split"],
-        "observe": run["env_kwargs"].get("observe", "plain"),
+        "observe": _observation(run["env_kwargs"]),
         "control": run["env_kwargs"].get("control", "nudge"),
     }
     exact = evaluate(run_dir, episodes=task["episodes"], mode="exact", baselines=())
@@ -249,7 +249,7 @@ def _entry_setting(env_id: str) -> str | None:
         entry = hyperparams_for(env_id).get("env_kwargs") or {}
     except UsageError:
         return None
-    return _setting({"observe": entry.get("observe", "plain"), **entry})
+    return _setting({**entry, "observe": _observation(entry)})
 
 
 def _shipped(row: dict) -> bool:
@@ -292,7 +292,9 @@ def presets_table(rows: list, base: list) -> str:
         "deviation over seeds, then each seed; training time: median over seeds, with the engine's share of it. "
         "Setting: the observation and the control of the shipped hyperparameter entry (marked *shipped*), and "
         "beside it the plain observation where the entry changes it (`predicted`: the env's "
-        '`observe="predicted"`, each ball\'s next wall impact as the engine predicts it) and nudges where the '
+        '`observe="predicted"`, each ball\'s next wall impact as the engine predicts it; `predicted (scoring)`: '
+        'with `predicted_impact="scoring"`, a scoring ball\'s first predicted impact that lands on a pending '
+        "target, however many bounces ahead, else its next) and nudges where the "
         "entry uses velocity control (`nudge`: the action is each step's velocity change; `velocity`: the env's "
         '`control="velocity"`, the velocity to steer to and an engage flag). The other rows keep the rest of '
         "the entry as it stood when they were trained (such as an aiming term taken from the prediction; the "
@@ -628,6 +630,15 @@ def variants(env_id: str, which: str = "both") -> list:
         if entry.get("control", "nudge") != "nudge":
             out.append({"control": "nudge"})
     return out
+
+
+def _observation(env_kwargs: dict) -> str:
+    """A run's observation by name: ``plain``, ``predicted`` (each ball's next wall impact), or
+    ``predicted (scoring)`` (a scoring ball's first predicted impact on a pending target)."""
+    observe = env_kwargs.get("observe", "plain")
+    if observe == "predicted" and env_kwargs.get("predicted_impact", "next") == "scoring":
+        return "predicted (scoring)"
+    return observe
 
 
 def _setting(row: dict) -> str:

@@ -23,6 +23,8 @@ from collision_env.envs._layout import BALL_OBS, GLOBAL_OBS, PREDICTED_OBS, TARG
 OBSERVATIONS = ("plain", "predicted")
 OBSERVED_BALLS = ("all", "controlled")
 AIMS = ("straight", "predicted")
+#: Which predicted wall impact of a scoring ball the prediction reports (see TaskConfig).
+PREDICTED_IMPACTS = ("next", "scoring")
 #: What an action component means: a velocity change, or a velocity the ball is steered to (see TaskConfig).
 CONTROLS = ("nudge", "velocity")
 SCORERS = ("any", "controlled", "others", "cluster")
@@ -112,7 +114,11 @@ class TaskConfig:
         for scenes of many balls that the agent does not steer); ``observe`` ("plain": balls, targets
         and the globals; "predicted": also, per observed ball, its next wall impact as the engine
         predicts it with no further nudge, found by running a copy of the engine ``lookahead`` s
-        ahead at every step: contact point, time, and whether it hits a target).
+        ahead at every step: contact point, time, and whether it hits a target);
+        ``predicted_impact`` (which impact of a scoring ball that prediction reports: "next", its
+        next wall impact; "scoring", the first of its wall impacts within the look-ahead that lands
+        on a visible pending target, or its next one when none does. With "scoring", ``aim="predicted"``
+        also takes the nearest of all its impacts within the look-ahead, not only the next).
     Episode:
         ``time_limit`` (s of simulated time; the env truncates after round(time_limit / dt) steps).
     Engine:
@@ -152,6 +158,7 @@ class TaskConfig:
     observed_balls: str = "all"
     observe: str = "plain"
     lookahead: float = 5.0
+    predicted_impact: str = "next"
     time_limit: float = 10.0
     mode: str = "exact"
     substeps: int = 1
@@ -247,6 +254,8 @@ class TaskConfig:
         if self.observe not in OBSERVATIONS:
             raise ValueError(f"observe: expected one of {OBSERVATIONS}, got {self.observe!r}")
         s("lookahead", _number("lookahead", self.lookahead, low=0.0, strict_low=True))
+        if self.predicted_impact not in PREDICTED_IMPACTS:
+            raise ValueError(f"predicted_impact: expected one of {PREDICTED_IMPACTS}, got {self.predicted_impact!r}")
         s("time_limit", _number("time_limit", self.time_limit, low=0.0, strict_low=True))
         if self.time_limit < self.dt:
             raise ValueError(f"time_limit: must be at least one control step dt={self.dt}, got {self.time_limit}")

@@ -276,6 +276,7 @@ class TaskCore:
             observe_predicted=int(cfg.observe == "predicted"),
             aim_predicted=int(cfg.aim == "predicted" and cfg.shaping != 0.0),
             velocity_control=int(cfg.control == "velocity"),
+            predict_scoring=int(cfg.predicted_impact == "scoring"),
         )
         self.ctrl = np.array(cfg.controlled, dtype=np.int64)
         self.qual = cfg.scoring_mask

@@ -520,10 +520,11 @@ def predict_kernel(flags, imp, sim_time, clusters, body, S, C, T, t_geo, qual, s
     their cluster roots, from which ``body`` (scratch, (B, N)) replays the clusters through the
     look-ahead as the task kernel does. A ball's entry is its first wall impact: the contact point,
     the time until it over ``time_limit``, and whether it would score on a visible pending target
-    (target status as the task kernel left it, so a target hit this step no longer counts).
+    (target status as the task kernel left it, so a target hit this step no longer counts); with
+    ``predict_scoring``, a scoring ball's entry is its first impact that scores so, if one does.
     With ``aim_predicted``, phi is minus the distance, over the play-area diagonal, from the nearest
-    of the scoring balls' predicted impact points to a visible pending target (-1 when none is
-    predicted): the task kernel's shaping term, computed here with the engine's prediction instead of
+    of the scoring balls' predicted impact points (their first ones; all of them with
+    ``predict_scoring``) to a visible pending target (-1 when none is predicted): the task kernel's shaping term, computed here with the engine's prediction instead of
     straight flight, added to the reward of stepped scenes without a hit.
     """
     xc, yc, xh, yh = _centre_and_half_size(P)
@@ -533,6 +534,7 @@ def predict_kernel(flags, imp, sim_time, clusters, body, S, C, T, t_geo, qual, s
     cluster = Q[SWITCHES.cluster] != 0
     observe = Q[SWITCHES.observe_predicted] != 0
     aim = Q[SWITCHES.aim_predicted] != 0
+    scan = Q[SWITCHES.predict_scoring] != 0
     N = body.shape[1]
     block = np.full(N, -1)  # the observation entry where each shown ball's block starts
     n_shown = 0
@@ -545,6 +547,7 @@ def predict_kernel(flags, imp, sim_time, clusters, body, S, C, T, t_geo, qual, s
             block[i] = o
             o += len(PREDICTED_OBS)
     seen = np.zeros(body.shape, dtype=np.bool_)
+    found = np.zeros(body.shape, dtype=np.bool_)  # (a scoring impact is in the ball's block)
     best = np.ones(body.shape[0])
     for b in range(flags.shape[0]):
         if flags[b] == ROW_SKIP:
@@ -571,7 +574,8 @@ def predict_kernel(flags, imp, sim_time, clusters, body, S, C, T, t_geo, qual, s
         scores = qual[i] and (not cluster or _in_cluster(body, b, i))
         if cluster:
             _split(body, b, i)
-        if seen[b, i]:
+        first = not seen[b, i]
+        if not (first or (scan and scores and not found[b, i])):
             continue
         seen[b, i] = True
         x = imp[j]["x"]
@@ -580,14 +584,17 @@ def predict_kernel(flags, imp, sim_time, clusters, body, S, C, T, t_geo, qual, s
         if aim and scores:
             best[b] = min(best[b], _aim_distance(x, y, b, C, T, t_geo, seq, P) / diag)
         if observe and shown[i]:
-            o = block[i]
-            obs[b, o + PREDICTED_OBS.x] = _clip1((x - xc) / xh)
-            obs[b, o + PREDICTED_OBS.y] = _clip1((y - yc) / yh)
-            obs[b, o + PREDICTED_OBS.time] = _clip1((t - sim_time[b]) / tlimit)
+            hits = False
             if scores:
                 k0, k1 = _visible_targets(C[b, SI.current], T.shape[1], seq)
-                if _target_at(T, t_geo, b, k0, k1, w, y if _on_side_wall(w) else x, t) >= 0:
-                    obs[b, o + PREDICTED_OBS.hits] = 1.0
+                hits = _target_at(T, t_geo, b, k0, k1, w, y if _on_side_wall(w) else x, t) >= 0
+            if first or hits:
+                found[b, i] = hits
+                o = block[i]
+                obs[b, o + PREDICTED_OBS.x] = _clip1((x - xc) / xh)
+                obs[b, o + PREDICTED_OBS.y] = _clip1((y - yc) / yh)
+                obs[b, o + PREDICTED_OBS.time] = _clip1((t - sim_time[b]) / tlimit)
+                obs[b, o + PREDICTED_OBS.hits] = 1.0 if hits else 0.0
     if aim:
         for b in range(flags.shape[0]):
             f = flags[b]

@@ -66,6 +66,7 @@ SWITCHES = layout(
         ("observe_predicted", "1: the observation ends with the engine's predicted impacts"),
         ("aim_predicted", "1: the aiming potential phi uses the engine's predicted impacts"),
         ("velocity_control", "1: each controlled ball's action is a velocity to steer to and an engage flag"),
+        ("predict_scoring", "1: the prediction looks past a scoring ball's next wall impact for one on a target"),
     ),
 )
 
@@ -185,7 +186,7 @@ GLOBAL_OBS = layout(
 PREDICTED_OBS = layout(
     "PredictedObs",
     (
-        ("x y", "ball i's predicted next wall impact (no more nudges), normalised like positions"),
+        ("x y", "ball i's predicted wall impact (no more nudges), normalised like positions"),
         ("time", "time until it / time_limit (1, and point 0, 0: none within the lookahead)"),
         ("hits", "1 if it lands on a visible pending target inside its window, else 0"),
     ),

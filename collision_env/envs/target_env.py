@@ -58,28 +58,31 @@ class CollisionTargetEnv(gym.Env):
     and half-size of the play area are (xc, yc), (xh, yh); `vs = 2 * max_speed`. Every entry is
     clipped to [-1, 1].
 
-    | Index                    | Observation                                                                     |
-    |--------------------------|---------------------------------------------------------------------------------|
-    | 6i + 0, 1                | ball i position: (x - xc) / xh, (y - yc) / yh                                   |
-    | 6i + 2, 3                | ball i velocity: vx / vs, vy / vs (0 for y in 1D)                               |
-    | 6i + 4                   | ball i mass / 3 kg                                                              |
-    | 6i + 5                   | 1 if ball i's wall impacts currently score, else 0                              |
-    | 6N + 10s + 0, 1          | target s centre point, normalised like positions                                |
-    | 6N + 10s + 2             | target s half width / half length of its wall                                   |
-    | 6N + 10s + 3..6          | target s wall one-hot (left, right, bottom, top)                                |
-    | 6N + 10s + 7             | target s status: 1 pending, 0 hit, -1 failed (window closed)                    |
-    | 6N + 10s + 8, 9          | (window open - t) / time_limit, (window close - t) / time_limit                 |
-    | 6N + 10S + 0             | fraction of the episode's control steps left                                    |
-    | 6N + 10S + 1             | fraction of targets not yet hit                                                 |
-    | 6N + 10S + 2 + 4i + 0, 1 | ball i's predicted next wall impact (no more nudges), normalised like positions |
-    | 6N + 10S + 2 + 4i + 2    | time until it / time_limit (1, and point 0, 0: none within the lookahead)       |
-    | 6N + 10S + 2 + 4i + 3    | 1 if it lands on a visible pending target inside its window, else 0             |
+    | Index                    | Observation                                                                |
+    |--------------------------|----------------------------------------------------------------------------|
+    | 6i + 0, 1                | ball i position: (x - xc) / xh, (y - yc) / yh                              |
+    | 6i + 2, 3                | ball i velocity: vx / vs, vy / vs (0 for y in 1D)                          |
+    | 6i + 4                   | ball i mass / 3 kg                                                         |
+    | 6i + 5                   | 1 if ball i's wall impacts currently score, else 0                         |
+    | 6N + 10s + 0, 1          | target s centre point, normalised like positions                           |
+    | 6N + 10s + 2             | target s half width / half length of its wall                              |
+    | 6N + 10s + 3..6          | target s wall one-hot (left, right, bottom, top)                           |
+    | 6N + 10s + 7             | target s status: 1 pending, 0 hit, -1 failed (window closed)               |
+    | 6N + 10s + 8, 9          | (window open - t) / time_limit, (window close - t) / time_limit            |
+    | 6N + 10S + 0             | fraction of the episode's control steps left                               |
+    | 6N + 10S + 1             | fraction of targets not yet hit                                            |
+    | 6N + 10S + 2 + 4i + 0, 1 | ball i's predicted wall impact (no more nudges), normalised like positions |
+    | 6N + 10S + 2 + 4i + 2    | time until it / time_limit (1, and point 0, 0: none within the lookahead)  |
+    | 6N + 10S + 2 + 4i + 3    | 1 if it lands on a visible pending target inside its window, else 0        |
 
     With sequential targets the single slot shows the current target. Targets without a window
     read -1 and 1 in the window entries. The predicted entries (`observe="predicted"`) come from a
     copy of the engine, in the env's own mode, loaded with the current state and run `lookahead`
     seconds ahead with no nudge at every step: what the engine will do if the agent stops acting
-    now (the planning the scripted policies do, offered to the agent as an observation).
+    now (the planning the scripted policies do, offered to the agent as an observation). A ball's
+    entry is its next wall impact, or with `predicted_impact="scoring"`, for a ball whose impacts
+    score, the first of its impacts in the look-ahead that lands on a pending target (its next one
+    when none does): whether coasting will score, however many bounces away.
 
     ## Rewards
 

@@ -356,8 +356,9 @@ def test_study_variants_change_one_setting_of_the_entry_back_to_the_default():
 
 
 def test_study_marks_the_entry_as_it_stands_shipped_and_lists_it_first():
-    # three settings of Billiards, in the order a study file could hold them: a row trained when the
-    # entry used nudges (no "control" field yet), a plain alternative, and the entry as it stands
+    # four settings of Billiards, in the order a study file could hold them: a row trained when the
+    # entry used nudges (no "control" field yet), a plain alternative, one trained when the entry
+    # predicted next impacts, and the entry as it stands
     def row(seed, observe, control, env_kwargs, success):
         out = {
             "part": "presets",
@@ -379,13 +380,27 @@ def test_study_marks_the_entry_as_it_stands_shipped_and_lists_it_first():
         return out
 
     rows = [row(0, "predicted", None, {}, 0.4), row(0, "plain", "velocity", {"observe": "plain"}, 0.3)]
-    rows += [row(0, "predicted", "velocity", {}, 0.5), row(1, "predicted", "velocity", {}, 0.7)]
+    rows += [row(0, "predicted", "velocity", {}, 0.45)]
+    rows += [row(0, "predicted (scoring)", "velocity", {}, 0.5), row(1, "predicted (scoring)", "velocity", {}, 0.7)]
     table = study.presets_table(rows, [])
     settings = [line.split(" | ")[1] for line in table.splitlines() if line.startswith("| `")]
-    assert settings == ["predicted, velocity (*shipped*)", "plain, velocity", "predicted, nudge"]
+    assert settings == [
+        "predicted (scoring), velocity (*shipped*)",
+        "plain, velocity",
+        "predicted, nudge",
+        "predicted, velocity",
+    ]
     assert "| 60 % ± 14 | 50 % / 70 % |" in table
-    shipped = study._by_preset(rows, [])[("CollisionEnv/Billiards-v0", "predicted, velocity")]
+    shipped = study._by_preset(rows, [])[("CollisionEnv/Billiards-v0", "predicted (scoring), velocity")]
     assert [r["seed"] for r in shipped] == [0, 1]
+
+
+def test_study_names_the_observation_a_run_trained_on():
+    assert study._observation({}) == "plain"
+    assert study._observation({"observe": "predicted"}) == "predicted"
+    assert study._observation({"observe": "predicted", "predicted_impact": "next"}) == "predicted"
+    assert study._observation({"observe": "predicted", "predicted_impact": "scoring"}) == "predicted (scoring)"
+    assert study._observation({"predicted_impact": "scoring"}) == "plain"  # (nothing predicted is observed)
 
 
 # --------------------------------------------------------------------------------------- bad input

@@ -135,6 +135,8 @@ def test_bad_observe_and_lookahead_are_value_errors():
         gym.make("CollisionEnv/OneBallTarget-v0", observed_balls="some")
     with pytest.raises(ValueError, match="lookahead"):
         gym.make("CollisionEnv/OneBallTarget-v0", observe="predicted", lookahead=0.0)
+    with pytest.raises(ValueError, match="predicted_impact"):
+        gym.make("CollisionEnv/OneBallTarget-v0", observe="predicted", predicted_impact="last")
 
 
 def test_predicted_aim_equals_straight_aim_where_nothing_is_in_the_way():
@@ -176,3 +178,48 @@ def test_predicted_aim_sees_through_ball_to_ball_transfer():
     env.step(np.zeros(2, np.float32))
     phi = core.S[0, SCENE_FLOATS.phi]
     assert -1.0 < phi <= 0.0
+
+
+def test_scoring_prediction_looks_past_a_miss_for_the_impact_on_the_target():
+    # one ball sent straight away from its target's wall at the target's centre: its next wall
+    # impact is on the opposite wall (a miss), the one after it lands on the target. With
+    # predicted_impact="next" the block shows the miss; with "scoring", the hit, which then happens
+    # at the predicted time and place.
+    blocks = {}
+    for which in ("next", "scoring"):
+        env = gym.make(
+            "CollisionEnv/OneBallTarget-v0", observe="predicted", lookahead=20.0, predicted_impact=which
+        ).unwrapped
+        cfg = env.config
+        env.reset(seed=1)
+        core = env.core
+        k = int(core.cur[0])
+        wall, centre = int(core.t_wall[0, k]), core.t_geo[0, k, TARGET_GEOMETRY.centre]
+        side = wall < 2  # a target on the left or right wall
+        position = np.array([0.0, centre] if side else [centre, 0.0])
+        away = np.array([1.0, 0.0] if side else [0.0, 1.0]) * (1.0 if wall % 2 == 0 else -1.0)
+        core.batch.set_scenes([0], position[None, None], 0.8 * away[None, None])
+        zero = np.zeros(2, np.float32)
+        obs, *_ = env.step(zero)
+        now = env.core.time[0]
+        blocks[which] = block = _predicted(obs, 1)[0]
+        if which == "next":
+            assert block[PREDICTED_OBS.hits] == 0.0
+            continue
+        assert block[PREDICTED_OBS.hits] == 1.0
+        for _ in range(400):  # coast: the miss, then the hit
+            obs, _, term, _, info = env.step(zero)
+            walls = [r for r in info["impacts"].records if r["wall"] >= 0]
+            if walls and walls[-1]["wall"] == wall:
+                break
+        r = walls[-1]
+        assert int(env.core.cur[0]) > k  # it scored
+        x, y = _normalised(cfg, r["x"], r["y"])
+        assert block[PREDICTED_OBS.x] == pytest.approx(x, abs=1e-5)
+        assert block[PREDICTED_OBS.y] == pytest.approx(y, abs=1e-5)
+        assert block[PREDICTED_OBS.time] == pytest.approx((r["time"] - now) / cfg.time_limit, abs=1e-5)
+    # the miss is the hit's mirror image across the axis the ball flies along, and comes first
+    across, along = (PREDICTED_OBS.x, PREDICTED_OBS.y) if side else (PREDICTED_OBS.y, PREDICTED_OBS.x)
+    assert blocks["next"][across] == pytest.approx(-blocks["scoring"][across], abs=1e-5)
+    assert blocks["next"][along] == pytest.approx(blocks["scoring"][along], abs=1e-5)
+    assert blocks["next"][PREDICTED_OBS.time] < blocks["scoring"][PREDICTED_OBS.time]
