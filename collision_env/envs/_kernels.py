@@ -524,8 +524,9 @@ def predict_kernel(flags, imp, sim_time, clusters, body, S, C, T, t_geo, qual, s
     ``predict_scoring``, a scoring ball's entry is its first impact that scores so, if one does.
     With ``aim_predicted``, phi is minus the distance, over the play-area diagonal, from the nearest
     of the scoring balls' predicted impact points (their first ones; all of them with
-    ``predict_scoring``) to a visible pending target (-1 when none is predicted): the task kernel's shaping term, computed here with the engine's prediction instead of
-    straight flight, added to the reward of stepped scenes without a hit.
+    ``predict_scoring``) to a visible pending target (-1 when none is predicted): the task kernel's
+    shaping term, computed here with the engine's prediction instead of straight flight, added to
+    the reward of stepped scenes without a hit.
     """
     xc, yc, xh, yh = _centre_and_half_size(P)
     diag = 2.0 * math.sqrt(xh * xh + yh * yh)
