@@ -40,6 +40,10 @@ class BilliardsEnv(CollisionTargetEnv):
     |                 | (target status: 1 pending, 0 hit; -1, 1: no time window)         |
     | 45              | fraction of the 2 targets not yet hit                            |
 
+    The shipped PPO agent also observes the engine's prediction (`observe="predicted"`,
+    `predicted_impact="scoring"`; 4 entries per ball: for an object ball, its first predicted impact
+    that lands on a pending target; see `CollisionTargetEnv`).
+
     ## Rewards
 
     +1 per target hit by an object ball's wall impact (exact contact point on the segment), +1

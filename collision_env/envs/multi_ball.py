@@ -44,6 +44,10 @@ class MultiBallEnv(CollisionTargetEnv):
     | 48              | fraction of the 200 control steps left                            |
     | 49              | fraction of the 3 targets not yet hit                             |
 
+    The shipped PPO agent also observes the engine's prediction (`observe="predicted"`,
+    `predicted_impact="scoring"`; 4 entries per ball: for a ball, its first predicted impact
+    that lands on a pending target; see `CollisionTargetEnv`).
+
     ## Rewards
 
     +1 per target hit (exact contact point on a pending target), +1 more when all three are hit,

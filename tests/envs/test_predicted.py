@@ -115,6 +115,20 @@ def test_checkers_and_vector_equality_with_predictions(env_id):
         assert run_pair(env_id, mode, steps=30, seed=2, max_episode_steps=10, observe="predicted") >= 4
 
 
+@pytest.mark.parametrize("env_id", ["CollisionEnv/Billiards-v0", "CollisionEnv/MultiBall-v0"])
+def test_checkers_and_vector_equality_with_scoring_predictions(env_id):
+    pytest.importorskip("stable_baselines3")
+    from stable_baselines3.common.env_checker import check_env as sb3_check_env
+
+    kwargs = {"observe": "predicted", "predicted_impact": "scoring", "aim": "predicted", "shaping": 1.0}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(gym.make(env_id, **kwargs).unwrapped, skip_render_check=True)
+        sb3_check_env(gym.make(env_id, **kwargs).unwrapped, warn=True)
+    for mode in (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP):
+        assert run_pair(env_id, mode, steps=30, seed=2, max_episode_steps=10, **kwargs) >= 4
+
+
 def test_only_the_controlled_balls_can_be_observed():
     # the crowd's gas has no blocks: ball 0's, the target's and the globals', then ball 0's prediction
     full = gym.make("CollisionEnv/Crowd-v0", observe="predicted", observed_balls="all").unwrapped
