@@ -294,7 +294,7 @@ def presets_table(rows: list, base: list) -> str:
         "beside it the plain observation where the entry changes it (`predicted`: the env's "
         '`observe="predicted"`, each ball\'s next wall impact as the engine predicts it; `predicted (scoring)`: '
         'with `predicted_impact="scoring"`, a scoring ball\'s first predicted impact that lands on a pending '
-        "target, however many bounces ahead, else its next) and nudges where the "
+        "target within the look-ahead, however many bounces ahead, else its next) and nudges where the "
         "entry uses velocity control (`nudge`: the action is each step's velocity change; `velocity`: the env's "
         '`control="velocity"`, the velocity to steer to and an engage flag). The other rows keep the rest of '
         "the entry as it stood when they were trained (such as an aiming term taken from the prediction; the "

@@ -511,7 +511,7 @@ def task_kernel(
 
 @njit
 def predict_kernel(flags, imp, sim_time, clusters, body, S, C, T, t_geo, qual, shown, P, Q, obs):  # pragma: no cover
-    """Each ball's predicted next wall impact: written into the observation's last entries, one
+    """Each ball's predicted wall impact: written into the observation's last entries, one
     ``PREDICTED_OBS`` block per ``shown`` ball (``observe_predicted``), and made the aiming potential
     (``aim_predicted``), for the rows whose flag is not ``ROW_SKIP``.
 

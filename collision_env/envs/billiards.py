@@ -42,7 +42,8 @@ class BilliardsEnv(CollisionTargetEnv):
 
     The shipped PPO agent also observes the engine's prediction (`observe="predicted"`,
     `predicted_impact="scoring"`; 4 entries per ball: for an object ball, its first predicted impact
-    that lands on a pending target; see `CollisionTargetEnv`).
+    that lands on a pending target, else its next impact (the cue ball's: its next impact); see
+    `CollisionTargetEnv`).
 
     ## Rewards
 

@@ -46,7 +46,7 @@ class MultiBallEnv(CollisionTargetEnv):
 
     The shipped PPO agent also observes the engine's prediction (`observe="predicted"`,
     `predicted_impact="scoring"`; 4 entries per ball: for a ball, its first predicted impact
-    that lands on a pending target; see `CollisionTargetEnv`).
+    that lands on a pending target, else its next impact; see `CollisionTargetEnv`).
 
     ## Rewards
 

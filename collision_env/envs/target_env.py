@@ -81,8 +81,10 @@ class CollisionTargetEnv(gym.Env):
     seconds ahead with no nudge at every step: what the engine will do if the agent stops acting
     now (the planning the scripted policies do, offered to the agent as an observation). A ball's
     entry is its next wall impact, or with `predicted_impact="scoring"`, for a ball whose impacts
-    score, the first of its impacts in the look-ahead that lands on a pending target (its next one
-    when none does): whether coasting will score, however many bounces away.
+    score, the first of its impacts within the look-ahead that lands on a pending target (its next
+    one when none does): whether coasting will score, however many bounces away. A hit is judged
+    against the targets as they stand now: the prediction does not stop at the episode's end, nor
+    account for another ball reaching the same target first.
 
     ## Rewards
 

@@ -199,10 +199,14 @@ def test_scoring_prediction_looks_past_a_miss_for_the_impact_on_the_target():
     # impact is on the opposite wall (a miss), the one after it lands on the target. With
     # predicted_impact="next" the block shows the miss; with "scoring", the hit, which then happens
     # at the predicted time and place.
-    blocks = {}
+    blocks, phis = {}, {}
     for which in ("next", "scoring"):
         env = gym.make(
-            "CollisionEnv/OneBallTarget-v0", observe="predicted", lookahead=20.0, predicted_impact=which
+            "CollisionEnv/OneBallTarget-v0",
+            observe="predicted",
+            aim="predicted",
+            lookahead=20.0,
+            predicted_impact=which,
         ).unwrapped
         cfg = env.config
         env.reset(seed=1)
@@ -217,6 +221,7 @@ def test_scoring_prediction_looks_past_a_miss_for_the_impact_on_the_target():
         obs, *_ = env.step(zero)
         now = env.core.time[0]
         blocks[which] = block = _predicted(obs, 1)[0]
+        phis[which] = core.S[0, SCENE_FLOATS.phi]  # minus the distance from the nearest impact to the target
         if which == "next":
             assert block[PREDICTED_OBS.hits] == 0.0
             continue
@@ -226,6 +231,8 @@ def test_scoring_prediction_looks_past_a_miss_for_the_impact_on_the_target():
             walls = [r for r in info["impacts"].records if r["wall"] >= 0]
             if walls and walls[-1]["wall"] == wall:
                 break
+        else:
+            pytest.fail("the ball never came back to its target's wall")
         r = walls[-1]
         assert int(env.core.cur[0]) > k  # it scored
         x, y = _normalised(cfg, r["x"], r["y"])
@@ -237,3 +244,39 @@ def test_scoring_prediction_looks_past_a_miss_for_the_impact_on_the_target():
     assert blocks["next"][across] == pytest.approx(-blocks["scoring"][across], abs=1e-5)
     assert blocks["next"][along] == pytest.approx(blocks["scoring"][along], abs=1e-5)
     assert blocks["next"][PREDICTED_OBS.time] < blocks["scoring"][PREDICTED_OBS.time]
+    # the aiming potential: the miss lies a wall away from the target; the later hit is on it
+    assert phis["next"] < -0.1 and phis["scoring"] == 0.0
+
+
+def test_scoring_prediction_changes_only_the_blocks_of_scoring_balls_that_will_hit():
+    # Billiards under the same random actions, "next" beside "scoring": the cue ball (whose impacts
+    # never score) and every object ball with no hit ahead keep their next impact, and everything
+    # outside the predicted blocks is the same; where they differ, "scoring" shows a hit later on
+    kwargs = {"observe": "predicted", "lookahead": 10.0, "control": "velocity"}
+    envs = {
+        w: gym.make("CollisionEnv/Billiards-v0", predicted_impact=w, **kwargs).unwrapped for w in ("next", "scoring")
+    }
+    n = envs["next"].config.n_balls
+    differ = 0
+    for seed in range(3):
+        first = {w: env.reset(seed=seed)[0] for w, env in envs.items()}
+        assert np.array_equal(first["next"][: -n * NP], first["scoring"][: -n * NP])
+        rng = np.random.default_rng(seed)
+        for _ in range(120):
+            a = rng.uniform(-1, 1, 3).astype(np.float32)
+            a[2] = 1.0 if rng.random() < 0.2 else -1.0  # steer now and then, else coast
+            steps = {w: env.step(a) for w, env in envs.items()}
+            o_next, o_scoring = steps["next"][0], steps["scoring"][0]
+            assert np.array_equal(o_next[: -n * NP], o_scoring[: -n * NP])
+            assert steps["next"][1:4] == steps["scoring"][1:4]
+            p_next, p_scoring = _predicted(o_next, n), _predicted(o_scoring, n)
+            assert np.array_equal(p_next[0], p_scoring[0])  # the cue ball
+            for i in range(1, n):
+                if p_scoring[i, PREDICTED_OBS.hits] == 0.0 or p_next[i, PREDICTED_OBS.hits] == 1.0:
+                    assert np.array_equal(p_next[i], p_scoring[i]), (seed, i)
+                else:
+                    differ += 1
+                    assert p_scoring[i, PREDICTED_OBS.time] > p_next[i, PREDICTED_OBS.time]
+            if steps["next"][2] or steps["next"][3]:
+                break
+    assert differ > 0
