@@ -100,31 +100,26 @@ def test_hits_flag_says_whether_the_coasting_ball_scores():
         assert scored == aim_at_target
 
 
-@pytest.mark.parametrize("env_id", IDS)
-def test_checkers_and_vector_equality_with_predictions(env_id):
+SCORING = {"predicted_impact": "scoring", "aim": "predicted", "shaping": 1.0}
+CHECKED = [(env_id, {}) for env_id in IDS] + [
+    (i, SCORING) for i in ("CollisionEnv/Billiards-v0", "CollisionEnv/MultiBall-v0")
+]
+
+
+@pytest.mark.parametrize(
+    "env_id, extra", CHECKED, ids=lambda x: ("scoring" if x else "next") if isinstance(x, dict) else None
+)
+def test_checkers_and_vector_equality_with_predictions(env_id, extra):
     pytest.importorskip("stable_baselines3")
     from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        check_env(gym.make(env_id, observe="predicted").unwrapped, skip_render_check=True)
-        sb3_check_env(gym.make(env_id, observe="predicted").unwrapped, warn=True)
-    # (a look-ahead that fills the engine's impact buffer is resumed exactly where it stopped, so a
-    # batch and a single scene agree bit for bit however many impacts their look-aheads record)
-    for mode in (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP):
-        assert run_pair(env_id, mode, steps=30, seed=2, max_episode_steps=10, observe="predicted") >= 4
-
-
-@pytest.mark.parametrize("env_id", ["CollisionEnv/Billiards-v0", "CollisionEnv/MultiBall-v0"])
-def test_checkers_and_vector_equality_with_scoring_predictions(env_id):
-    pytest.importorskip("stable_baselines3")
-    from stable_baselines3.common.env_checker import check_env as sb3_check_env
-
-    kwargs = {"observe": "predicted", "predicted_impact": "scoring", "aim": "predicted", "shaping": 1.0}
+    kwargs = {"observe": "predicted", **extra}
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         check_env(gym.make(env_id, **kwargs).unwrapped, skip_render_check=True)
         sb3_check_env(gym.make(env_id, **kwargs).unwrapped, warn=True)
+    # (a look-ahead that fills the engine's impact buffer is resumed exactly where it stopped, so a
+    # batch and a single scene agree bit for bit however many impacts their look-aheads record)
     for mode in (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP):
         assert run_pair(env_id, mode, steps=30, seed=2, max_episode_steps=10, **kwargs) >= 4
 
