@@ -14,7 +14,7 @@ def compiled():
 
 
 def test_a_gas_on_the_grid_stays_valid_and_collides_at_enskogs_rate():
-    row = scale.bench_size(400, log=lambda *_: None)
+    row = scale.bench_size(400, log=lambda *_: None, min_slice_s=0.0)
     assert row["overlaps"] == 0 and row["outside"] == 0
     assert row["energy_rel_change"] < 1e-9
     assert 0.7 < row["rate_ratio"] < 1.3  # a small box: walls and finite size shift it a little
@@ -31,11 +31,12 @@ def test_the_report_renders_every_size():
         "versions": {"numpy": "1", "numba": "2"},
         "first_call_s": 1.0,
         "seconds": 3.0,
-        "sizes": [scale.bench_size(n, log=lambda *_: None) for n in (100, 200)],
+        "sizes": scale.bench_sizes((100, 200), log=lambda *_: None, min_slice_s=0.0),
         "frames": scale.bench_frames(n=20, horizon=1.0, repeats=1),
     }
     text = scale.render_markdown(results)
     assert "| 100 |" in text and "| 200 |" in text
+    assert all(row["frames"] >= scale.SLICES * 10 for row in results["sizes"])  # every size timed in every round
     assert "% of the one-step rate" in text and "into arrays it is given" in text
     frames = results["frames"]
     ratios = ("frames_over_one_step", "frames_call_over_one_step", "frames_given_over_one_step")
