@@ -13,6 +13,8 @@ Every section is a module with a ``main(argv)``, runnable on its own
 - :mod:`.extremes`: every mode over the stress grid.
 - :mod:`.scale`: exact mode on hard-disk gases of 10^2 to 10^5 disks in frames: events per second,
   memory per disk, and the validity of each run.
+- :mod:`.misses`: the cache lines an event of that gas misses, by array, counted on the Python path
+  through a model of one cache (where the cost per event of a large gas comes from).
 
 What they share:
 
@@ -30,4 +32,5 @@ SECTIONS: dict[str, tuple[str, str]] = {
     "envs": ("collision_env.bench.envs", "env steps per second of every registered id against CartPole"),
     "extremes": ("collision_env.bench.extremes", "every mode over the stress grid"),
     "scale": ("collision_env.bench.scale", "exact mode on gases of 10^2 to 10^5 disks: events/s, memory, validity"),
+    "misses": ("collision_env.bench.misses", "cache lines missed per event of a gas, by array (a cache model)"),
 }

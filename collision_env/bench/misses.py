@@ -1,0 +1,190 @@
+"""Cache misses per event in exact mode, by array: where a large gas's cost per event comes from.
+
+Run it as::
+
+    python -m collision_env.bench.misses                       # N = 1e3 and 1e5 (about 5 minutes)
+    python -m collision_env.bench.misses --sizes 400 --cache-kib 2048
+
+Timings on a shared machine cannot say which of the engine's arrays an event waits for, and numba's
+machine code carries no symbols a cache profiler could attribute to. This tool counts instead. It
+runs the scale benchmark's gas (:class:`~collision_env.bench.scale.TimedGas`, built and warmed up
+as that benchmark does) through the engine's Python path (``NUMBA_DISABLE_JIT=1``: the same kernel
+source, interpreted). It hands the kernel views of the simulator's arrays that note the 64-byte
+line of every element the kernel reads or writes. Those lines go through a model of one cache:
+fully associative, least recently used first out, ``--cache-kib`` in all. The default, 2 MiB, is
+the private L2 cache of one core of a current server.
+
+Every line of every array is fetched once, a short step then fills the model with what events use,
+and one frame of 1/60 s is counted. The report gives, per event (ball-ball and ball-wall
+collisions) and per array of the kernel's arguments (named as
+:func:`~collision_env.engine.exact.step_exact` names them), the lines that missed.
+What the counts leave out:
+
+- the frame's passes over every ball (the step's start and end) are counted with the events, as
+  the scale benchmark times them; they stream through the arrays in order, which hardware
+  prefetchers hide;
+- reads and writes count alike;
+- associativity, prefetchers and the other levels are not modelled.
+
+So the counts rank the arrays; they are not a time.
+"""
+
+from __future__ import annotations
+
+import argparse
+import inspect
+import json
+import os
+import subprocess
+import sys
+import time
+from collections import OrderedDict
+
+import numpy as np
+
+SIZES = (1_000, 100_000)
+CACHE_KIB = 2048
+LINE = 64
+#: The step that fills the cache model before the counted frame (s): at 10^5 disks, several
+#: thousand events, each touching dozens of lines.
+WARM_S = 0.002
+FRAME = 1.0 / 60.0
+
+
+class LineCache:
+    """A fully associative, least-recently-used cache of ``lines`` lines that counts, per tag, the
+    lines it had to fetch while ``counting`` is on."""
+
+    def __init__(self, lines: int):
+        self.lines = lines
+        self.held: OrderedDict[int, None] = OrderedDict()
+        self.counting = False
+        self.misses: dict[str, int] = {}
+
+    def touch_all(self, array: np.ndarray, tag: str) -> None:
+        """Fetch every line of ``array``, in order."""
+        start = array.__array_interface__["data"][0]
+        for line in range(start // LINE, (start + array.nbytes + LINE - 1) // LINE):
+            self.touch(line, tag)
+
+    def touch(self, line: int, tag: str) -> None:
+        if line in self.held:
+            self.held.move_to_end(line)
+            return
+        if self.counting:
+            self.misses[tag] = self.misses.get(tag, 0) + 1
+        self.held[line] = None
+        if len(self.held) > self.lines:
+            self.held.popitem(last=False)
+
+
+class TracedArray(np.ndarray):
+    """A view that reports the line of every element (or row) the kernel indexes with integers to
+    its :class:`LineCache` (views of it, and rows of a structured array, report theirs too)."""
+
+    def __array_finalize__(self, obj):
+        self.tag = getattr(obj, "tag", "?")
+        self.cache = getattr(obj, "cache", None)
+        self.address = self.__array_interface__["data"][0]
+
+    def _touch(self, key) -> None:
+        if self.cache is None:
+            return
+        address = self.address
+        for index, stride in zip(key if isinstance(key, tuple) else (key,), self.strides, strict=False):
+            if not isinstance(index, int | np.integer):
+                return  # (a slice makes a view: its elements report when they are indexed)
+            address += int(index) * stride
+        self.cache.touch(address // LINE, self.tag)
+
+    def __getitem__(self, key):
+        self._touch(key)
+        return super().__getitem__(key)
+
+    def __setitem__(self, key, value):
+        self._touch(key)
+        super().__setitem__(key, value)
+
+
+def measure(n: int, cache_kib: int = CACHE_KIB) -> dict:
+    """Misses per event, by array, of one frame of the ``n``-disk gas (the Python path only)."""
+    from collision_env.engine._jit import HAVE_NUMBA
+    from collision_env.engine.exact import step_exact
+
+    from .scale import TimedGas
+
+    if HAVE_NUMBA:
+        raise RuntimeError("measure() traces the Python path: run it with NUMBA_DISABLE_JIT=1 (main() does)")
+    sim = TimedGas(n).sim  # (built, and warmed up as the scale benchmark does: the lattice melts)
+    cache = LineCache(cache_kib * 1024 // LINE)
+    names = list(inspect.signature(step_exact).parameters)
+    traced = []
+    for name, array in zip(names, sim._kernel_args, strict=False):
+        view = array.view(TracedArray)
+        view.tag, view.cache = name, cache
+        traced.append(view)
+        cache.touch_all(array, name)
+    sim._kernel_args = tuple(traced)
+    sim.step(WARM_S)
+    cache.counting = True
+    before = sim.stats
+    t0 = time.perf_counter()
+    sim.step(FRAME)
+    seconds = time.perf_counter() - t0
+    after = sim.stats
+    events = after["events"] - before["events"]
+    per_event = {tag: count / events for tag, count in sorted(cache.misses.items(), key=lambda kv: -kv[1])}
+    return {
+        "n": n,
+        "cache_kib": cache_kib,
+        "events": events,
+        "pair_tests": (after["pair_tests"] - before["pair_tests"]) / events,
+        "cell_crossings": (after["cell_crossings"] - before["cell_crossings"]) / events,
+        "misses_per_event": per_event,
+        "python_seconds": seconds,
+    }
+
+
+def render_markdown(rows: list[dict]) -> str:
+    largest = rows[-1]["misses_per_event"]
+    arrays = sorted({tag for row in rows for tag in row["misses_per_event"]}, key=lambda tag: -largest.get(tag, 0.0))
+    arrays = [tag for tag in arrays if max(row["misses_per_event"].get(tag, 0.0) for row in rows) >= 0.01]
+    lines = [
+        f"Lines missed per event in a {rows[0]['cache_kib']} KiB least-recently-used cache, one frame of 1/60 s "
+        "of the scale benchmark's gas (`python -m collision_env.bench.misses`):",
+        "",
+        "| disks | events | pair tests per event | crossings per event | all | " + " | ".join(arrays) + " |",
+        "|---:|---:|---:|---:|---:|" + "---:|" * len(arrays),
+    ]
+    for row in rows:
+        m = row["misses_per_event"]
+        lines.append(
+            f"| {row['n']:,} | {row['events']:,} | {row['pair_tests']:.1f} | {row['cell_crossings']:.2f} "
+            f"| {sum(m.values()):.1f} | " + " | ".join(f"{m.get(tag, 0.0):.2f}" for tag in arrays) + " |"
+        )
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m collision_env.bench.misses", description=__doc__.split("\n")[0])
+    parser.add_argument("--sizes", type=int, nargs="+", default=list(SIZES), help="gases of these many disks")
+    parser.add_argument("--cache-kib", type=int, default=CACHE_KIB, help="the modelled cache's size (KiB)")
+    parser.add_argument("--json", help="write the raw figures here")
+    args = parser.parse_args(argv)
+    if os.environ.get("NUMBA_DISABLE_JIT") != "1":  # (numba decides at import: trace in a fresh process)
+        env = dict(os.environ, NUMBA_DISABLE_JIT="1")
+        command = [sys.executable, "-m", "collision_env.bench.misses", *(argv if argv is not None else sys.argv[1:])]
+        return subprocess.run(command, env=env, check=False).returncode
+    rows = []
+    for n in args.sizes:
+        rows.append(measure(n, args.cache_kib))
+        print(f"  N = {n:,}: {sum(rows[-1]['misses_per_event'].values()):.1f} misses per event", flush=True)
+    print(render_markdown(rows))
+    if args.json:
+        with open(args.json, "w") as fh:
+            json.dump(rows, fh, indent=1)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
