@@ -2,7 +2,7 @@
 
 Run it as::
 
-    python -m collision_env.bench.misses                       # N = 1e3 and 1e5 (about 5 minutes)
+    python -m collision_env.bench.misses                       # N = 1e3 and 1e5 (about 10 minutes)
     python -m collision_env.bench.misses --sizes 400 --cache-kib 2048
 
 Timings on a shared machine cannot say which of the engine's arrays an event waits for, and numba's
@@ -23,8 +23,10 @@ What the counts leave out:
 - the frame's passes over every ball (the step's start and end) are counted with the events, as
   the scale benchmark times them; they stream through the arrays in order, which hardware
   prefetchers hide;
+- the Python side's work between kernel calls (copying impacts out of the buffer) is not counted;
 - reads and writes count alike;
-- associativity, prefetchers and the other levels are not modelled.
+- associativity, prefetchers and the other levels are not modelled, and where numpy places an
+  array that is not aligned to a line moves its counts a little from run to run.
 
 So the counts rank the arrays; they are not a time.
 """
@@ -37,7 +39,6 @@ import json
 import os
 import subprocess
 import sys
-import time
 from collections import OrderedDict
 
 import numpy as np
@@ -79,8 +80,10 @@ class LineCache:
 
 
 class TracedArray(np.ndarray):
-    """A view that reports the line of every element (or row) the kernel indexes with integers to
-    its :class:`LineCache` (views of it, and rows of a structured array, report theirs too)."""
+    """A view that reports to its :class:`LineCache` the lines of every element the kernel indexes
+    with integers (all the lines a structured record spans; the first line of a row indexed by
+    fewer integers than the array has axes). Views of it report theirs too; the fields a kernel
+    reads from a record it took out (``r = rec[k]; r["x"]``) are the record's."""
 
     def __array_finalize__(self, obj):
         self.tag = getattr(obj, "tag", "?")
@@ -90,12 +93,16 @@ class TracedArray(np.ndarray):
     def _touch(self, key) -> None:
         if self.cache is None:
             return
+        key = key if isinstance(key, tuple) else (key,)
         address = self.address
-        for index, stride in zip(key if isinstance(key, tuple) else (key,), self.strides, strict=False):
+        for index, stride, size in zip(key, self.strides, self.shape, strict=False):
             if not isinstance(index, int | np.integer):
                 return  # (a slice makes a view: its elements report when they are indexed)
-            address += int(index) * stride
-        self.cache.touch(address // LINE, self.tag)
+            address += (int(index) % size) * stride  # (a negative index counts from the end)
+        # an element reports every line it spans (a structured record may span two); a row, its first
+        end = address + (self.itemsize if len(key) == self.ndim else 1)
+        for line in range(address // LINE, (end - 1) // LINE + 1):
+            self.cache.touch(line, self.tag)
 
     def __getitem__(self, key):
         self._touch(key)
@@ -115,7 +122,7 @@ def measure(n: int, cache_kib: int = CACHE_KIB) -> dict:
 
     if HAVE_NUMBA:
         raise RuntimeError("measure() traces the Python path: run it with NUMBA_DISABLE_JIT=1 (main() does)")
-    sim = TimedGas(n).sim  # (built, and warmed up as the scale benchmark does: the lattice melts)
+    sim = TimedGas(n, trace_memory=False).sim  # (built, and warmed up as the scale benchmark does)
     cache = LineCache(cache_kib * 1024 // LINE)
     names = list(inspect.signature(step_exact).parameters)
     traced = []
@@ -129,9 +136,7 @@ def measure(n: int, cache_kib: int = CACHE_KIB) -> dict:
     sim.step(WARM_S)
     cache.counting = True
     before = sim.stats
-    t0 = time.perf_counter()
     sim.step(FRAME)
-    seconds = time.perf_counter() - t0
     after = sim.stats
     events = after["events"] - before["events"]
     per_event = {tag: count / events for tag, count in sorted(cache.misses.items(), key=lambda kv: -kv[1])}
@@ -139,22 +144,22 @@ def measure(n: int, cache_kib: int = CACHE_KIB) -> dict:
         "n": n,
         "cache_kib": cache_kib,
         "events": events,
-        "pair_tests": (after["pair_tests"] - before["pair_tests"]) / events,
+        "pair_tests": (after["pair_tests"] - before["pair_tests"]) / events,  # (pair predictions)
         "cell_crossings": (after["cell_crossings"] - before["cell_crossings"]) / events,
         "misses_per_event": per_event,
-        "python_seconds": seconds,
     }
 
 
 def render_markdown(rows: list[dict]) -> str:
-    largest = rows[-1]["misses_per_event"]
+    largest = max(rows, key=lambda row: row["n"])["misses_per_event"]
     arrays = sorted({tag for row in rows for tag in row["misses_per_event"]}, key=lambda tag: -largest.get(tag, 0.0))
     arrays = [tag for tag in arrays if max(row["misses_per_event"].get(tag, 0.0) for row in rows) >= 0.01]
     lines = [
         f"Lines missed per event in a {rows[0]['cache_kib']} KiB least-recently-used cache, one frame of 1/60 s "
         "of the scale benchmark's gas (`python -m collision_env.bench.misses`):",
         "",
-        "| disks | events | pair tests per event | crossings per event | all |" + "".join(f" {a} |" for a in arrays),
+        "| disks | events | pair predictions per event | crossings per event | all |"
+        + "".join(f" {tag} |" for tag in arrays),
         "|---:|---:|---:|---:|---:|" + "---:|" * len(arrays),
     ]
     for row in rows:

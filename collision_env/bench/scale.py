@@ -56,9 +56,9 @@ FRAME = 1.0 / 60.0
 #: Collisions per disk before timing starts (the lattice melts), and at least this many timed.
 WARM_COLLISIONS = 3.0
 TIMED_COLLISIONS = 10.0
-#: The timed frames are split into this many slices, one per round over the sizes, and the
-#: fastest slice gives the rate; a slice runs at least this long (s), so that a small gas, whose
-#: timed collisions take a millisecond, is not timed on a blip of the machine's load.
+#: The timed frames come in this many slices, one per round over the sizes, and the fastest slice
+#: gives the rate; a slice runs at least this long (s), so that a small gas, whose timed
+#: collisions take a millisecond, is not timed on a blip of the machine's load.
 SLICES = 3
 MIN_SLICE_S = 0.2
 
@@ -83,10 +83,11 @@ class TimedGas:
     """One gas of ``n`` disks: built and warmed up, then timed in slices of frames
     (:meth:`time_slice`, called in rounds that take every size in turn), then checked (:meth:`row`)."""
 
-    def __init__(self, n: int):
+    def __init__(self, n: int, trace_memory: bool = True):
         self.n = n
         self.scene, pos, vel = lattice_gas(n)
-        tracemalloc.start()
+        if trace_memory:  # (tracing slows Python code: the engine's Python path, ten times)
+            tracemalloc.start()
         base = tracemalloc.get_traced_memory()[0]
         t0 = time.perf_counter()
         self.sim = BatchSimulator(
@@ -99,7 +100,7 @@ class TimedGas:
         nu = enskog_rate(n / self.area, 2 * RADIUS, PACKING, self.e0 / n, 1.0)  # 2D: kT = mean kinetic energy
         for _ in range(max(1, math.ceil(WARM_COLLISIONS / nu / FRAME))):
             self.sim.step(FRAME)
-        self.peak = tracemalloc.get_traced_memory()[1] - base  # (tracing stops before the timing)
+        self.peak = tracemalloc.get_traced_memory()[1] - base  # (tracing stops before the timing; 0 without)
         tracemalloc.stop()
         self.slice_frames = max(10, math.ceil(TIMED_COLLISIONS / nu / FRAME / SLICES))
         self.before = self.sim.stats
@@ -266,6 +267,7 @@ def run(quick: bool = False, log=print) -> dict:
         "timestamp": timestamp(),
         "versions": versions(["numpy", "numba"]),
         "first_call_s": first_call_s,
+        "min_slice_s": MIN_SLICE_S,
         "sizes": rows,
         "frames": frames,
         "seconds": time.perf_counter() - t0,
@@ -281,7 +283,7 @@ def render_markdown(results: dict) -> str:
         f"({results['first_call_s']:.1f} s to compile or load them).",
         "",
         f"Elastic hard-disk gas, r = {RADIUS} m, area fraction {PACKING}, square box, frames of 1/60 s. Events "
-        f"per second are the fastest of {SLICES} slices of frames (each at least {MIN_SLICE_S:g} s and "
+        f"per second are the fastest of {SLICES} slices of frames (each at least {results['min_slice_s']:g} s and "
         f"{TIMED_COLLISIONS / SLICES:.2g} collisions per disk), timed in rounds that take every size in turn:",
         "",
         "| disks | build (s) | peak memory per disk | events/s | µs per event | ÷ smallest | pair predictions "

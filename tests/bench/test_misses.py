@@ -32,6 +32,26 @@ def test_a_traced_array_reports_the_line_of_each_element_it_is_indexed_at():
     assert set(cache.held) == {(rows.address + offset) // misses.LINE for offset in (128, 192, 256)}
 
 
+def test_records_report_every_line_they_span_and_indices_count_as_numpy_counts_them():
+    cache = misses.LineCache(100)
+    cache.counting = True
+    buffer = np.zeros(4 * 64 + 64, dtype=np.uint8)
+    start = -buffer.ctypes.data % 64 + 16  # records of 64 bytes that start 16 bytes into a line
+    record = np.dtype([(f"f{k}", np.float64) for k in range(8)])
+    records = buffer[start : start + 3 * 64].view(record).view(misses.TracedArray)
+    records.tag, records.cache = "records", cache
+    _ = records[1]  # a record: both lines it spans
+    line = (records.address + 64) // misses.LINE
+    assert set(cache.held) == {line, line + 1}
+    grid = np.zeros((5, 8)).view(misses.TracedArray)  # rows of one line's width
+    grid.tag, grid.cache = "grid", cache
+    column = grid[:, 3]
+    grid[-1, 0] = 1.0  # the last row
+    _ = column[2]  # a strided view: row 2, column 3
+    assert {(grid.address + offset) // misses.LINE for offset in (4 * 64, 2 * 64 + 3 * 8)} <= set(cache.held)
+    assert cache.misses == {"records": 2, "grid": 2}
+
+
 def test_a_small_gas_misses_nothing_in_a_large_cache_and_its_records_in_a_tiny_one(tmp_path):
     """(``main`` counts in a fresh interpreter on the Python path, since numba is on here.)"""
     out = tmp_path / "misses.json"

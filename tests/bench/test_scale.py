@@ -30,6 +30,7 @@ def test_the_report_renders_every_size():
         "timestamp": "t",
         "versions": {"numpy": "1", "numba": "2"},
         "first_call_s": 1.0,
+        "min_slice_s": 0.0,
         "seconds": 3.0,
         "sizes": scale.bench_sizes((100, 200), log=lambda *_: None, min_slice_s=0.0),
         "frames": scale.bench_frames(n=20, horizon=1.0, repeats=1),
@@ -41,3 +42,10 @@ def test_the_report_renders_every_size():
     frames = results["frames"]
     ratios = ("frames_over_one_step", "frames_call_over_one_step", "frames_given_over_one_step")
     assert all(frames[key] > 0 for key in ratios)
+
+
+def test_a_small_gas_is_timed_for_the_slices_least_time():
+    """A 100-disk gas's share of the timed collisions takes about a millisecond: a slice runs on
+    until its least time has passed."""
+    row = scale.bench_size(100, log=lambda *_: None, min_slice_s=0.05)
+    assert row["frames"] > 3 * scale.SLICES * 10
