@@ -2,7 +2,7 @@
 
 Run it as::
 
-    python -m collision_env.bench.misses                       # N = 1e3 and 1e5 (about 10 minutes)
+    python -m collision_env.bench.misses                       # N = 1e3 and 1e5 (about 3 minutes)
     python -m collision_env.bench.misses --sizes 400 --cache-kib 2048
 
 Timings on a shared machine cannot say which of the engine's arrays an event waits for, and numba's
