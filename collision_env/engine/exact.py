@@ -55,6 +55,7 @@ from . import grid
 from ._jit import HAVE_NUMBA, njit
 from .clock import finish_step
 from .layout import (
+    BALL,
     C_CELL,
     C_EVENT_OTHER,
     CAL_RECORD,
@@ -140,6 +141,7 @@ class SceneCalendar(NamedTuple):
     ci: np.ndarray  #: (N, len(CAL_I)) int32
     heads: np.ndarray  #: (cells,) int32, the first ball of each grid cell
     q: cal.EventQueue  #: the event queue
+    inv_mass: np.ndarray  #: (N,) float64, each ball's inverse mass, taken with its radius
 
 
 class Physics(NamedTuple):
@@ -170,6 +172,7 @@ class Work(NamedTuple):
     c_hit: np.ndarray  #: ... and whether it was reported already
     ki: np.ndarray  #: a rotating cluster member's kinematics (7 floats)
     kj: np.ndarray  #: ... and its partner's
+    event: SceneBalls  #: the two balls of an event, rows 0 and 1 (see ``_event_balls``)
 
 
 @njit(inline="always")
@@ -192,7 +195,18 @@ def _work(n, imp, n_imp, counters, scratch_f, scratch_i, scratch_b):
         scratch_b[n : n + nc],
         scratch_f[0:7],
         scratch_f[7:14],
+        _event_balls(
+            scratch_f[14 : 14 + 2 * len(BALL)].reshape((1, 2, len(BALL))), scratch_i[n + 2 * nc : n + 2 * nc + 2]
+        ),
     )
+
+
+@njit(inline="always")
+def _event_balls(rows, body):
+    """The two balls of an event, rows 0 and 1 of ``rows``: a (1, 2, len(BALL)) scratch laid out as
+    the ball state (``layout.BALL``), so that the response kernels take them as they take a scene."""
+    pos, vel, mass, inv_mass, radius, omega = ball_views(rows)
+    return SceneBalls(pos[0], vel[0], mass[0], inv_mass[0], radius[0], body, omega[0])
 
 
 @njit(inline="always")
@@ -587,7 +601,7 @@ def _stop_group(vel, inv_mass, group, size, c_b, n_contacts):
 def scratch_sizes(n):
     """Lengths of :func:`step_exact`'s float, int and bool work buffers for ``n`` balls: O(N)."""
     nc = contact_capacity(n)
-    return 14, n + 2 * nc, n + nc
+    return 14 + 2 * len(BALL), n + 2 * nc + 2, n + nc
 
 
 @njit
@@ -607,11 +621,14 @@ def impacts_per_event(n, cascades):
 # ---------------------------------------------------------------------------- lazy motion
 # A ball's calendar record (``layout.CAL_RECORD``) holds its straight-line trajectory: its centre
 # at its own ``ref_time`` and its velocity. Balls are moved there lazily, only when an event
-# touches them. The engine's ball state (``pos``, ``vel``: what the response kernels change and
-# what the caller reads) is brought up to date from the records for the balls of an event before
-# it is resolved, and for every ball when the step ends; the records take back what the response
-# changed. Stick scenes are the exception: their clusters move as a whole, so the ball state is
-# advanced for every ball at once and the records are loaded from it.
+# touches them. An event's balls are copied from their records (and the calendar's inverse
+# masses) into two rows laid out as ball state (``Work.event``), the response kernels resolve
+# them there, and the records take back what changed; the engine's ball state (what the caller
+# reads) is brought up to date from the records for every ball when the step ends. So an event
+# reads and writes the calendar alone: in a large scene the ball state's rows stay out of the
+# cache. Stick scenes and contact groups are the exception: clusters move as a whole and a group
+# may take in any ball, so the whole ball state is advanced at once, resolved in place, and the
+# records are loaded from it.
 @njit(inline="always")
 def _position_at(k, t, rec):
     """Where ball ``k`` is at step time ``t``."""
@@ -632,24 +649,33 @@ def _sync(k, t, rec):
 
 
 @njit(inline="always")
-def _store(k, rec, pos, vel):
-    """Ball ``k``'s record (position and velocity) into the ball state."""
+def _store(k, rec, pos, vel, row):
+    """Ball ``k``'s record (position and velocity) into row ``row`` of a ball state."""
     r = rec[k]
-    pos[k, 0] = r["x"]
-    pos[k, 1] = r["y"]
-    vel[k, 0] = r["vx"]
-    vel[k, 1] = r["vy"]
+    pos[row, 0] = r["x"]
+    pos[row, 1] = r["y"]
+    vel[row, 0] = r["vx"]
+    vel[row, 1] = r["vy"]
 
 
 @njit(inline="always")
-def _load(k, t, rec, pos, vel):
-    """The ball state of ball ``k`` into its record, as of step time ``t``."""
+def _load(k, t, rec, pos, vel, row):
+    """Row ``row`` of a ball state into ball ``k``'s record, as of step time ``t``."""
     r = rec[k]
-    r["x"] = pos[k, 0]
-    r["y"] = pos[k, 1]
-    r["vx"] = vel[k, 0]
-    r["vy"] = vel[k, 1]
+    r["x"] = pos[row, 0]
+    r["y"] = pos[row, 1]
+    r["vx"] = vel[row, 0]
+    r["vy"] = vel[row, 1]
     r["ref_time"] = t
+
+
+@njit(inline="always")
+def _take(k, row, t, cl, ev):
+    """Ball ``k``, moved in its record to step time ``t``, into row ``row`` of an event's balls."""
+    _sync(k, t, cl.rec)
+    _store(k, cl.rec, ev.pos, ev.vel, row)
+    ev.radius[row] = cl.rec[k]["radius"]
+    ev.inv_mass[row] = cl.inv_mass[k]
 
 
 @njit(inline="always")
@@ -661,11 +687,11 @@ def _sync_all(t, pos, vel, mass, body, omega, rot, sticky, rec):
         if dt != 0.0:
             advance_all(dt, pos, vel, mass, body, omega, rot)
             for k in range(n):
-                _load(k, t, rec, pos, vel)
+                _load(k, t, rec, pos, vel, k)
     else:
         for k in range(n):
             _sync(k, t, rec)
-            _store(k, rec, pos, vel)
+            _store(k, rec, pos, vel, k)
 
 
 @njit(inline="always")
@@ -814,18 +840,19 @@ def _predict(i, now, horizon, rebuild, rot, b, cl, ph, geo, wk):
 
 # ---------------------------------------------------------------------------- begin
 @njit(inline="always")
-def _begin_whole_scene(now, pos, vel, radius, rec, ci, heads, geo, pending):
-    """Forget every prediction of a scene, take every ball's state (its radius too) into its
-    record as of step time ``now`` and lay the balls into the grid; every ball is then to be
-    predicted (listed in ``pending``). Returns how many."""
-    n = pos.shape[0]
+def _begin_whole_scene(now, b, cl, geo, pending):
+    """Forget every prediction of a scene, take every ball's state (its radius and inverse mass
+    too) into the calendar as of step time ``now`` and lay the balls into the grid; every ball is
+    then to be predicted (listed in ``pending``). Returns how many."""
+    n = b.pos.shape[0]
     x0, y0, hx, hy, nx, ny = geo
     for i in range(n):
-        _load(i, now, rec, pos, vel)
-        rec[i]["radius"] = radius[i]
-        cal.set_event(i, INF, cal.EV_NONE, 0, rec, ci)
+        _load(i, now, cl.rec, b.pos, b.vel, i)
+        cl.rec[i]["radius"] = b.radius[i]
+        cl.inv_mass[i] = b.inv_mass[i]
+        cal.set_event(i, INF, cal.EV_NONE, 0, cl.rec, cl.ci)
         pending[i] = i
-    grid.fill_cells(n, rec, ci, heads, x0, y0, hx, hy, nx, ny)
+    grid.fill_cells(n, cl.rec, cl.ci, cl.heads, x0, y0, hx, hy, nx, ny)
     return n
 
 
@@ -848,7 +875,7 @@ def _begin_changed_balls(pos, vel, rec, ci, heads, geo, pending):
         if _changed_since_last_step(i, pos, vel, rec):
             pending[n_changed] = i
             n_changed += 1
-            _load(i, 0.0, rec, pos, vel)
+            _load(i, 0.0, rec, pos, vel, i)
             rec[i]["changes"] += 1
             if nx * ny > 1:
                 grid.move_to_cell(i, grid.cell_of(pos[i, 0], pos[i, 1], x0, y0, hx, hy, nx, ny), rec, ci, heads)
@@ -880,8 +907,7 @@ def _finish(t_end, pos, vel, mass, body, omega, rot, sticky, rec, ci, q):
             dt = t_end - r["ref_time"]
             r["x"] += r["vx"] * dt
             r["y"] += r["vy"] * dt
-            pos[i, 0] = r["x"]
-            pos[i, 1] = r["y"]
+            _store(i, rec, pos, vel, i)  # (events leave the ball state alone)
         r["ref_time"] = 0.0
         r["event_time"] -= t_end
     cal.rebase_queue(n, t_end, rec, ci, q)  # (the same times, rebased the same way)
@@ -900,9 +926,10 @@ def _cascade(sc, t_abs, i0, j0, b, ph, wk):
 
 
 @njit(inline="always")
-def _resolve_wall(sc, t_abs, bi, wall, b, ph, wk):
-    """Ball ``bi`` meets ``wall``. Returns how many balls' motion it changed (listed in
-    ``wk.pending``)."""
+def _resolve_wall(sc, t_abs, bi, li, wall, b, ph, wk):
+    """Ball ``bi``, row ``li`` of ``b`` (the whole ball state, ``li = bi``, in stick scenes and when
+    contact groups form; else the event's rows), meets ``wall``. Returns how many balls' motion it
+    changed (listed in ``wk.pending``)."""
     pos, vel, radius, body, omega, bounds = b.pos, b.vel, b.radius, b.body, b.omega, ph.bounds
     involved = wk.pending
     n = pos.shape[0]
@@ -925,11 +952,11 @@ def _resolve_wall(sc, t_abs, bi, wall, b, ph, wk):
             involved[0] = bi
             n_inv = 1
         return n_inv
-    snap_to_wall(bi, wall, pos, radius, bounds)
-    u_min = impact_threshold(bi, -1, vel, ph.ratio, ph.floor)
-    speed = ball_wall(bi, wall, vel, ph.e, u_min)
+    snap_to_wall(li, wall, pos, radius, bounds)
+    u_min = impact_threshold(li, -1, vel, ph.ratio, ph.floor)
+    speed = ball_wall(li, wall, vel, ph.e, u_min)
     if speed > 0.0:
-        x, y = wall_point(bi, wall, pos, radius, bounds)
+        x, y = wall_point(li, wall, pos, radius, bounds)
         record(wk.imp, wk.n_imp, sc, t_abs, bi, -1, wall, x, y, speed)
     involved[0] = bi
     n_inv = 1
@@ -939,17 +966,17 @@ def _resolve_wall(sc, t_abs, bi, wall, b, ph, wk):
 
 
 @njit(inline="always")
-def _resolve_pair(sc, t_abs, bi, bj, b, ph, wk):
-    """Balls ``bi`` and ``bj`` meet. Returns how many balls' motion it changed (listed in
-    ``wk.pending``)."""
+def _resolve_pair(sc, t_abs, bi, bj, li, lj, b, ph, wk):
+    """Balls ``bi`` and ``bj``, rows ``li`` and ``lj`` of ``b`` (as in :func:`_resolve_wall`), meet.
+    Returns how many balls' motion it changed (listed in ``wk.pending``)."""
     pos, vel, radius, body = b.pos, b.vel, b.radius, b.body
     involved = wk.pending
     n = pos.shape[0]
     n_inv = 0
-    dx = pos[bj, 0] - pos[bi, 0]
-    dy = pos[bj, 1] - pos[bi, 1]
+    dx = pos[lj, 0] - pos[li, 0]
+    dy = pos[lj, 1] - pos[li, 1]
     dist = math.sqrt(dx * dx + dy * dy)
-    closing = (vel[bj, 0] - vel[bi, 0]) * dx + (vel[bj, 1] - vel[bi, 1]) * dy
+    closing = (vel[lj, 0] - vel[li, 0]) * dx + (vel[lj, 1] - vel[li, 1]) * dy
     if ph.sticky:
         if _touching(bi, bj, pos, radius) and closing < 0.0:
             x = pos[bi, 0] + radius[bi] * dx / dist
@@ -965,11 +992,11 @@ def _resolve_pair(sc, t_abs, bi, bj, b, ph, wk):
             involved[1] = bj
             n_inv = 2
         return n_inv
-    u_min = impact_threshold(bi, bj, vel, ph.ratio, ph.floor)
-    speed = ball_ball(bi, bj, pos, vel, b.inv_mass, ph.e, u_min)
+    u_min = impact_threshold(li, lj, vel, ph.ratio, ph.floor)
+    speed = ball_ball(li, lj, pos, vel, b.inv_mass, ph.e, u_min)
     if speed > 0.0:
-        x = pos[bi, 0] + radius[bi] * dx / dist
-        y = pos[bi, 1] + radius[bi] * dy / dist
+        x = pos[li, 0] + radius[li] * dx / dist
+        y = pos[li, 1] + radius[li] * dy / dist
         record(wk.imp, wk.n_imp, sc, t_abs, bi, bj, -1, x, y, speed)
     involved[0] = bi
     involved[1] = bj
@@ -1014,26 +1041,34 @@ def _screen(bi, t, now, ph, cl, geo, wk):
 
 
 @njit(inline="always")
-def _advance(bi, bj, now, rot, b, cl, ph):
-    """Bring the balls of an event (``bj < 0``: a wall) to ``now``, in their records and in the
-    ball state the response reads: every ball in stick scenes and when a contact group may form."""
-    if ph.sticky or ph.cascades:
-        _sync_all(now, b.pos, b.vel, b.mass, b.body, b.omega, rot, ph.sticky, cl.rec)
-    else:
-        _sync(bi, now, cl.rec)
-        _store(bi, cl.rec, b.pos, b.vel)
-        if bj >= 0:
-            _sync(bj, now, cl.rec)
-            _store(bj, cl.rec, b.pos, b.vel)
+def _whole_state(ph):
+    """The response works on the whole ball state (stick clusters, contact groups), not on the
+    event's two rows."""
+    return ph.sticky or ph.cascades
 
 
 @njit(inline="always")
-def _invalidate(n_changed, now, b, cl, wk):
+def _advance(bi, bj, now, rot, b, cl, ph, wk):
+    """Bring the balls of an event (``bj < 0``: a wall) to ``now``, in their records and in the
+    rows the response reads: the whole ball state (:func:`_whole_state`), or else rows 0 and 1
+    of ``wk.event``."""
+    if _whole_state(ph):
+        _sync_all(now, b.pos, b.vel, b.mass, b.body, b.omega, rot, ph.sticky, cl.rec)
+    else:
+        _take(bi, 0, now, cl, wk.event)
+        if bj >= 0:
+            _take(bj, 1, now, cl, wk.event)
+
+
+@njit(inline="always")
+def _invalidate(n_changed, now, ev, in_place, cl, wk):
     """The balls whose motion an event changed (``wk.pending``) take their new state into their
-    records, and their change counters move on: events other balls hold with them become stale."""
+    records, from the rows the response changed (``ev``: the whole ball state if ``in_place``, else
+    the event's rows, in the order of ``wk.pending``), and their change counters move on: events
+    other balls hold with them become stale."""
     for q in range(n_changed):
         k = wk.pending[q]
-        _load(k, now, cl.rec, b.pos, b.vel)
+        _load(k, now, cl.rec, ev.pos, ev.vel, k if in_place else q)
         cl.rec[k]["changes"] += 1
 
 
@@ -1057,6 +1092,7 @@ def step_exact(
     cal_heads,
     cal_heap,
     cal_buckets,
+    cal_inv_mass,
     scratch_f,
     scratch_i,
     scratch_b,
@@ -1071,7 +1107,8 @@ def step_exact(
     geometry (``layout.WORK_F``/``WORK_I``, which also hold the event queue's counts);
     ``cal_rec``/``cal_i``/``cal_heads``/``cal_heap``/``cal_buckets`` the persistent calendar records,
     its int rows, the grid's cell heads, and the event queue's heap and buckets
-    (``layout.CAL_RECORD``/``CAL_I``/``HEAP``, :class:`~collision_env.engine.calendar.EventQueue`);
+    (``layout.CAL_RECORD``/``CAL_I``/``HEAP``, :class:`~collision_env.engine.calendar.EventQueue`),
+    ``cal_inv_mass`` the (B, N) inverse masses the calendar took with the radii;
     ``clock`` the compensated clocks (:mod:`~collision_env.engine.clock`), advanced when a scene's
     step ends. ``start`` is
     :data:`START_STEP` to start a step of ``dt_abs`` for every scene, :data:`START_NEXT` to start
@@ -1112,7 +1149,7 @@ def step_exact(
             pos_all[sc], vel_all[sc], mass_all[sc], inv_mass_all[sc], radius_all[sc], body_all[sc], omega_all[sc]
         )
         queue = cal.EventQueue(cal_heap[sc], cal_buckets[sc], work_f[sc], work_i[sc])
-        cl = SceneCalendar(cal_rec[sc], cal_i[sc], cal_heads[sc], queue)
+        cl = SceneCalendar(cal_rec[sc], cal_i[sc], cal_heads[sc], queue, cal_inv_mass[sc])
         geo = grid.scene_geometry(work_f, work_i, sc)
         horizon_end = work_f[sc, W_REMAINING]
         t0 = time[sc]
@@ -1123,7 +1160,7 @@ def step_exact(
         # only to the end of a step), otherwise only the balls changed since the last step
         whole = not work_i[sc, W_CALENDAR_VALID] or rot
         if whole:
-            n_pending = _begin_whole_scene(now, b.pos, b.vel, b.radius, cl.rec, cl.ci, cl.heads, geo, wk.pending)
+            n_pending = _begin_whole_scene(now, b, cl, geo, wk.pending)
         elif start == START_STEP:
             n_pending = _begin_changed_balls(b.pos, b.vel, cl.rec, cl.ci, cl.heads, geo, wk.pending)
         else:
@@ -1158,19 +1195,22 @@ def step_exact(
             code = cl.ci[bi, C_EVENT_OTHER]
             bj = max(bi, code) if code >= 0 else -1
             bi = min(bi, code) if code >= 0 else bi
-            _advance(bi, bj, now, rot, b, cl, ph)
+            _advance(bi, bj, now, rot, b, cl, ph, wk)
             work_i[sc, W_EVENTS] += 1
             counters[EVENTS] += 1
             # resolve (the balls whose motion changed are listed in ``wk.pending``)
             t_abs = t0 + ph.sign * now
+            in_place = _whole_state(ph)
+            ev = b if in_place else wk.event
+            li = bi if in_place else 0
             if bj < 0:
-                n_pending = _resolve_wall(sc, t_abs, bi, cal.EV_WALL - code, b, ph, wk)
+                n_pending = _resolve_wall(sc, t_abs, bi, li, cal.EV_WALL - code, ev, ph, wk)
             else:
-                n_pending = _resolve_pair(sc, t_abs, bi, bj, b, ph, wk)
+                n_pending = _resolve_pair(sc, t_abs, bi, bj, li, bj if in_place else 1, ev, ph, wk)
             if ph.sticky:
                 rot = has_rotation(b.body, b.omega)
             # invalidate (the changed balls are predicted afresh at the top of the loop)
-            _invalidate(n_pending, now, b, cl, wk)
+            _invalidate(n_pending, now, ev, in_place, cl, wk)
 
         if work_i[sc, W_STALLED]:  # the next call goes on from here, as if nothing had stopped it
             work_f[sc, W_STALLED_AT] = now
@@ -1222,9 +1262,10 @@ if HAVE_NUMBA:
             view2(h, 14, np.int32),
             view3(h, 15, np.float64),
             view2(h, 16, np.int32),
-            view1(h, 17, np.float64),
-            view1(h, 18, np.int64),
-            view1(h, 19, np.bool_),
+            view2(h, 17, np.float64),
+            view1(h, 18, np.float64),
+            view1(h, 19, np.int64),
+            view1(h, 20, np.bool_),
             dt_abs,
             start,
         )

@@ -140,8 +140,8 @@ def _output_arrays(out, shapes):
 
 
 def _aligned_zeros(shape, dtype, align=64):
-    """Zeros whose rows start on ``align``-byte boundaries: a 64-byte calendar record is then one
-    cache line (numpy itself aligns to 16 bytes)."""
+    """Zeros whose rows start on ``align``-byte boundaries: a 64-byte calendar record or ball state
+    row is then one cache line (numpy itself aligns to 16 bytes)."""
     dtype = np.dtype(dtype)
     size = int(np.prod(shape)) * dtype.itemsize
     buffer = np.zeros(size + align, dtype=np.uint8)
@@ -292,7 +292,7 @@ class BatchSimulator:
         pos, vel, mass, radius = self._checked_balls(np.arange(n_scenes), positions, velocities, masses, radii)
         # Every per-ball float lives in one (B, N, 8) array, _pos, _vel, ... are views into it: each
         # array handed to a kernel costs ~0.1 us per call, which is most of a small scene's step.
-        self._balls = np.zeros((n_scenes, n, BALL_FIELDS))
+        self._balls = _aligned_zeros((n_scenes, n, BALL_FIELDS), np.float64)
         self._bind_views()
         self._pos[...] = pos
         self._vel[...] = vel
@@ -330,6 +330,7 @@ class BatchSimulator:
         self._cal_heads = np.zeros((n_scenes, grid.EXACT_CELLS_PER_BALL * n), dtype=np.int32)
         self._cal_heap = _aligned_zeros((n_scenes, heap_rows(n), len(HEAP)), np.float64)
         self._cal_buckets = np.full((n_scenes, bucket_count(n) + 1), -1, dtype=np.int32)
+        self._cal_inv_mass = np.zeros((n_scenes, n))
         self._invalidate(np.arange(n_scenes))
         self._alloc_work()
 
@@ -497,7 +498,8 @@ class BatchSimulator:
         if self.mode == "exact":
             nf, ni, nb = scratch_sizes(self._n)
             scratch = (np.empty(nf), np.empty(ni, dtype=np.int64), np.zeros(nb, dtype=np.bool_))
-            arrays = state + (self._cal, self._cal_i, self._cal_heads, self._cal_heap, self._cal_buckets) + scratch
+            calendar = (self._cal, self._cal_i, self._cal_heads, self._cal_heap, self._cal_buckets, self._cal_inv_mass)
+            arrays = state + calendar + scratch
             self._kernel, self._kernel_args = step_exact, arrays
             if HAVE_NUMBA:  # one packed array per call instead of twenty (see argpack)
                 self._kernel, self._kernel_args = step_exact_packed, (pack(arrays),)
@@ -927,7 +929,7 @@ class BatchSimulator:
         for field in (S_ELASTICITY, S_SIGN):  # (the direction of time the state is kept for)
             self._fparams[field] = other._fparams[field]
         if self.mode == "exact":
-            for name in ("_cal", "_cal_i", "_cal_heads", "_cal_heap", "_cal_buckets"):
+            for name in ("_cal", "_cal_i", "_cal_heads", "_cal_heap", "_cal_buckets", "_cal_inv_mass"):
                 np.copyto(getattr(self, name), getattr(other, name))
         self._sign = other._sign
         self._forward = other._forward
@@ -958,6 +960,7 @@ class BatchSimulator:
     def __setstate__(self, state):
         self.__dict__.update(state)
         # a copy or an unpickled array has numpy's alignment
+        self._balls = _aligned_copy(self._balls)
         self._cal = _aligned_copy(self._cal)
         self._cal_heap = _aligned_copy(self._cal_heap)
         self._bind_views()
