@@ -907,7 +907,7 @@ def _finish(t_end, pos, vel, mass, body, omega, rot, sticky, rec, ci, q):
             dt = t_end - r["ref_time"]
             r["x"] += r["vx"] * dt
             r["y"] += r["vy"] * dt
-            _store(i, rec, pos, vel, i)  # (events leave the ball state alone)
+            _store(i, rec, pos, vel, i)  # (events resolved on their own rows left it behind)
         r["ref_time"] = 0.0
         r["event_time"] -= t_end
     cal.rebase_queue(n, t_end, rec, ci, q)  # (the same times, rebased the same way)
@@ -927,9 +927,9 @@ def _cascade(sc, t_abs, i0, j0, b, ph, wk):
 
 @njit(inline="always")
 def _resolve_wall(sc, t_abs, bi, li, wall, b, ph, wk):
-    """Ball ``bi``, row ``li`` of ``b`` (the whole ball state, ``li = bi``, in stick scenes and when
-    contact groups form; else the event's rows), meets ``wall``. Returns how many balls' motion it
-    changed (listed in ``wk.pending``)."""
+    """Ball ``bi``, row ``li`` of ``b`` (the whole ball state, ``li = bi``, in stick scenes and
+    where contact groups may form, see :func:`_whole_state`; else the event's rows), meets
+    ``wall``. Returns how many balls' motion it changed (listed in ``wk.pending``)."""
     pos, vel, radius, body, omega, bounds = b.pos, b.vel, b.radius, b.body, b.omega, ph.bounds
     involved = wk.pending
     n = pos.shape[0]
@@ -1042,8 +1042,8 @@ def _screen(bi, t, now, ph, cl, geo, wk):
 
 @njit(inline="always")
 def _whole_state(ph):
-    """The response works on the whole ball state (stick clusters, contact groups), not on the
-    event's two rows."""
+    """The response works on the whole ball state, not on the event's two rows: in stick scenes,
+    and in every step at e < 1 forward, where any event may start a contact group."""
     return ph.sticky or ph.cascades
 
 
