@@ -4,6 +4,7 @@ Run it as::
 
     python -m collision_env.bench.misses                       # N = 1e3 and 1e5 (about 3 minutes)
     python -m collision_env.bench.misses --sizes 400 --cache-kib 2048
+    python -m collision_env.bench.misses --sizes 100000 --sites 20     # and the 20 costliest lines
 
 Timings on a shared machine cannot say which of the engine's arrays an event waits for, and numba's
 machine code carries no symbols a cache profiler could attribute to. This tool counts instead. It
@@ -17,7 +18,8 @@ the private L2 cache of one core of a current server.
 Every line of every array is fetched once (the largest array first), a short step then fills the
 model with what events use, and one frame of 1/60 s is counted. The report gives, per event (ball-
 ball and ball-wall collisions) and per array of the kernel's arguments (named as
-:func:`~collision_env.engine.exact.step_exact` names them), the lines that missed.
+:func:`~collision_env.engine.exact.step_exact` names them), the lines that missed; with ``--sites``,
+also per line of the kernel source that indexed the array (``exact._pair_gap:702``).
 What the counts leave out:
 
 - the frame's passes over every ball (the step's start and end) are counted with the events, as
@@ -54,13 +56,15 @@ FRAME = 1.0 / 60.0
 
 class LineCache:
     """A fully associative, least-recently-used cache of ``lines`` lines that counts, per tag, the
-    lines it had to fetch while ``counting`` is on."""
+    lines it had to fetch while ``counting`` is on; and per ``(tag, site)`` too, in ``sites``, once
+    that is set to a dict (the traced arrays then name the source line of each access)."""
 
     def __init__(self, lines: int):
         self.lines = lines
         self.held: OrderedDict[int, None] = OrderedDict()
         self.counting = False
         self.misses: dict[str, int] = {}
+        self.sites: dict[tuple[str, str], int] | None = None
 
     def touch_all(self, array: np.ndarray, tag: str) -> None:
         """Fetch every line of ``array``, in order."""
@@ -68,12 +72,14 @@ class LineCache:
         for line in range(start // LINE, (start + array.nbytes + LINE - 1) // LINE):
             self.touch(line, tag)
 
-    def touch(self, line: int, tag: str) -> None:
+    def touch(self, line: int, tag: str, site: str = "") -> None:
         if line in self.held:
             self.held.move_to_end(line)
             return
         if self.counting:
             self.misses[tag] = self.misses.get(tag, 0) + 1
+            if self.sites is not None:
+                self.sites[tag, site] = self.sites.get((tag, site), 0) + 1
         self.held[line] = None
         if len(self.held) > self.lines:
             self.held.popitem(last=False)
@@ -101,8 +107,9 @@ class TracedArray(np.ndarray):
             address += (int(index) % size) * stride  # (a negative index counts from the end)
         # an element reports every line it spans (a structured record may span two); a row, its first
         end = address + (self.itemsize if len(key) == self.ndim else 1)
+        site = _site(sys._getframe(2)) if self.cache.sites is not None else ""  # (who indexed: 2 calls up)
         for line in range(address // LINE, (end - 1) // LINE + 1):
-            self.cache.touch(line, self.tag)
+            self.cache.touch(line, self.tag, site)
 
     def __getitem__(self, key):
         self._touch(key)
@@ -113,8 +120,15 @@ class TracedArray(np.ndarray):
         super().__setitem__(key, value)
 
 
-def measure(n: int, cache_kib: int = CACHE_KIB) -> dict:
-    """Misses per event, by array, of one frame of the ``n``-disk gas (the Python path only)."""
+def _site(frame) -> str:
+    """A source line, as ``module.function:line``."""
+    module = os.path.splitext(os.path.basename(frame.f_code.co_filename))[0]
+    return f"{module}.{frame.f_code.co_name}:{frame.f_lineno}"
+
+
+def measure(n: int, cache_kib: int = CACHE_KIB, sites: int = 0) -> dict:
+    """Misses per event, by array, of one frame of the ``n``-disk gas (the Python path only); with
+    ``sites``, also the that many source lines that missed most, under ``"sites"``."""
     from collision_env.engine._jit import HAVE_NUMBA
     from collision_env.engine.exact import step_exact
 
@@ -124,6 +138,8 @@ def measure(n: int, cache_kib: int = CACHE_KIB) -> dict:
         raise RuntimeError("measure() traces the Python path: run it with NUMBA_DISABLE_JIT=1 (main() does)")
     sim = TimedGas(n, trace_memory=False).sim  # (built, and warmed up as the scale benchmark does)
     cache = LineCache(cache_kib * 1024 // LINE)
+    if sites:
+        cache.sites = {}
     names = list(inspect.signature(step_exact).parameters)
     traced = []
     for name, array in zip(names, sim._kernel_args, strict=False):
@@ -140,6 +156,7 @@ def measure(n: int, cache_kib: int = CACHE_KIB) -> dict:
     after = sim.stats
     events = after["events"] - before["events"]
     per_event = {tag: count / events for tag, count in sorted(cache.misses.items(), key=lambda kv: -kv[1])}
+    costliest = sorted((cache.sites or {}).items(), key=lambda kv: -kv[1])[:sites]
     return {
         "n": n,
         "cache_kib": cache_kib,
@@ -147,6 +164,11 @@ def measure(n: int, cache_kib: int = CACHE_KIB) -> dict:
         "pair_tests": (after["pair_tests"] - before["pair_tests"]) / events,  # (pair predictions)
         "cell_crossings": (after["cell_crossings"] - before["cell_crossings"]) / events,
         "misses_per_event": per_event,
+        **(
+            {"sites": [{"array": tag, "site": site, "per_event": count / events} for (tag, site), count in costliest]}
+            if sites
+            else {}
+        ),
     }
 
 
@@ -168,6 +190,11 @@ def render_markdown(rows: list[dict]) -> str:
             f"| {row['n']:,} | {row['events']:,} | {row['pair_tests']:.1f} | {row['cell_crossings']:.2f} "
             f"| {sum(m.values()):.1f} |" + "".join(f" {m.get(tag, 0.0):.2f} |" for tag in arrays)
         )
+    for row in rows:
+        if row.get("sites"):
+            lines += ["", f"Where {row['n']:,} disks miss most (source line of the access):", ""]
+            lines += ["| line | array | per event |", "|---|---|---:|"]
+            lines += [f"| `{s['site']}` | {s['array']} | {s['per_event']:.2f} |" for s in row["sites"]]
     return "\n".join(lines)
 
 
@@ -175,6 +202,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m collision_env.bench.misses", description=__doc__.split("\n")[0])
     parser.add_argument("--sizes", type=int, nargs="+", default=list(SIZES), help="gases of these many disks")
     parser.add_argument("--cache-kib", type=int, default=CACHE_KIB, help="the modelled cache's size (KiB)")
+    parser.add_argument("--sites", type=int, default=0, help="also list this many source lines that miss most")
     parser.add_argument("--json", help="write the raw figures here")
     args = parser.parse_args(argv)
     if os.environ.get("NUMBA_DISABLE_JIT") != "1":  # (numba decides at import: trace in a fresh process)
@@ -183,7 +211,7 @@ def main(argv=None) -> int:
         return subprocess.run(command, env=env, check=False).returncode
     rows = []
     for n in args.sizes:
-        rows.append(measure(n, args.cache_kib))
+        rows.append(measure(n, args.cache_kib, args.sites))
         print(f"  N = {n:,}: {sum(rows[-1]['misses_per_event'].values()):.1f} misses per event", flush=True)
     print(render_markdown(rows))
     if args.json:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 
 from collision_env.bench import misses
 
@@ -53,13 +54,20 @@ def test_records_report_every_line_they_span_and_indices_count_as_numpy_counts_t
 
 
 def test_a_small_gas_misses_nothing_in_a_large_cache_and_its_records_in_a_tiny_one(tmp_path):
-    """(``main`` counts in a fresh interpreter on the Python path, since numba is on here.)"""
+    """(``main`` counts in a fresh interpreter on the Python path, since numba is on here.) The
+    tiny cache's count is also split by source line, every line of it: the lines add up to the
+    arrays' counts, and the neighbour test of a prediction reads records."""
     out = tmp_path / "misses.json"
     for kib in (2048, 4):
-        assert misses.main(["--sizes", "200", "--cache-kib", str(kib), "--json", str(out)]) == 0
+        assert misses.main(["--sizes", "200", "--cache-kib", str(kib), "--sites", "1000", "--json", str(out)]) == 0
         (row,) = json.loads(out.read_text())
         assert row["n"] == 200 and row["events"] > 50
         if kib == 2048:  # every array fits, and every line was fetched before the count
-            assert row["misses_per_event"] == {}
+            assert row["misses_per_event"] == {} and row["sites"] == []
         else:
             assert row["misses_per_event"]["cal_rec"] > 1.0
+            by_array = {}
+            for site in row["sites"]:
+                by_array[site["array"]] = by_array.get(site["array"], 0.0) + site["per_event"]
+            assert by_array == pytest.approx(row["misses_per_event"])
+            assert any(s["array"] == "cal_rec" and s["site"].startswith("exact._pair_gap:") for s in row["sites"])
