@@ -626,9 +626,9 @@ def impacts_per_event(n, cascades):
 # them there, and the records take back what changed; the engine's ball state (what the caller
 # reads) is brought up to date from the records for every ball when the step ends. So an event
 # reads and writes the calendar alone: in a large scene the ball state's rows stay out of the
-# cache. Stick scenes and contact groups are the exception: clusters move as a whole and a group
-# may take in any ball, so the whole ball state is advanced at once, resolved in place, and the
-# records are loaded from it.
+# cache. Stick scenes and inelastic forward steps are the exception (:func:`_whole_state`):
+# clusters move as a whole and a contact group may take in any ball, so the whole ball state is
+# advanced at once, resolved in place, and the records are loaded from it.
 @njit(inline="always")
 def _position_at(k, t, rec):
     """Where ball ``k`` is at step time ``t``."""
@@ -1048,11 +1048,11 @@ def _whole_state(ph):
 
 
 @njit(inline="always")
-def _advance(bi, bj, now, rot, b, cl, ph, wk):
+def _advance(bi, bj, now, rot, in_place, b, cl, ph, wk):
     """Bring the balls of an event (``bj < 0``: a wall) to ``now``, in their records and in the
-    rows the response reads: the whole ball state (:func:`_whole_state`), or else rows 0 and 1
-    of ``wk.event``."""
-    if _whole_state(ph):
+    rows the response reads: the whole ball state if ``in_place`` (:func:`_whole_state`), or else
+    rows 0 and 1 of ``wk.event``."""
+    if in_place:
         _sync_all(now, b.pos, b.vel, b.mass, b.body, b.omega, rot, ph.sticky, cl.rec)
     else:
         _take(bi, 0, now, cl, wk.event)
@@ -1155,6 +1155,8 @@ def step_exact(
         t0 = time[sc]
         now = work_f[sc, W_STALLED_AT]  # (0 at a step's start)
         rot = ph.sticky and has_rotation(b.body, b.omega)
+        in_place = _whole_state(ph)  # (the rows an event is resolved on: see _advance)
+        ev = b if in_place else wk.event
 
         # begin: everything afresh after a reset (and for rotating clusters, whose predictions reach
         # only to the end of a step), otherwise only the balls changed since the last step
@@ -1195,13 +1197,11 @@ def step_exact(
             code = cl.ci[bi, C_EVENT_OTHER]
             bj = max(bi, code) if code >= 0 else -1
             bi = min(bi, code) if code >= 0 else bi
-            _advance(bi, bj, now, rot, b, cl, ph, wk)
+            _advance(bi, bj, now, rot, in_place, b, cl, ph, wk)
             work_i[sc, W_EVENTS] += 1
             counters[EVENTS] += 1
             # resolve (the balls whose motion changed are listed in ``wk.pending``)
             t_abs = t0 + ph.sign * now
-            in_place = _whole_state(ph)
-            ev = b if in_place else wk.event
             li = bi if in_place else 0
             if bj < 0:
                 n_pending = _resolve_wall(sc, t_abs, bi, li, cal.EV_WALL - code, ev, ph, wk)
