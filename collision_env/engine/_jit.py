@@ -24,6 +24,10 @@ ways:
 * **It says so when it compiles.** The first compilation in a process (a fresh install, or edited
   sources) prints one line on stderr, since it takes a while and is otherwise silent.
 
+:func:`prefetch` asks the processor for an array element's cache line ahead of its use (an LLVM
+intrinsic under numba, nothing in the Python path): the kernels use it where they know an address
+well before they read it.
+
 ``@njit(refcount=False)`` compiles a kernel without numba's reference counting of arrays (its
 private ``_nrt`` target option). Numba increments and decrements an array's count whenever a
 kernel binds it to a new name, and an inlined helper with a branch binds every array it takes:
@@ -216,3 +220,46 @@ def njit(func=None, *, refcount=True, **options):
     )
     dispatcher.enable_caching()
     return dispatcher
+
+
+if HAVE_NUMBA:
+    from llvmlite import ir as _ir
+    from numba.core import cgutils as _cgutils
+    from numba.extending import intrinsic as _intrinsic
+
+    @_intrinsic
+    def prefetch(typingctx, array, index):
+        """Ask for the cache line of ``array[index]`` (``index``: an integer, or a tuple of one per
+        axis) to be brought in for reading. A hint: it changes no value and cannot fault."""
+        indices = tuple(index) if isinstance(index, _types.BaseTuple) else (index,)
+        if not (isinstance(array, _types.Array) and len(indices) == array.ndim):
+            return None
+        if not all(isinstance(i, _types.Integer) for i in indices):
+            return None
+
+        def codegen(context, builder, signature, args):
+            array_type, index_type = signature.args
+            view = context.make_array(array_type)(context, builder, args[0])
+            if isinstance(index_type, _types.BaseTuple):
+                values, types = _cgutils.unpack_tuple(builder, args[1]), tuple(index_type)
+            else:
+                values, types = [args[1]], (index_type,)
+            index_values = [context.cast(builder, v, t, _types.intp) for v, t in zip(values, types, strict=True)]
+            ptr = _cgutils.get_item_pointer(context, builder, array_type, view, index_values, wraparound=False)
+            i8_ptr = _ir.IntType(8).as_pointer()
+            i32 = _ir.IntType(32)
+            # (llvm.prefetch(address, read = 0, locality = 3: keep in every level, data cache = 1); the
+            # name of its opaque-pointer form, which LLVM's typed-pointer versions also accept)
+            intrinsic = _cgutils.get_or_insert_function(
+                builder.module, _ir.FunctionType(_ir.VoidType(), [i8_ptr, i32, i32, i32]), "llvm.prefetch.p0"
+            )
+            address = builder.bitcast(ptr, i8_ptr)
+            builder.call(intrinsic, [address, _ir.Constant(i32, 0), _ir.Constant(i32, 3), _ir.Constant(i32, 1)])
+            return context.get_dummy_value()
+
+        return _types.void(array, index), codegen
+
+else:
+
+    def prefetch(array, index):
+        """Ask for the cache line of ``array[index]`` ahead of its use: nothing to do in Python."""

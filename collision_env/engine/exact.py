@@ -52,7 +52,7 @@ import numpy as np
 
 from . import calendar as cal
 from . import grid
-from ._jit import HAVE_NUMBA, njit
+from ._jit import HAVE_NUMBA, njit, prefetch
 from .clock import finish_step
 from .layout import (
     BALL,
@@ -838,6 +838,50 @@ def _predict(i, now, horizon, rebuild, rot, b, cl, ph, geo, wk):
         cal.schedule(i, cl.rec, cl.ci, cl.q)
 
 
+# ---------------------------------------------------------------------------- prefetch
+# In a large scene an event's data is out of the cache, and a prediction waits first for the cell
+# heads around its ball, then for the records they name. The heads' addresses are known as soon as
+# the event is popped: asking for them then overlaps their loads with the event's own work (screen,
+# advance, resolve), which cuts the cost per event at 10^5 balls by about a tenth and costs nothing
+# measurable at 10^2 (scale benchmark). Asking for the records too (once the heads are in) cost more
+# at 10^2 than it saved at 10^5: an empty cell's test is a branch no predictor learns.
+@njit(inline="always")
+def _prefetch_heads(c, nx, heads):
+    """Ask for the heads of the 3 x 3 cells around cell ``c`` (both ends of each row of three, which
+    may straddle two cache lines; clamped to the array, since only the lines matter)."""
+    last = heads.shape[0] - 1
+    for dy in range(-1, 2):
+        middle = np.int64(c) + dy * np.int64(nx)
+        prefetch(heads, min(max(middle - 1, 0), last))
+        prefetch(heads, min(max(middle + 1, 0), last))
+
+
+@njit(inline="always")
+def _prefetch_popped(bi, cl, geo):
+    """Ask for what ball ``bi``'s popped event reads first: its partner's record and int row, and
+    the cell heads of the prediction that follows (around the cell it enters, for a crossing).
+    Only with a grid: a scene without one is small enough to stay in the cache."""
+    nx = geo[4]
+    if nx * geo[5] == 1:
+        return
+    code = cl.ci[bi, C_EVENT_OTHER]
+    c = cl.ci[bi, C_CELL]
+    if cal.is_crossing(code):
+        c = grid.neighbour_cell(c, cal.EV_CROSS - code, nx)
+    _prefetch_heads(c, nx, cl.heads)
+    if code >= 0:
+        prefetch(cl.rec, code)
+        prefetch(cl.ci, (code, 0))
+
+
+@njit(inline="always")
+def _prefetch_partner(bj, cl, geo):
+    """Ask for the cell heads of pair partner ``bj``'s coming prediction (its cell is in its int row,
+    which :func:`_prefetch_popped` asked for)."""
+    if geo[4] * geo[5] > 1:
+        _prefetch_heads(cl.ci[bj, C_CELL], geo[4], cl.heads)
+
+
 # ---------------------------------------------------------------------------- begin
 @njit(inline="always")
 def _begin_whole_scene(now, b, cl, geo, pending):
@@ -1180,6 +1224,7 @@ def step_exact(
             bi = cal.next_ball(cl.rec, cl.ci, cl.q)
             if bi < 0:
                 break
+            _prefetch_popped(bi, cl, geo)
             t = cl.rec[bi]["event_time"]
             if not t <= horizon_end:
                 break
@@ -1195,6 +1240,8 @@ def step_exact(
             # advance (a pair is resolved, and reported, from its lower ball)
             now = max(now, t)
             code = cl.ci[bi, C_EVENT_OTHER]
+            if code >= 0:
+                _prefetch_partner(code, cl, geo)
             bj = max(bi, code) if code >= 0 else -1
             bi = min(bi, code) if code >= 0 else bi
             _advance(bi, bj, now, rot, in_place, b, cl, ph, wk)

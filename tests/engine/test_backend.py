@@ -2,12 +2,16 @@
 
 import json
 import os
+import platform
 import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 from collision_env.engine import BACKEND, Scene, Simulator
+from collision_env.engine._jit import HAVE_NUMBA, _numba, prefetch
+from collision_env.engine.layout import CAL_RECORD
 
 SCRIPT = """
 import json, numpy as np
@@ -65,3 +69,37 @@ def test_models_report_what_the_scene_needs():
     assert not Simulator(
         Scene(elasticity=0, inelastic="stick", ball_collisions=False), [[-1, 0], [1, 0]], [[1, 0], [0, 0]], [1, 1]
     ).models["clusters"]
+
+
+def _prefetched_sum(rec, rows, k):
+    """Prefetch elements of a record array and of a 2-D array (first and last included), then read them."""
+    prefetch(rec, k)
+    prefetch(rec, rec.shape[0] - 1)
+    prefetch(rows, (k, 0))
+    prefetch(rows, (0, rows.shape[1] - 1))
+    return rec[k]["x"] + rows[k, 0] + rows[0, rows.shape[1] - 1]
+
+
+def test_prefetch_is_a_hint_that_changes_nothing():
+    rec = np.zeros(5, CAL_RECORD)
+    rec["x"] = np.arange(5.0)
+    rows = np.arange(35, dtype=np.int32).reshape(5, 7)
+    before = rec.copy(), rows.copy()
+    kernel = _numba.njit(_prefetched_sum) if HAVE_NUMBA else _prefetched_sum  # (not cached: its code is inspected)
+    assert kernel(rec, rows, 3) == 3.0 + 21 + 6
+    assert (rec == before[0]).all() and (rows == before[1]).all()
+    if HAVE_NUMBA and platform.machine() in ("x86_64", "AMD64"):
+        (signature,) = kernel.signatures
+        assert "prefetcht0" in kernel.inspect_asm(signature)  # the hint reaches the machine code
+
+
+@pytest.mark.skipif(not HAVE_NUMBA, reason="typing is numba's")
+def test_prefetch_wants_one_integer_per_axis():
+    from numba.core.errors import TypingError
+
+    @_numba.njit
+    def row_only(rows):
+        prefetch(rows, 1)
+
+    with pytest.raises(TypingError):
+        row_only(np.zeros((2, 2)))
