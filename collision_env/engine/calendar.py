@@ -31,7 +31,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ._jit import njit
+from ._jit import njit, prefetch
 from .layout import (
     C_EVENT_OTHER,
     C_EVENT_STAMP,
@@ -438,6 +438,24 @@ def _open_next_bucket(rec, ci, q):
     if bucket >= q.qi[W_QUEUE_RELEASE]:  # (after the bucket is emptied: the far list may refill it)
         _release_far(rec, ci, q)
     return True
+
+
+@njit(inline="always")
+def walk_next_bucket(cursor, rec, ci, q):
+    """One step down the list of the bucket that opens next, asking for the rows of the ball it
+    reaches. Opening a bucket chases its list, one dependent load per ball, each a miss at 10^5
+    balls; a step per popped event walks the list ahead of that. ``cursor`` is the ball the last
+    step reached (-1 to start at the list's head, as after the bucket opened or the ball left the
+    list); returns the ball this one reaches (-1 at the end: the next step starts again)."""
+    ring = _ring_size(q)
+    if ring == 0:
+        return -1
+    p = (q.qi[W_QUEUE_BUCKET] + 1) % ring
+    ball = q.buckets[p] if cursor < 0 or ci[cursor, C_QUEUE_SLOT] != -1 - p else ci[cursor, C_QUEUE_NEXT]
+    if ball >= 0:
+        prefetch(ci, (ball, 0))
+        prefetch(rec, ball)
+    return ball
 
 
 # Called where the heap ran empty, once per bucket (and never without buckets): a call of its own,

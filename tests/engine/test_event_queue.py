@@ -5,6 +5,8 @@ event earlier or later, rebase every time as a step's end does) on rings of 0 to
 several widths, with times drawn from a coarse set so that ties and bucket boundaries are
 frequent: the queue's first ball is always the one a sort by time and the tie rule names, and
 after every operation its structure is intact (heap order, lists, counts, each event's bucket).
+A walk down the list of the bucket that opens next (the scheduler's prefetching) takes a step
+before every operation and never leaves that list.
 """
 
 from __future__ import annotations
@@ -88,6 +90,13 @@ def queue_intact(n, rec, ci, q):
 
 
 @njit
+def walk_in_next_bucket(ball, ci, q):
+    """The walk reached the end of the list (-1), or a ball queued in the bucket that opens next."""
+    ring = q.buckets.shape[0] - 1
+    return ball == -1 or (ring > 0 and ci[ball, C_QUEUE_SLOT] == -1 - (q.qi[W_QUEUE_BUCKET] + 1) % ring)
+
+
+@njit
 def run_queue(width, rec, ci, hp, buckets, qf, qi, kinds, balls, times):
     """Queue the events of ``rec``, then apply the operations, each after noting the queue's
     first ball (-1: none): pop the first event and queue the ball's next ``times[k]`` later, move
@@ -100,9 +109,13 @@ def run_queue(width, rec, ci, hp, buckets, qf, qi, kinds, balls, times):
     firsts = np.full(kinds.shape[0], -2, dtype=np.int64)
     if not queue_intact(n, rec, ci, q):
         return firsts, -1
+    walk = -1
     for k in range(kinds.shape[0]):
         first = cal.next_ball(rec, ci, q)
         firsts[k] = first
+        walk = cal.walk_next_bucket(walk, rec, ci, q)
+        if not walk_in_next_bucket(walk, ci, q):
+            return firsts, k
         if kinds[k] == REBASE:
             for i in range(n):
                 rec[i]["event_time"] -= times[k]
@@ -144,6 +157,40 @@ def check_queue(ring, width, times, codes, kinds, balls, steps):
         elif kind == REBASE:
             t -= step
     np.testing.assert_array_equal(rec["event_time"], t)
+
+
+@njit
+def walk_steps(steps, width, rec, ci, hp, buckets, qf, qi):
+    """Queue the events of ``rec`` and take ``steps`` steps of the walk on the queue as it stands;
+    also the list of the bucket that opens next, as its links give it."""
+    q = cal.EventQueue(hp, buckets, qf, qi)
+    cal.reset_queue(rec.shape[0], 0.0, width, rec, ci, q)
+    walked = np.empty(steps, dtype=np.int64)
+    walk = -1
+    for k in range(steps):
+        walk = cal.walk_next_bucket(walk, rec, ci, q)
+        walked[k] = walk
+    listed = []
+    ball = buckets[(qi[W_QUEUE_BUCKET] + 1) % (buckets.shape[0] - 1)]
+    while ball >= 0:
+        listed.append(ball)
+        ball = ci[ball, C_QUEUE_NEXT]
+    return walked, listed
+
+
+def test_the_walk_goes_down_the_next_bucket_and_starts_again_at_its_end():
+    """Balls 1, 3 and 4 fall in bucket 1 (the next to open; 0 and 2 are in the heap's bucket 0,
+    5 in bucket 2): the walk visits the list as it is linked (the last queued first), then -1,
+    then the list again."""
+    times = [0.05, 0.12, 0.01, 0.15, 0.11, 0.25]
+    n = len(times)
+    rec = np.zeros(n, dtype=CAL_RECORD)
+    rec["event_time"] = times
+    ci = np.zeros((n, len(CAL_I)), dtype=np.int32)
+    heap, buckets, qf = np.zeros((cal.heap_rows(n), 2)), np.full(4 + 1, -1, dtype=np.int32), np.zeros(len(WORK_F))
+    walked, listed = walk_steps(9, 0.1, rec, ci, heap, buckets, qf, np.zeros(len(WORK_I), dtype=np.int64))
+    assert list(listed) == [4, 3, 1]
+    assert walked.tolist() == [4, 3, 1, -1, 4, 3, 1, -1, 4]
 
 
 def tie_codes(n, codes):
