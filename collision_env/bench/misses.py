@@ -27,6 +27,8 @@ What the counts leave out:
   prefetchers hide;
 - the Python side's work between kernel calls (copying impacts out of the buffer) is not counted;
 - reads and writes count alike;
+- the kernels' software prefetches (``_jit.prefetch``, a hint, not an access) are not counted: a
+  miss they hide still counts where the data is used;
 - associativity, prefetchers and the other levels are not modelled, and where numpy places an
   array that is not aligned to a line moves its counts a little from run to run.
 

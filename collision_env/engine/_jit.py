@@ -248,8 +248,8 @@ if HAVE_NUMBA:
             ptr = _cgutils.get_item_pointer(context, builder, array_type, view, index_values, wraparound=False)
             i8_ptr = _ir.IntType(8).as_pointer()
             i32 = _ir.IntType(32)
-            # (llvm.prefetch(address, read = 0, locality = 3: keep in every level, data cache = 1); the
-            # name of its opaque-pointer form, which LLVM's typed-pointer versions also accept)
+            # (llvm.prefetch(address, read = 0, locality = 3: keep in every level, data cache = 1), by
+            # the name of its opaque-pointer form, which LLVM 14's typed pointers (numba 0.60) accept too)
             intrinsic = _cgutils.get_or_insert_function(
                 builder.module, _ir.FunctionType(_ir.VoidType(), [i8_ptr, i32, i32, i32]), "llvm.prefetch.p0"
             )

@@ -441,19 +441,27 @@ def _open_next_bucket(rec, ci, q):
 
 
 @njit(inline="always")
+def prefetch_int_row(ball, ci):
+    """Ask for ``ball``'s int row (both ends: a row of seven int32 may straddle two cache lines)."""
+    prefetch(ci, (ball, 0))
+    prefetch(ci, (ball, ci.shape[1] - 1))
+
+
+@njit(inline="always")
 def walk_next_bucket(cursor, rec, ci, q):
     """One step down the list of the bucket that opens next, asking for the rows of the ball it
     reaches. Opening a bucket chases its list, one dependent load per ball, each a miss at 10^5
     balls; a step per popped event walks the list ahead of that. ``cursor`` is the ball the last
-    step reached (-1 to start at the list's head, as after the bucket opened or the ball left the
-    list); returns the ball this one reaches (-1 at the end: the next step starts again)."""
+    step reached, or -1. The step starts at the list's head when there is none, or when that ball is
+    no longer in the list (the bucket opened, or its event moved); returns the ball it reaches (-1
+    past the list's end, and the next step starts again). Without buckets: always -1."""
     ring = _ring_size(q)
     if ring == 0:
         return -1
     p = (q.qi[W_QUEUE_BUCKET] + 1) % ring
     ball = q.buckets[p] if cursor < 0 or ci[cursor, C_QUEUE_SLOT] != -1 - p else ci[cursor, C_QUEUE_NEXT]
     if ball >= 0:
-        prefetch(ci, (ball, 0))
+        prefetch_int_row(ball, ci)
         prefetch(rec, ball)
     return ball
 

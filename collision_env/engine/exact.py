@@ -863,16 +863,15 @@ def _prefetch_popped(bi, cl, geo):
     the cell heads of the prediction that follows (around the cell it enters, for a crossing).
     Only with a grid: a scene without one is small enough to stay in the cache."""
     nx = geo[4]
-    if nx * geo[5] == 1:
-        return
-    code = cl.ci[bi, C_EVENT_OTHER]
-    c = cl.ci[bi, C_CELL]
-    if cal.is_crossing(code):
-        c = grid.neighbour_cell(c, cal.EV_CROSS - code, nx)
-    _prefetch_heads(c, nx, cl.heads)
-    if code >= 0:
-        prefetch(cl.rec, code)
-        prefetch(cl.ci, (code, 0))
+    if nx * geo[5] > 1:
+        code = cl.ci[bi, C_EVENT_OTHER]
+        c = cl.ci[bi, C_CELL]
+        if cal.is_crossing(code):
+            c = grid.neighbour_cell(c, cal.EV_CROSS - code, nx)
+        _prefetch_heads(c, nx, cl.heads)
+        if code >= 0:
+            prefetch(cl.rec, code)
+            cal.prefetch_int_row(code, cl.ci)
 
 
 @njit(inline="always")

@@ -72,7 +72,8 @@ def test_models_report_what_the_scene_needs():
 
 
 def _prefetched_sum(rec, rows, k):
-    """Prefetch elements of a record array and of a 2-D array (first and last included), then read them."""
+    """Prefetch elements of a record array (the last one among them) and of a 2-D array (with a
+    tuple index, the last column among them), then read some."""
     prefetch(rec, k)
     prefetch(rec, rec.shape[0] - 1)
     prefetch(rows, (k, 0))

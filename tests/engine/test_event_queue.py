@@ -5,8 +5,8 @@ event earlier or later, rebase every time as a step's end does) on rings of 0 to
 several widths, with times drawn from a coarse set so that ties and bucket boundaries are
 frequent: the queue's first ball is always the one a sort by time and the tie rule names, and
 after every operation its structure is intact (heap order, lists, counts, each event's bucket).
-A walk down the list of the bucket that opens next (the scheduler's prefetching) takes a step
-before every operation and never leaves that list.
+A walk down the list of the bucket that opens next (the sorter's prefetching) takes a step
+before every operation: it reaches a ball of that list, or the list's end.
 """
 
 from __future__ import annotations
@@ -90,19 +90,26 @@ def queue_intact(n, rec, ci, q):
 
 
 @njit
-def walk_in_next_bucket(ball, ci, q):
-    """The walk reached the end of the list (-1), or a ball queued in the bucket that opens next."""
+def walk_in_next_bucket(cursor, ball, ci, q):
+    """A step of the walk from ``cursor`` reached ``ball``: a ball queued in the bucket that opens
+    next, or -1 only past the end of that list (from its last ball, or on an empty list)."""
     ring = q.buckets.shape[0] - 1
-    return ball == -1 or (ring > 0 and ci[ball, C_QUEUE_SLOT] == -1 - (q.qi[W_QUEUE_BUCKET] + 1) % ring)
+    if ring == 0:
+        return ball == -1
+    p = (q.qi[W_QUEUE_BUCKET] + 1) % ring
+    if ball >= 0:
+        return ci[ball, C_QUEUE_SLOT] == -1 - p
+    return q.buckets[p] < 0 or (cursor >= 0 and ci[cursor, C_QUEUE_SLOT] == -1 - p and ci[cursor, C_QUEUE_NEXT] < 0)
 
 
 @njit
 def run_queue(width, rec, ci, hp, buckets, qf, qi, kinds, balls, times):
     """Queue the events of ``rec``, then apply the operations, each after noting the queue's
-    first ball (-1: none): pop the first event and queue the ball's next ``times[k]`` later, move
-    ball ``balls[k]``'s event to ``times[k]``, or rebase every time by ``times[k]``. Returns the
-    first ball before each operation, and how many operations left the queue intact (it stops at
-    the first that does not)."""
+    first ball (-1: none) and taking a step of the walk down the next bucket: pop the first event
+    and queue the ball's next ``times[k]`` later, move ball ``balls[k]``'s event to ``times[k]``,
+    or rebase every time by ``times[k]``. Returns the first ball before each operation, and how
+    many operations left the queue intact and had a step of the walk land where it should (it
+    stops at the first that did not)."""
     n = rec.shape[0]
     q = cal.EventQueue(hp, buckets, qf, qi)
     cal.reset_queue(n, 0.0, width, rec, ci, q)
@@ -113,9 +120,10 @@ def run_queue(width, rec, ci, hp, buckets, qf, qi, kinds, balls, times):
     for k in range(kinds.shape[0]):
         first = cal.next_ball(rec, ci, q)
         firsts[k] = first
-        walk = cal.walk_next_bucket(walk, rec, ci, q)
-        if not walk_in_next_bucket(walk, ci, q):
+        walked = cal.walk_next_bucket(walk, rec, ci, q)
+        if not walk_in_next_bucket(walk, walked, ci, q):
             return firsts, k
+        walk = walked
         if kinds[k] == REBASE:
             for i in range(n):
                 rec[i]["event_time"] -= times[k]
@@ -140,7 +148,7 @@ def check_queue(ring, width, times, codes, kinds, balls, steps):
     qi = np.zeros(len(WORK_I), dtype=np.int64)
     heap, buckets, qf = np.zeros((cal.heap_rows(n), 2)), np.full(ring + 1, -1, dtype=np.int32), np.zeros(len(WORK_F))
     firsts, intact = run_queue(width, rec, ci, heap, buckets, qf, qi, kinds, balls, steps)
-    assert intact == len(kinds), f"the queue broke at operation {intact}"
+    assert intact == len(kinds), f"the queue (or the walk) broke at operation {intact}"
 
     keys = np.array([cal.order_key(i, codes[i]) for i in range(n)])  # the tie rule, per ball
     t = np.array(times, dtype=np.float64)
