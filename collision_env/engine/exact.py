@@ -778,7 +778,7 @@ def _partner_event(i, now, horizon, rebuild, rot, best_t, best_code, best_stamp,
     rec = cl.rec
     n = rec.shape[0]
     nx, ny = geo[4], geo[5]
-    one_cell = nx * ny == 1
+    one_cell = not grid.has_cells(geo)
     tests = 0
     cx0, cx1, cy0, cy1 = (0, 0, 0, 0) if one_cell else grid.block(cl.ci[i, C_CELL], nx, ny)
     for cy in range(cy0, cy1 + 1):
@@ -826,7 +826,7 @@ def _predict(i, now, horizon, rebuild, rot, b, cl, ph, geo, wk):
         best_t, best_code = INF, cal.EV_NONE
     best_stamp = 0
     if ph.pairs:
-        if geo[4] * geo[5] > 1:
+        if grid.has_cells(geo):
             t, code = _crossing_event(i, cl.rec, cl.ci, geo)
             if cal.earlier(t, code, best_t, best_code, i):
                 best_t, best_code = t, code
@@ -862,8 +862,8 @@ def _prefetch_popped(bi, cl, geo):
     """Ask for what ball ``bi``'s popped event reads first: its partner's record and int row, and
     the cell heads of the prediction that follows (around the cell it enters, for a crossing).
     Only with a grid: a scene without one is small enough to stay in the cache."""
-    nx = geo[4]
-    if nx * geo[5] > 1:
+    if grid.has_cells(geo):
+        nx = geo[4]
         code = cl.ci[bi, C_EVENT_OTHER]
         c = cl.ci[bi, C_CELL]
         if cal.is_crossing(code):
@@ -878,7 +878,7 @@ def _prefetch_popped(bi, cl, geo):
 def _prefetch_partner(bj, cl, geo):
     """Ask for the cell heads of pair partner ``bj``'s coming prediction (its cell is in its int row,
     which :func:`_prefetch_popped` asked for)."""
-    if geo[4] * geo[5] > 1:
+    if grid.has_cells(geo):
         _prefetch_heads(cl.ci[bj, C_CELL], geo[4], cl.heads)
 
 
@@ -921,7 +921,7 @@ def _begin_changed_balls(pos, vel, rec, ci, heads, geo, pending):
             n_changed += 1
             _load(i, 0.0, rec, pos, vel, i)
             rec[i]["changes"] += 1
-            if nx * ny > 1:
+            if grid.has_cells(geo):
                 grid.move_to_cell(i, grid.cell_of(pos[i, 0], pos[i, 1], x0, y0, hx, hy, nx, ny), rec, ci, heads)
     return n_changed
 

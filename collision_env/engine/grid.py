@@ -104,6 +104,12 @@ def scene_geometry(work_f, work_i, sc):
 
 
 @njit(inline="always")
+def has_cells(geo):
+    """The grid ``geo`` (:func:`scene_geometry`) has more than one cell: the scene uses it."""
+    return geo[4] * geo[5] > 1
+
+
+@njit(inline="always")
 def _axis_cell(x, x0, h, n_cells):
     f = (x - x0) / h
     if not f > 0.0:  # (also the one-cell case, h = inf)
