@@ -132,7 +132,7 @@ def measure(n: int, cache_kib: int = CACHE_KIB, sites: int = 0) -> dict:
     """Misses per event, by array, of one frame of the ``n``-disk gas (the Python path only); with
     ``sites``, also the that many source lines that missed most, under ``"sites"``."""
     from collision_env.engine._jit import HAVE_NUMBA
-    from collision_env.engine.exact import step_exact
+    from collision_env.engine.exact.scheduler import step_exact
 
     from .scale import TimedGas
 

@@ -54,9 +54,9 @@ if HAVE_NUMBA:
     import numpy as np
 
     from .argpack import view1, view3
-    from .exact import START_NEXT, START_STEP, step_exact_packed
+    from .exact.scheduler import START_NEXT, START_STEP, step_exact_packed
     from .layout import IMPACT_DTYPE
-    from .substep import step_substeps_packed
+    from .stepped.substep import step_substeps_packed
 
     @njit
     def step_frames(mode, k_total, h, dt, first, n_frames, times, positions, velocities, out, n_out):

@@ -16,18 +16,18 @@ from typing import Any, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import grid
 from ._jit import BACKEND, HAVE_NUMBA
 from .argpack import pack
-from .calendar import bucket_count, heap_rows
-from .exact import COUNTERS, RESUME, START_STEP, impacts_per_event, scratch_sizes, step_exact
+from .exact import grid
+from .exact.calendar import bucket_count, heap_rows
+from .exact.scheduler import COUNTERS, RESUME, START_STEP, impacts_per_event, scratch_sizes, step_exact
 from .frames import EXACT, copy_impacts, record_frame
 
 if HAVE_NUMBA:
-    from .exact import step_exact_packed
+    from .exact.scheduler import step_exact_packed
     from .frames import step_frames
-    from .substep import step_substeps_packed
-from .grid import GRID_MIN_BALLS, first_overlap, grid_geometry
+    from .stepped.substep import step_substeps_packed
+from .exact.grid import GRID_MIN_BALLS, first_overlap, grid_geometry
 from .layout import (
     B_INV_MASS,
     B_MASS,
@@ -50,11 +50,11 @@ from .layout import (
     WORK_F,
     WORK_I,
 )
-from .motion import BALL_FIELDS, apply_impulses
+from .physics.motion import BALL_FIELDS, apply_impulses
+from .physics.tolerance import CONTACT_RTOL, EPS, roundoff
 from .scene import CONSTANT_RADIUS, WALL_NAMES, Scene, radius_from_mass
-from .substep import NAIVE, POSTERIORI, step_substeps, worst_case_impacts
-from .substep import scratch_size as substep_scratch_size
-from .tolerance import CONTACT_RTOL, EPS, roundoff
+from .stepped.substep import NAIVE, POSTERIORI, step_substeps, worst_case_impacts
+from .stepped.substep import scratch_size as substep_scratch_size
 
 MODES = ("naive", "posteriori", "exact")
 

@@ -19,7 +19,7 @@ import math
 import numpy as np
 
 from collision_env.engine._jit import njit
-from collision_env.engine.motion import apply_impulses, ball_views
+from collision_env.engine.physics.motion import apply_impulses, ball_views
 from collision_env.engine.scene import WALL_BOTTOM, WALL_LEFT, WALL_RIGHT, WALL_TOP
 from collision_env.envs._layout import (
     BALL_OBS,

@@ -14,8 +14,8 @@ import pytest
 
 import collision_env.engine.simulator as simulator_module
 from collision_env.engine import BatchSimulator, Scene, Simulator
-from collision_env.engine.calendar import QUEUE_MIN_BALLS
-from collision_env.engine.grid import GRID_MIN_BALLS
+from collision_env.engine.exact.calendar import QUEUE_MIN_BALLS
+from collision_env.engine.exact.grid import GRID_MIN_BALLS
 from collision_env.engine.layout import W_QUEUE_FAR, W_QUEUE_HEAP, W_QUEUE_RING
 
 

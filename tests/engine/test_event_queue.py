@@ -16,8 +16,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from collision_env.engine import calendar as cal
 from collision_env.engine._jit import njit
+from collision_env.engine.exact import calendar as cal
 from collision_env.engine.layout import (
     C_EVENT_OTHER,
     C_QUEUE_NEXT,

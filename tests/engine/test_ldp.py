@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from collision_env.engine.ldp import least_distance, nnls
+from collision_env.engine.physics.ldp import least_distance, nnls
 
 
 def test_nnls_matches_the_unconstrained_solution_when_it_is_positive():

@@ -56,7 +56,7 @@ from __future__ import annotations
 
 import math
 
-from ._jit import njit
+from .._jit import njit
 
 #: Closing speeds up to this many ulps of a group's fastest speed are round-off, not collisions.
 _ROUNDOFF_SPEED = 8.0 * 2.0**-52

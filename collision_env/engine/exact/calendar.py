@@ -31,8 +31,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ._jit import njit, prefetch
-from .layout import (
+from .._jit import njit, prefetch
+from ..layout import (
     C_EVENT_OTHER,
     C_EVENT_STAMP,
     C_QUEUE_NEXT,

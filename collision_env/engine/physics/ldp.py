@@ -21,7 +21,7 @@ import math
 
 import numpy as np
 
-from ._jit import njit
+from .._jit import njit
 
 #: Relative tolerance of the NNLS optimality test and of the feasibility test.
 _TOL = 1e-12

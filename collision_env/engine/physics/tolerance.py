@@ -11,7 +11,7 @@ be a millimetre.
 
 from __future__ import annotations
 
-from ._jit import njit
+from .._jit import njit
 
 #: Contact tolerance relative to the feature size (radii, diameters).
 CONTACT_RTOL = 1e-9

@@ -50,11 +50,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from . import calendar as cal
-from . import grid
-from ._jit import HAVE_NUMBA, njit, prefetch
-from .clock import finish_step
-from .layout import (
+from .._jit import HAVE_NUMBA, njit, prefetch
+from ..clock import finish_step
+from ..layout import (
     BALL,
     C_CELL,
     C_EVENT_OTHER,
@@ -78,14 +76,16 @@ from .layout import (
     W_STALLED,
     W_STALLED_AT,
 )
-from .ldp import least_distance
+from ..physics.ldp import least_distance
+from . import calendar as cal
+from . import grid
 
 if HAVE_NUMBA:
-    from .argpack import view1, view2, view3
-from .motion import advance_all, ball_views, body_kinematics, has_rotation
-from .response import ball_ball, ball_wall, group_threshold, impact_threshold, merge_bodies, stop_body
-from .toi import INF, ca_pair, ca_wall, toi_pair, toi_wall
-from .tolerance import CONTACT_RTOL, contact_tolerance
+    from ..argpack import view1, view2, view3
+from ..physics.motion import advance_all, ball_views, body_kinematics, has_rotation
+from ..physics.response import ball_ball, ball_wall, group_threshold, impact_threshold, merge_bodies, stop_body
+from ..physics.toi import INF, ca_pair, ca_wall, toi_pair, toi_wall
+from ..physics.tolerance import CONTACT_RTOL, contact_tolerance
 
 #: Work counters (``BatchSimulator.stats``): pair predictions, wall predictions, events,
 #: rotating-cluster predictions, grid-cell crossings, stale calendar entries re-predicted.

@@ -27,8 +27,8 @@ import math
 
 import numpy as np
 
-from ._jit import njit
-from .layout import (
+from .._jit import njit
+from ..layout import (
     C_CELL,
     C_CELL_PREV,
     W_GRID_HX,

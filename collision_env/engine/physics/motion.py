@@ -17,8 +17,8 @@ from __future__ import annotations
 
 import math
 
-from ._jit import njit
-from .layout import B_INV_MASS, B_MASS, B_OMEGA, B_RADIUS, B_VX, B_X, BALL
+from .._jit import njit
+from ..layout import B_INV_MASS, B_MASS, B_OMEGA, B_RADIUS, B_VX, B_X, BALL
 
 #: Last axis of the (B, N, 8) per-ball state, laid out as ``layout.BALL``: position (2),
 #: velocity (2), mass, 1 / mass, radius, and the angular velocity of the cluster the ball roots.

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 
-from ._jit import njit
+from .._jit import njit
 from .motion import position_at
 from .tolerance import contact_tolerance
 

@@ -2,26 +2,26 @@
 
 from __future__ import annotations
 
-from ._jit import HAVE_NUMBA, njit
-from .clock import finish_step
-from .exact import RESUME, scene_params
-from .grid import CHEAP_CELLS_PER_BALL, block, cell_of, scene_geometry
-from .layout import (
+from .._jit import HAVE_NUMBA, njit
+from ..clock import finish_step
+from ..exact.grid import CHEAP_CELLS_PER_BALL, block, cell_of, scene_geometry
+from ..exact.scheduler import RESUME, scene_params
+from ..layout import (
     W_ACTIVE,
     W_STALLED,
     W_SUBSTEP_START,
     W_SUBSTEPS_DONE,
 )
-from .motion import advance_all, ball_views, has_rotation
+from ..physics.motion import advance_all, ball_views, has_rotation
+from ..physics.response import elastic_threshold
 from .naive import resolve_naive
 from .posteriori import resolve_posteriori
-from .response import elastic_threshold
 
 if HAVE_NUMBA:
     import numpy as np
 
-    from .argpack import view1
-    from .exact import unpack_state
+    from ..argpack import view1
+    from ..exact.scheduler import unpack_state
 
 NAIVE, POSTERIORI = 0, 1
 

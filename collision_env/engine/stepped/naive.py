@@ -17,10 +17,10 @@ from __future__ import annotations
 
 import math
 
-from ._jit import njit
-from .exact import EVENTS, PAIR_TESTS, WALL_TESTS, record, wall_point
-from .grid import later_neighbours
-from .response import ball_ball, ball_wall, merge_bodies, stop_body
+from .._jit import njit
+from ..exact.grid import later_neighbours
+from ..exact.scheduler import EVENTS, PAIR_TESTS, WALL_TESTS, record, wall_point
+from ..physics.response import ball_ball, ball_wall, merge_bodies, stop_body
 
 
 @njit(inline="always")
