@@ -17,9 +17,10 @@ the private L2 cache of one core of a current server.
 
 Every line of every array is fetched once (the largest array first), a short step then fills the
 model with what events use, and one frame of 1/60 s is counted. The report gives, per event (ball-
-ball and ball-wall collisions) and per array of the kernel's arguments (named as
-:func:`~collision_env.engine.exact.step_exact` names them), the lines that missed; with ``--sites``,
-also per line of the kernel source that indexed the array (``exact._pair_gap:702``).
+ball and ball-wall collisions) and per array the kernel takes (named as the fields of its bundles,
+:class:`~collision_env.engine.state.State`, :class:`~collision_env.engine.state.Calendar` and
+:class:`~collision_env.engine.state.ExactScratch`), the lines that missed; with ``--sites``, also
+per line of the kernel source that indexed the array (``trajectories.pair_gap:95``).
 What the counts leave out:
 
 - the frame's passes over every ball (the step's start and end) are counted with the events, as
@@ -38,7 +39,6 @@ So the counts rank the arrays; they are not a time.
 from __future__ import annotations
 
 import argparse
-import inspect
 import json
 import os
 import subprocess
@@ -132,7 +132,6 @@ def measure(n: int, cache_kib: int = CACHE_KIB, sites: int = 0) -> dict:
     """Misses per event, by array, of one frame of the ``n``-disk gas (the Python path only); with
     ``sites``, also the that many source lines that missed most, under ``"sites"``."""
     from collision_env.engine._jit import HAVE_NUMBA
-    from collision_env.engine.exact.scheduler import step_exact
 
     from .scale import TimedGas
 
@@ -142,13 +141,15 @@ def measure(n: int, cache_kib: int = CACHE_KIB, sites: int = 0) -> dict:
     cache = LineCache(cache_kib * 1024 // LINE)
     if sites:
         cache.sites = {}
-    names = list(inspect.signature(step_exact).parameters)
     traced = []
-    for name, array in zip(names, sim._kernel_args, strict=False):
-        view = array.view(TracedArray)
-        view.tag, view.cache = name, cache
-        traced.append(view)
-    sim._kernel_args = tuple(traced)
+    bundles = []
+    for bundle in sim._pack:  # (the Python path's pack: the kernel's bundles of arrays)
+        views = [array.view(TracedArray) for array in bundle]
+        for name, view in zip(bundle._fields, views, strict=True):
+            view.tag, view.cache = name, cache
+        traced += views
+        bundles.append(type(bundle)(*views))
+    sim._pack = tuple(bundles)
     for view in sorted(traced, key=lambda view: -view.nbytes):  # (largest first: what fits stays)
         cache.touch_all(view, view.tag)
     sim.step(WARM_S)

@@ -42,7 +42,7 @@ import tracemalloc
 import numpy as np
 
 from collision_env.engine import BatchSimulator, Scene, warm_up
-from collision_env.engine.exact.grid import first_overlap
+from collision_env.engine.broadphase import first_overlap
 
 from .machine import cpus, machine, timestamp, versions
 from .metrics import enskog_rate

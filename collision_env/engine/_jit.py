@@ -19,10 +19,24 @@ ways:
   made. A kernel outside the package (a test's, which inlines the package's kernels) is cached in
   the same folder, keyed on its own file's contents as well (one that has no file is not cached).
 * **One compiled version per kernel.** numba compiles a separate version of a called kernel for
-  every distinct literal argument (``f(i, -1)`` and ``f(i, j)`` are two compilations); here a
-  kernel called from another kernel is compiled for the arguments' plain types only.
-* **It says so when it compiles.** The first compilation in a process (a fresh install, or edited
-  sources) prints one line on stderr, since it takes a while and is otherwise silent.
+  every distinct literal argument (``f(i, -1)`` and ``f(i, j)`` are two compilations) and integer
+  type (an int32 read from an array, an int64 loop counter); here a kernel called from another
+  kernel is compiled for the arguments' plain types, every integer as int64.
+* **Kernels built for a kind of scene are cached too.** A stepping kernel is made by a factory for
+  one kind of scene (a closure over a few constants, see :mod:`collision_env.engine.modes`), so
+  that a scene never compiles the paths it cannot take. numba keys a closure's cache entry on its
+  cells' pickled values; a cell that holds another kernel would pickle differently in every
+  process, so here such a cell is keyed on the kernel's name and its own cells instead.
+* **It says what it compiles.** The first compilation in a process (a fresh install, or edited
+  sources) prints :data:`COMPILE_NOTICE` on stderr; a kernel given a ``label`` (each mode's
+  stepping kernel for a kind of scene, each env kernel) then prints its label, the kernels it
+  compiles along with it as they come, and its time.
+
+Compile time: numba compiles every kernel once (then cached) and LLVM inlines the small ones where
+they are called. ``inline="always"`` (numba's inlining of its own IR into every call site) is kept
+for a few helpers that must be inlined (those that build arrays from a pack, or are called once in
+a kernel's hot loop): each copy is typed and lowered again, which costs compile time that grows
+faster than the number of call sites.
 
 :func:`prefetch` asks the processor for an array element's cache line ahead of its use (an LLVM
 intrinsic under numba, nothing in the Python path): the kernels use it where they know an address
@@ -41,8 +55,10 @@ from __future__ import annotations
 
 import hashlib
 import os
+import pickle
 import shutil
 import sys
+import time
 from pathlib import Path
 
 try:  # numba is an optional accelerator, not a requirement of the core install
@@ -118,15 +134,31 @@ def remove_stale_caches(root: Path, keep: Path) -> None:
 
 
 class _CompileNotice:
-    """Prints :data:`COMPILE_NOTICE` on stderr the first time a kernel misses the cache."""
+    """What the compiler is doing, on stderr: :data:`COMPILE_NOTICE` once, at the first kernel that
+    misses the cache; then, for each labelled kernel compiled, its label, the names of the kernels
+    compiled with it as they come, and its time."""
 
     shown = False
+    labels: list = []  # (label, start time) of the labelled kernels being compiled, innermost last
 
     @classmethod
-    def show(cls) -> None:
+    def miss(cls, name: str, label: str | None) -> None:
+        """Kernel ``name`` (with ``label``, or None) is compiled now."""
         if not cls.shown:
             cls.shown = True
             print(COMPILE_NOTICE, file=sys.stderr, flush=True)
+        if label is not None:
+            print(f"collision_env: compiling {label}:", end="", file=sys.stderr, flush=True)
+            cls.labels.append((label, time.perf_counter()))
+        elif cls.labels:
+            print(f" {name}", end="", file=sys.stderr, flush=True)
+
+    @classmethod
+    def done(cls, label: str) -> None:
+        """The labelled kernel whose compilation :meth:`miss` announced is compiled."""
+        if cls.labels and cls.labels[-1][0] == label:
+            start = cls.labels.pop()[1]
+            print(f" ... {time.perf_counter() - start:.1f} s", file=sys.stderr, flush=True)
 
 
 if HAVE_NUMBA:
@@ -171,25 +203,66 @@ if HAVE_NUMBA:
     class _SourceHashCacheImpl(CompileResultCacheImpl):
         _locator_classes = [_SourceHashLocator]
 
+    def _plain(t):
+        """The type a kernel called from another is compiled for: literals as their plain type, and
+        every integer as int64 (an index read from an int32 array and one counted in a loop then
+        share one compiled version)."""
+        t = _types.unliteral(t)
+        return _types.int64 if isinstance(t, _types.Integer) else t
+
+    def _closure_key(func) -> bytes:
+        """What identifies a closure's constants across processes: each cell's pickled value, or for
+        a cell holding a kernel, that kernel's name and the key of its own cells (its code is
+        covered by :data:`SOURCE_HASH`)."""
+        parts = []
+        for cell in func.__closure__ or ():
+            value = cell.cell_contents
+            if isinstance(value, CPUDispatcher):
+                inner = value.py_func
+                parts.append((inner.__module__, inner.__qualname__, _closure_key(inner)))
+            else:
+                parts.append(pickle.dumps(value))
+        return pickle.dumps(parts)
+
     class _KernelCache(FunctionCache):
         _impl_class = _SourceHashCacheImpl
 
+        def __init__(self, py_func, label):
+            super().__init__(py_func)
+            self._label = label
+
         def load_overload(self, sig, target_context):
             loaded = super().load_overload(sig, target_context)
-            if loaded is None:
-                _CompileNotice.show()  # a miss: numba compiles this signature now
+            if loaded is None:  # a miss: numba compiles this signature now
+                _CompileNotice.miss(self._py_func.__name__, self._label)
             return loaded
+
+        def _index_key(self, sig, codegen):
+            key = super()._index_key(sig, codegen)
+            if self._py_func.__closure__ is None:
+                return key
+            code_hash, _ = key[2]
+            return key[0], key[1], (code_hash, hashlib.sha256(_closure_key(self._py_func)).hexdigest())
 
     class _KernelDispatcher(CPUDispatcher):
         """A CPU dispatcher compiled for plain (non-literal) argument types, cached by source hash."""
 
+        label = None  #: what :class:`_CompileNotice` calls it (None: named only inside a labelled one)
+
         def get_call_template(self, args, kws):
-            args = tuple(_types.unliteral(a) for a in args)
-            kws = {k: _types.unliteral(v) for k, v in kws.items()}
+            args = tuple(_plain(a) for a in args)
+            kws = {k: _plain(v) for k, v in kws.items()}
             return super().get_call_template(args, kws)
 
+        def compile(self, sig):
+            try:
+                return super().compile(sig)
+            finally:
+                if self.label is not None:
+                    _CompileNotice.done(self.label)
+
         def enable_caching(self):
-            self._cache = _KernelCache(self.py_func)
+            self._cache = _KernelCache(self.py_func, self.label)
 
 
 def _in_package(func) -> bool:
@@ -199,14 +272,22 @@ def _in_package(func) -> bool:
         return False
 
 
-def njit(func=None, *, refcount=True, **options):
+def compile_for(kernel, *example_args) -> None:
+    """Compile ``kernel`` now for the types of ``example_args`` (or load it from the cache), rather
+    than at its first call; without numba, nothing to do."""
+    if HAVE_NUMBA:
+        kernel.compile(tuple(_numba.typeof(a) for a in example_args))
+
+
+def njit(func=None, *, refcount=True, label=None, **options):
     """Compile ``func`` with numba in nopython mode (cached), or return it unchanged.
 
     Use bare (``@njit``) or with extra numba options (``@njit(inline="always")``);
-    ``refcount=False``: see the module docstring.
+    ``refcount=False`` and ``label`` (what the compile notice calls the kernel): see the module
+    docstring.
     """
     if func is None:
-        return lambda f: njit(f, refcount=refcount, **options)
+        return lambda f: njit(f, refcount=refcount, label=label, **options)
     if not HAVE_NUMBA:
         return func
     # set explicitly, so that a kernel called from a ``refcount=False`` one does not inherit it
@@ -218,6 +299,7 @@ def njit(func=None, *, refcount=True, **options):
         locals=options.pop("locals", {}),
         targetoptions={"nopython": True, "nogil": True, "boundscheck": None, **options},
     )
+    dispatcher.label = label
     dispatcher.enable_caching()
     return dispatcher
 

@@ -2,21 +2,21 @@
 
 A loop of ``step(dt)`` calls from Python pays, per frame, for the call into compiled code, the
 step's set-up and the Python around it: about a microsecond, as much as an event of a sparse gas.
-:func:`step_frames` runs the same steps (the same kernel, so the same impacts, state and clocks
-bit for bit) in a compiled loop and copies each frame's ball positions, velocities, clocks and
-impacts into the caller's arrays. It stops early at a frame that needs Python: one whose step
-reached the event cap or found the kernel's impact buffer full (which the simulator completes
-as it completes any step), or one whose impacts do not fit the caller's buffer.
+Every mode's stepping kernel is made by :func:`frames_kernel`, which runs either one step (the
+``start`` codes of :mod:`~collision_env.engine.state`) or, with ``RUN_FRAMES``, the same steps
+(so the same impacts, state and clocks, bit for bit) in a compiled loop that copies each frame's
+ball positions, velocities, clocks and impacts into the caller's arrays (``state.FramesOut``). It
+stops early at a frame that needs Python: one whose step reached the event cap or found the
+kernel's impact buffer full (which the simulator completes as it completes any step), or one
+whose impacts do not fit the caller's buffer. One kernel for both means a mode's step is compiled
+once, not again inside a loop of its own.
 """
 
 from __future__ import annotations
 
-from ._jit import HAVE_NUMBA, njit
-from .layout import B_VX, B_X
-
-#: The mode code of exact mode for :func:`step_frames` (the cheap modes use their own,
-#: ``substep.NAIVE`` and ``substep.POSTERIORI``, which are not negative).
-EXACT = -1
+from ._jit import njit
+from .layout import B_VX, B_X, FRAME_FIRST, FRAME_LAST, FRAME_ROWS, FRAME_STEPPED, FRAME_STOPPED_AT
+from .state import RUN_FRAMES, START_NEXT, START_STEP, unpack_frames, unpack_state
 
 
 @njit(refcount=False)
@@ -39,52 +39,64 @@ def copy_impacts(buf, out, sign):
 
 @njit(refcount=False)
 def record_frame(f, balls, time, times, positions, velocities):
-    """Frame ``f`` of the caller's arrays: every scene's clock, positions and velocities now."""
+    """Frame ``f`` of the caller's arrays: every scene's clock, positions and velocities now
+    (``positions`` and ``velocities`` are ``(F, B * N, 2)``: each frame's scenes one after another)."""
     n_scenes, n = balls.shape[0], balls.shape[1]
     for sc in range(n_scenes):
         times[f, sc] = time[sc]
         for i in range(n):
-            positions[f, sc, i, 0] = balls[sc, i, B_X]
-            positions[f, sc, i, 1] = balls[sc, i, B_X + 1]
-            velocities[f, sc, i, 0] = balls[sc, i, B_VX]
-            velocities[f, sc, i, 1] = balls[sc, i, B_VX + 1]
+            row = sc * n + i
+            positions[f, row, 0] = balls[sc, i, B_X]
+            positions[f, row, 1] = balls[sc, i, B_X + 1]
+            velocities[f, row, 0] = balls[sc, i, B_VX]
+            velocities[f, row, 1] = balls[sc, i, B_VX + 1]
 
 
-if HAVE_NUMBA:
-    import numpy as np
+@njit(refcount=False)
+def _take_frame(f, rows, state, out):
+    """After frame ``f``'s step, which returned ``rows``: record the frame and its impacts (True),
+    or note where the run stops (False): a step the caller must complete (``rows < 0``), or
+    impacts that do not fit ``out``."""
+    request = out.request
+    n_out = request[FRAME_ROWS]
+    if rows < 0 or n_out + rows > out.out.shape[0]:
+        request[FRAME_STOPPED_AT] = f
+        request[FRAME_STEPPED] = rows >= 0
+        return False
+    copy_impacts(state.imp, out.out[n_out : n_out + rows], 1.0)
+    request[FRAME_ROWS] = n_out + rows
+    record_frame(f, state.balls, state.time, out.times, out.positions, out.velocities)
+    return True
 
-    from .argpack import view1, view3
-    from .exact.scheduler import START_NEXT, START_STEP, step_exact_packed
-    from .layout import IMPACT_DTYPE
-    from .stepped.substep import step_substeps_packed
 
-    @njit
-    def step_frames(mode, k_total, h, dt, first, n_frames, times, positions, velocities, out, n_out):
-        """Frames ``first`` to ``n_frames - 1``: a forward step of ``dt`` each by the kernel of
-        ``mode`` (:data:`EXACT`, or the cheap modes' code and ``k_total`` sub-steps) on the pack
-        ``h``, recording each into row ``f`` of ``times`` (F, B), ``positions`` and
-        ``velocities`` (F, B, N, 2), and its impacts into ``out`` from row ``n_out`` on.
+def frames_kernel(step, label: str, frames_slot: int):
+    """A mode's stepping kernel, ``kernel(h, dt, start)``, from its step (an inlined function of
+    the same arguments, see :mod:`~collision_env.engine.state` for ``start``): one step, whose
+    return value it returns, or with ``start = RUN_FRAMES`` forward steps of ``dt`` for the frames
+    requested in the ``state.FramesOut`` at ``frames_slot`` of the pack (``layout.FRAME_FIELDS``:
+    from ``first`` up to ``last``; its ``stopped_at`` and ``stepped`` say where the run stopped,
+    ``stopped_at = last`` when every frame was recorded). ``label``: what the compile notice calls it."""
 
-        Returns ``(f, stepped, n_out)``: ``f == n_frames`` when every frame was recorded; else
-        frame ``f`` is not, and ``stepped`` says whether its step ended (its impacts did not fit
-        ``out`` and are still in the kernel's buffer) or needs the caller to complete it (the
-        kernel returned -1: the event cap, or a full kernel buffer).
-        """
-        balls = view3(h, 0, np.float64)
-        time = view1(h, 2, np.float64)
-        imp = view1(h, 6, IMPACT_DTYPE)
-        start = START_STEP  # (the caller may have changed the balls since the last step)
-        for f in range(first, n_frames):
-            if mode == EXACT:
-                rows = step_exact_packed(h, dt, start)
-            else:
-                rows = step_substeps_packed(mode, k_total, h, dt, start)
-            start = START_NEXT
-            if rows < 0:
-                return f, False, n_out
-            if n_out + rows > out.shape[0]:
-                return f, True, n_out
-            copy_impacts(imp, out[n_out : n_out + rows], 1.0)
-            n_out += rows
-            record_frame(f, balls, time, times, positions, velocities)
-        return n_frames, True, n_out
+    @njit(label=label)
+    def kernel(h, dt, start):
+        frames = start == RUN_FRAMES
+        first, last = 0, 1
+        if frames:
+            request = unpack_frames(h, frames_slot).request
+            first, last = request[FRAME_FIRST], request[FRAME_LAST]
+        state = unpack_state(h)
+        go = START_STEP if frames else start  # (the caller may have changed the balls since the last step)
+        for f in range(first, last):
+            rows = step(h, dt, go)
+            if not frames:
+                return rows
+            go = START_NEXT
+            if not _take_frame(f, rows, state, unpack_frames(h, frames_slot)):
+                return 0
+        if frames:
+            request = unpack_frames(h, frames_slot).request
+            request[FRAME_STOPPED_AT] = last
+            request[FRAME_STEPPED] = True
+        return 0
+
+    return kernel

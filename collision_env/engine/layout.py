@@ -8,10 +8,10 @@ tuple and its constants agree.
 
 Per ball, ``(B, N, len(fields))``:
 
-- :data:`BALL` (float64): the physical state, see :mod:`collision_env.engine.motion`.
+- :data:`BALL` (float64): the physical state, see :mod:`collision_env.engine.physics.motion`.
 - :data:`CAL_RECORD` (a structured dtype, ``(B, N)``) and :data:`CAL_I` (int32): exact mode's
-  persistent event calendar and cell grid, see :mod:`collision_env.engine.calendar` and
-  :mod:`collision_env.engine.grid`; :data:`HEAP` (float64): the heap of the calendar's event
+  persistent event calendar and cell grid, see :mod:`collision_env.engine.exact.calendar` and
+  :mod:`collision_env.engine.exact.grid`; :data:`HEAP` (float64): the heap of the calendar's event
   queue (its time buckets are an int32 array of list heads, ``(B, buckets + 1)``).
 
 Per scene:
@@ -77,9 +77,9 @@ SCENE_F = ("xmin", "ymin", "xmax", "ymax", "elasticity", "collapse_ratio", "sign
 S_XMIN, S_YMIN, S_XMAX, S_YMAX, S_ELASTICITY, S_COLLAPSE_RATIO, S_SIGN, S_COLLAPSE_FLOOR = range(8)
 
 #: Scene ints: a border exists; ball pairs are modelled; the dimension (1 or 2); stick clusters
-#: are formed; the cap on events per step.
-SCENE_I = ("has_walls", "pairs", "dim", "sticky", "max_events")
-S_HAS_WALLS, S_PAIRS, S_DIM, S_STICKY, S_MAX_EVENTS = range(5)
+#: are formed; the cap on events per step (exact mode); sub-steps per step (the cheap modes).
+SCENE_I = ("has_walls", "pairs", "dim", "sticky", "max_events", "substeps")
+S_HAS_WALLS, S_PAIRS, S_DIM, S_STICKY, S_MAX_EVENTS, S_SUBSTEPS = range(6)
 
 #: Per-scene work floats: the length of the current step, and the time left of it once it ends
 #: (more than 0 only at the event cap); how far into the step a scene that found the impact buffer
@@ -125,6 +125,18 @@ IMPACT_DTYPE = np.dtype(
     ]
 )
 
+#: Work counters (``BatchSimulator.stats``), int64: pair predictions (or overlap tests), wall
+#: predictions, events, rotating-cluster predictions, grid-cell crossings, stale calendar entries
+#: re-predicted.
+COUNTERS = ("pair_tests", "wall_tests", "events", "cluster_tests", "cell_crossings", "stale_events")
+PAIR_TESTS, WALL_TESTS, EVENTS, CLUSTER_TESTS, CELL_CROSSINGS, STALE_EVENTS = range(6)
+
+#: A frames run's request and result (int64): the frames to record (``first`` up to ``last``), the
+#: impact rows written so far, and, when the run returns, the frame it stopped at and whether that
+#: frame's step was taken (its impacts did not fit) or needs the caller to complete it.
+FRAME_FIELDS = ("first", "last", "rows", "stopped_at", "stepped")
+FRAME_FIRST, FRAME_LAST, FRAME_ROWS, FRAME_STOPPED_AT, FRAME_STEPPED = range(5)
+
 #: Every packed layout indexed by column constants, by name (for documentation and the layout test);
 #: the calendar record, :data:`CAL_RECORD`, names its fields in its dtype.
 LAYOUTS = {
@@ -135,4 +147,6 @@ LAYOUTS = {
     "SCENE_I": SCENE_I,
     "WORK_F": WORK_F,
     "WORK_I": WORK_I,
+    "COUNTERS": COUNTERS,
+    "FRAME_FIELDS": FRAME_FIELDS,
 }

@@ -13,6 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .physics.walls import WALL_BOTTOM, WALL_LEFT, WALL_NAMES, WALL_RIGHT, WALL_TOP
+
 #: PhET Collision Lab's 2D play area, (xmin, ymin, xmax, ymax) in metres.
 PLAY_AREA_2D = (-2.0, -1.0, 2.0, 1.0)
 #: PhET's 1D play area: 4 m by 1.1 m; balls stay on y = 0.
@@ -22,9 +24,19 @@ BALL_DENSITY = 35.0
 #: PhET's radius with "Constant Size" checked (m).
 CONSTANT_RADIUS = 0.15
 
-WALL_NAMES = ("left", "right", "bottom", "top")
-#: Wall codes: indices into ``WALL_NAMES``, as impact records and the kernels store them.
-WALL_LEFT, WALL_RIGHT, WALL_BOTTOM, WALL_TOP = 0, 1, 2, 3
+__all__ = [
+    "BALL_DENSITY",
+    "CONSTANT_RADIUS",
+    "PLAY_AREA_1D",
+    "PLAY_AREA_2D",
+    "WALL_BOTTOM",
+    "WALL_LEFT",
+    "WALL_NAMES",
+    "WALL_RIGHT",
+    "WALL_TOP",
+    "Scene",
+    "radius_from_mass",
+]
 
 
 def _is_real(x):

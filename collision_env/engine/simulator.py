@@ -1,8 +1,10 @@
 """The public engine: :class:`BatchSimulator` steps many independent scenes at once; a
 :class:`Simulator` is a batch of one with per-ball conveniences.
 
-Both call the same kernels (``exact.step_exact`` and ``substep.step_substeps``), so there is one
-copy of the physics for the single env and the vector env alike.
+Both call the same compiled kernels (one per mode and kind of scene, see
+:mod:`~collision_env.engine.modes`), so there is one copy of the physics for the single env and the
+vector env alike. Input is checked by :mod:`~collision_env.engine.validation` before anything
+changes.
 """
 
 from __future__ import annotations
@@ -16,18 +18,10 @@ from typing import Any, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._jit import BACKEND, HAVE_NUMBA
-from .argpack import pack
-from .exact import grid
-from .exact.calendar import bucket_count, heap_rows
-from .exact.scheduler import COUNTERS, RESUME, START_STEP, impacts_per_event, scratch_sizes, step_exact
-from .frames import EXACT, copy_impacts, record_frame
-
-if HAVE_NUMBA:
-    from .exact.scheduler import step_exact_packed
-    from .frames import step_frames
-    from .stepped.substep import step_substeps_packed
-from .exact.grid import GRID_MIN_BALLS, first_overlap, grid_geometry
+from ._jit import BACKEND, compile_for
+from .argpack import pack_arrays
+from .broadphase import GRID_MIN_BALLS, grid_geometry
+from .frames import copy_impacts, record_frame
 from .layout import (
     B_INV_MASS,
     B_MASS,
@@ -35,9 +29,14 @@ from .layout import (
     B_RADIUS,
     B_VX,
     B_X,
-    CAL_I,
-    CAL_RECORD,
-    HEAP,
+    BALL,
+    COUNTERS,
+    FRAME_FIELDS,
+    FRAME_FIRST,
+    FRAME_LAST,
+    FRAME_ROWS,
+    FRAME_STEPPED,
+    FRAME_STOPPED_AT,
     IMPACT_DTYPE,
     S_ELASTICITY,
     S_PAIRS,
@@ -50,35 +49,36 @@ from .layout import (
     WORK_F,
     WORK_I,
 )
-from .physics.motion import BALL_FIELDS, apply_impulses
-from .physics.tolerance import CONTACT_RTOL, EPS, roundoff
-from .scene import CONSTANT_RADIUS, WALL_NAMES, Scene, radius_from_mass
-from .stepped.substep import NAIVE, POSTERIORI, step_substeps, worst_case_impacts
-from .stepped.substep import scratch_size as substep_scratch_size
+from .modes import MODES as MODE_REGISTRY
+from .physics.motion import apply_impulses
+from .physics.walls import WALL_NAMES
+from .scene import Scene
+from .state import RESUME, RUN_FRAMES, START_STEP, FramesOut, State, aligned_copy, aligned_zeros, pack, with_frames
+from .validation import (
+    MAX_MAGNITUDE,
+    Labels,
+    check_reach,
+    check_seconds,
+    checked_balls,
+    checked_nudge,
+    is_real,
+    positive_integer,
+    real_number,
+)
 
-MODES = ("naive", "posteriori", "exact")
+#: The engine's mode names, cheapest first.
+MODES = tuple(MODE_REGISTRY)
 
 #: What a step without impacts returns: one shared array of no rows (read-only, as nothing can be
 #: written to it; a fresh empty structured array costs more than a small scene's step).
 _NO_IMPACTS = np.empty(0, dtype=IMPACT_DTYPE)
 _NO_IMPACTS.flags.writeable = False
 
-#: Relative tolerance for "touching" in the start-state checks (exact contact is allowed).
-_CONTACT_RTOL = 1e-12
-#: Largest position (m), speed (m/s) and |dt| (s) accepted: squares and sums of these stay finite in
-#: float64 (the time-of-impact kernels square separations and relative velocities).
-_MAX_MAGNITUDE = 1e150
-#: A radius must span this many units in the last place of the scene's coordinates: contact is then
-#: resolved to better than 1e-4 of the radius (``tolerance.contact_tolerance``) anywhere in the scene.
-_MIN_RADIUS_ULPS = 2.0**16
-#: The largest finite float64.
-_FLOAT_MAX = np.finfo(np.float64).max
-
 
 class LiveArrays(NamedTuple):
     """The engine's own state arrays (not copies): see :meth:`BatchSimulator.live_arrays`."""
 
-    balls: np.ndarray  #: (B, N, 8) per-ball state, laid out as ``motion.BALL_FIELDS``
+    balls: np.ndarray  #: (B, N, 8) per-ball state, laid out as ``layout.BALL``
     positions: np.ndarray  #: (B, N, 2) view of ``balls``
     velocities: np.ndarray  #: (B, N, 2) view of ``balls``
     masses: np.ndarray  #: (B, N) view of ``balls``
@@ -139,71 +139,6 @@ def _output_arrays(out, shapes):
     return arrays
 
 
-def _aligned_zeros(shape, dtype, align=64):
-    """Zeros whose rows start on ``align``-byte boundaries: a 64-byte calendar record or ball state
-    row is then one cache line (numpy itself aligns to 16 bytes)."""
-    dtype = np.dtype(dtype)
-    size = int(np.prod(shape)) * dtype.itemsize
-    buffer = np.zeros(size + align, dtype=np.uint8)
-    start = -buffer.ctypes.data % align
-    return buffer[start : start + size].view(dtype).reshape(shape)
-
-
-def _aligned_copy(array, align=64):
-    out = _aligned_zeros(array.shape, array.dtype, align)
-    out[...] = array
-    return out
-
-
-def _is_real(x):
-    """A real number that is not a boolean (Python or numpy scalar types alike)."""
-    return isinstance(x, numbers.Real) and not isinstance(x, (bool, np.bool_))
-
-
-def _real_number(value, field):
-    """``value`` as a float: a real number (numpy scalar types included), not a boolean or a string."""
-    if isinstance(value, float):  # the common case (np.float64 too), at the cost of one test
-        return value
-    if isinstance(value, np.ndarray) and value.ndim == 0:
-        value = value[()]
-    if not _is_real(value):
-        raise ValueError(
-            f"{field}: expected a number (real, not a boolean or a string), got {value!r} ({type(value).__name__})"
-        )
-    return float(value)
-
-
-def _check_seconds(value, field):
-    """A time or a step (s), already a float: finite and at most ``_MAX_MAGNITUDE``."""
-    if not abs(value) <= _MAX_MAGNITUDE:
-        raise ValueError(f"{field}: must be finite and at most {_MAX_MAGNITUDE:g} s, got {value}")
-
-
-def _real_array(value, shapes, field, where):
-    """A float64 copy of ``value``: real numbers (no booleans, strings or complex numbers) in one of
-    ``shapes``. ``where(index)`` names the ball of an element (for the error message)."""
-    if isinstance(value, np.ndarray) and value.dtype.kind in "iuf":
-        arr = value.astype(np.float64)
-    else:
-        try:
-            obj = np.array(value, dtype=object)
-        except ValueError:
-            raise ValueError(
-                f"{field}: expected real numbers of shape {' or '.join(map(str, shapes))}, got a ragged sequence"
-            ) from None
-        if obj.shape in shapes:
-            for index, x in np.ndenumerate(obj):
-                if not _is_real(x):
-                    raise ValueError(
-                        f"{where(index)}{field} must be real numbers (not booleans, strings or complex), "
-                        f"got {x!r} ({type(x).__name__})"
-                    )
-        arr = obj.astype(np.float64) if obj.shape in shapes else obj
-    if arr.shape not in shapes:
-        raise ValueError(f"{field}: expected shape {' or '.join(map(str, shapes))}, got {arr.shape}")
-    return arr
-
-
 class BatchSimulator:
     """Step ``B`` independent scenes of ``N`` balls each, sharing one :class:`Scene`.
 
@@ -220,7 +155,8 @@ class BatchSimulator:
         (0.15 m), or explicit radii, ``(B, N)`` or ``(N,)``.
     mode:
         ``"exact"`` (event-driven, machine precision at any dt), ``"posteriori"`` (PhET Collision
-        Lab's first engine's overlap-time reconstruction) or ``"naive"`` (move, then reflect overlaps).
+        Lab's first engine's overlap-time reconstruction) or ``"naive"`` (move, then reflect overlaps);
+        see :data:`~collision_env.engine.modes.MODES`.
     substeps:
         Equal sub-steps per step for naive and posteriori (their speed/accuracy knob). Exact mode
         is exact at any step, so it takes only 1.
@@ -232,7 +168,7 @@ class BatchSimulator:
         The inelastic-collapse regulariser: a collision whose normal closing speed is at most
         ``u_min = max(collapse_ratio * s, collapse_floor)`` leaves the pair separating at ``u_min``,
         ``s`` being the fastest speed among the balls of the impact (exact mode; the cheap modes use
-        the scene's slowest moving ball), see :mod:`collision_env.engine.response`. The default
+        the scene's slowest moving ball), see :mod:`collision_env.engine.physics.response`. The default
         floor, 0, keeps energy from growing beyond round-off at e < 1.
 
     Inputs are real numbers (numpy scalar types included; booleans, strings and complex numbers
@@ -258,22 +194,22 @@ class BatchSimulator:
     ) -> None:
         if not isinstance(scene, Scene):
             raise ValueError(f"scene: expected a collision_env.engine.Scene, got {type(scene).__name__}")
-        if not (isinstance(mode, str) and mode in MODES):
+        if not (isinstance(mode, str) and mode in MODE_REGISTRY):
             raise ValueError(f"mode: must be one of {MODES}, got {mode!r}")
-        if isinstance(substeps, (bool, np.bool_)) or not isinstance(substeps, numbers.Integral) or substeps < 1:
-            raise ValueError(f"substeps: must be a positive integer, got {substeps!r}")
-        if mode == "exact" and substeps != 1:
-            raise ValueError("substeps: exact mode resolves every event at its exact time; substeps must be 1")
-        if isinstance(max_events, (bool, np.bool_)) or not isinstance(max_events, numbers.Integral) or max_events < 1:
-            raise ValueError(f"max_events: must be a positive integer, got {max_events!r}")
-        if not (_is_real(collapse_ratio) and 0.0 <= float(collapse_ratio) < 1.0):
+        spec = MODE_REGISTRY[mode]
+        substeps = positive_integer(substeps, "substeps")
+        if not spec.substeps and substeps != 1:
+            raise ValueError(f"substeps: {mode} mode resolves every event at its exact time; substeps must be 1")
+        max_events = positive_integer(max_events, "max_events")
+        if not (is_real(collapse_ratio) and 0.0 <= float(collapse_ratio) < 1.0):
             raise ValueError(f"collapse_ratio: must be a number in [0, 1), got {collapse_ratio!r}")
-        if not (_is_real(collapse_floor) and 0.0 <= float(collapse_floor) < _MAX_MAGNITUDE):
+        if not (is_real(collapse_floor) and 0.0 <= float(collapse_floor) < MAX_MAGNITUDE):
             raise ValueError(f"collapse_floor: must be a finite speed >= 0 (m/s), got {collapse_floor!r}")
         self.scene = scene
         self._mode = mode
-        self._substeps = int(substeps)
-        self._max_events = int(max_events)
+        self._spec = spec
+        self._substeps = substeps
+        self._max_events = max_events
         self._collapse_ratio = float(collapse_ratio)
         self._collapse_floor = float(collapse_floor)
 
@@ -289,10 +225,13 @@ class BatchSimulator:
             raise ValueError(f"positions: need at least one scene and one ball, got shape {shape}")
         self._n_scenes = n_scenes
         self._n = n
-        pos, vel, mass, radius = self._checked_balls(np.arange(n_scenes), positions, velocities, masses, radii)
+        self._label = Labels(n_scenes)
+        pos, vel, mass, radius = checked_balls(
+            scene, self._label, np.arange(n_scenes), n, positions, velocities, masses, radii
+        )
         # Every per-ball float lives in one (B, N, 8) array, _pos, _vel, ... are views into it: each
         # array handed to a kernel costs ~0.1 us per call, which is most of a small scene's step.
-        self._balls = _aligned_zeros((n_scenes, n, BALL_FIELDS), np.float64)
+        self._balls = aligned_zeros((n_scenes, n, len(BALL)), np.float64)
         self._bind_views()
         self._pos[...] = pos
         self._vel[...] = vel
@@ -319,125 +258,18 @@ class BatchSimulator:
             dim=scene.dimension,
             sticky=scene.sticky,
             max_events=self.max_events,
+            substeps=self.substeps,
         )
         self._fparams = np.array([scene_f[name] for name in SCENE_F])
         self._iparams = np.array([scene_i[name] for name in SCENE_I], dtype=np.int64)
         self._work_f = np.zeros((n_scenes, len(WORK_F)))
         self._work_i = np.zeros((n_scenes, len(WORK_I)), dtype=np.int64)
-        # exact mode's event calendar and grid, kept from step to step (a few cells per ball at most)
-        self._cal = _aligned_zeros((n_scenes, n), CAL_RECORD)
-        self._cal_i = np.zeros((n_scenes, n, len(CAL_I)), dtype=np.int32)
-        self._cal_heads = np.zeros((n_scenes, grid.EXACT_CELLS_PER_BALL * n), dtype=np.int32)
-        self._cal_heap = _aligned_zeros((n_scenes, heap_rows(n), len(HEAP)), np.float64)
-        self._cal_buckets = np.full((n_scenes, bucket_count(n) + 1), -1, dtype=np.int32)
-        self._cal_inv_mass = np.zeros((n_scenes, n))
+        # the mode's own arrays (exact mode's event calendar and grid, kept from step to step, and work
+        # space), and its kernel for this kind of scene
+        self._mode_arrays = spec.arrays(n_scenes, n)
+        self._kernel = spec.kernel(scene, n)
         self._invalidate(np.arange(n_scenes))
         self._alloc_work()
-
-    # ------------------------------------------------------------------ validation
-    def _label(self, sc, ball=None):
-        where = f"scene {sc}, " if self._n_scenes > 1 else ""
-        return f"{where}ball {ball}: " if ball is not None else (f"scene {sc}: " if self._n_scenes > 1 else "")
-
-    def _checked_balls(self, scenes, positions, velocities, masses, radii):
-        """Validate and return float64 copies of the balls of ``scenes`` (raises ValueError)."""
-        k, n = len(scenes), self._n
-
-        def where(index):
-            return self._label(scenes[index[0]], index[1]) if len(index) > 1 else self._label(scenes[0], index[0])
-
-        pos = _real_array(positions, [(k, n, 2)], "positions", where)
-        vel = _real_array(velocities, [(k, n, 2)], "velocities", where)
-        if masses is None:
-            raise ValueError(f"masses: expected shape ({n},) or ({k}, {n}), got None")
-        m = np.broadcast_to(_real_array(masses, [(n,), (k, n)], "masses", where), (k, n)).copy()
-        if radii is None:
-            r = radius_from_mass(m)
-        elif isinstance(radii, str):
-            if radii != "constant":
-                raise ValueError(f"radii: expected None, 'constant' or an array, got {radii!r}")
-            r = np.full((k, n), CONSTANT_RADIUS)
-        else:
-            r = np.broadcast_to(_real_array(radii, [(n,), (k, n)], "radii", where), (k, n)).copy()
-
-        def fail(mask, message):
-            bad = np.argwhere(mask)
-            if len(bad):
-                s, i = bad[0][0], bad[0][1]
-                raise ValueError(self._label(scenes[s], i) + message(s, i))
-
-        big = _MAX_MAGNITUDE
-        with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
-            speed = np.hypot(vel[..., 0], vel[..., 1])
-            fail(
-                ~(np.abs(pos) <= big).all(-1),
-                lambda s, i: f"position must be finite, within {big:g} m, got {tuple(pos[s, i])}",
-            )
-            fail(
-                ~(np.abs(vel) <= big).all(-1) | ~(speed <= big),
-                lambda s, i: f"velocity must be finite, speed within {big:g} m/s, got {tuple(vel[s, i])}",
-            )
-            fail(
-                ~(np.isfinite(m) & (m > 0) & np.isfinite(1.0 / m)),
-                lambda s, i: f"mass must be positive and finite, with a finite inverse, got {m[s, i]}",
-            )
-            fail(
-                ~np.isfinite(0.5 * m * speed * speed),
-                lambda s, i: f"velocity {tuple(vel[s, i])} gives mass {m[s, i]} a kinetic energy beyond float64",
-            )
-        fail(
-            ~(np.isfinite(r) & (r > 0) & (r <= big)), lambda s, i: f"radius must be positive and finite, got {r[s, i]}"
-        )
-        scene = self.scene
-        # the coordinates' magnitude in each scene: the border, or the balls' own extent
-        extent = np.max(np.abs(pos) + r[..., None], axis=(1, 2))
-        if scene.bounds is not None:
-            extent = np.maximum(extent, max(abs(v) for v in scene.bounds))
-        smallest = _MIN_RADIUS_ULPS * EPS * extent
-        fail(
-            r < smallest[:, None],
-            lambda s, i: (
-                f"radius {r[s, i]:.6g} m is too small for float64 to resolve its "
-                f"contacts at coordinates of {extent[s]:.6g} m "
-                f"(at least {smallest[s]:.3g} m)"
-            ),
-        )
-        if scene.dimension == 1:
-            fail(pos[..., 1] != 0.0, lambda s, i: f"position y must be 0 in a 1D scene, got {pos[s, i, 1]}")
-            fail(vel[..., 1] != 0.0, lambda s, i: f"velocity y must be 0 in a 1D scene, got {vel[s, i, 1]}")
-        if scene.bounds is not None:
-            xmin, ymin, xmax, ymax = scene.bounds
-            # a ball needs room to move across the box: more than the contact tolerance of the walls
-            for lo, hi, name in ((xmin, xmax, "width"), (ymin, ymax, "height"))[: scene.dimension]:
-                room = (hi - lo) - 2.0 * r
-                fail(
-                    room <= CONTACT_RTOL * 2.0 * r + roundoff(extent[:, None]),
-                    lambda s, i, size=hi - lo, name=name: (
-                        f"radius {r[s, i]:.6g} m leaves no room to move: its "
-                        f"diameter is the box {name} {size:.6g} m or more"
-                    ),
-                )
-            tol = _CONTACT_RTOL * r + roundoff(np.abs(pos).max(-1))
-            out = (pos[..., 0] - r < xmin - tol) | (pos[..., 0] + r > xmax + tol)
-            if scene.dimension == 2:
-                out |= (pos[..., 1] - r < ymin - tol) | (pos[..., 1] + r > ymax + tol)
-            fail(
-                out,
-                lambda s, i: (
-                    f"position must keep the ball inside the reflecting border {scene.bounds}, "
-                    f"got {tuple(pos[s, i])} with radius {r[s, i]:.6g}"
-                ),
-            )
-        if scene.ball_collisions and n > 1:
-            for s_ in range(k):
-                i, j = first_overlap(pos[s_], r[s_], _CONTACT_RTOL)
-                if i >= 0:
-                    dist = float(np.hypot(*(pos[s_, i] - pos[s_, j])))
-                    raise ValueError(
-                        f"{self._label(scenes[s_], i)}position overlaps ball {j} "
-                        f"(centres {dist:.6g} m apart, radii sum to {r[s_, i] + r[s_, j]:.6g} m)"
-                    )
-        return pos, vel, m, r
 
     # ------------------------------------------------------------------ stepping
     def _bind_views(self):
@@ -452,12 +284,8 @@ class BatchSimulator:
     def _invalidate(self, scenes):
         """Drop the calendar's predictions for ``scenes`` (they are made afresh at the next step)
         and lay out their grid for the balls they now hold."""
-        if self.mode == "exact":
-            shape = dict(balls_per_cell=grid.EXACT_BALLS_PER_CELL, cells_per_ball=grid.EXACT_CELLS_PER_BALL)
-        else:
-            shape = dict(reach=2.0, balls_per_cell=0.0, cells_per_ball=grid.CHEAP_CELLS_PER_BALL)
         origin_and_cells, counts = grid_geometry(
-            self.scene.bounds, self._pos[scenes], self._radius[scenes], self._uses_grid(), **shape
+            self.scene.bounds, self._pos[scenes], self._radius[scenes], self._uses_grid(), **self._spec.grid
         )
         self._work_f[scenes, W_GRID_X0 : W_GRID_X0 + 4] = origin_and_cells
         self._work_i[scenes, W_GRID_NX : W_GRID_NX + 2] = counts
@@ -469,19 +297,15 @@ class BatchSimulator:
 
     def _alloc_work(self, rows=None):
         if rows is None:
-            if self.mode == "exact":
-                worst = impacts_per_event(self._n, self.scene.elasticity < 1.0)
-            else:  # with a grid, a sub-step's bound is counted from its cells; the buffer grows if needed
-                worst = 32 * self._n if self._uses_grid() else worst_case_impacts(self._n)
-            rows = max(4096, 2 * worst)
+            rows = self._spec.impact_rows(self.scene, self._n, self._uses_grid())
         self._imp = np.empty(rows, dtype=IMPACT_DTYPE)
         self._imp_bytes = memoryview(self._imp.view(np.uint8))
         counts = getattr(self, "_n_imp", None)  # (kept when the buffer grows in the middle of a step)
         self._n_imp = np.zeros(3, dtype=np.int64)  # rows filled, scenes that reached the cap, stalled
         if counts is not None:
             self._n_imp[:] = counts
-        # the mode's kernel and its arguments, bound once (the arrays are only ever updated in place)
-        state = (
+        # the kernel's arguments, packed once (the arrays are only ever updated in place)
+        self._state = State(
             self._balls,
             self._body,
             self._time,
@@ -495,23 +319,7 @@ class BatchSimulator:
             self._work_i,
             self._clock,
         )
-        if self.mode == "exact":
-            nf, ni, nb = scratch_sizes(self._n)
-            scratch = (np.empty(nf), np.empty(ni, dtype=np.int64), np.zeros(nb, dtype=np.bool_))
-            calendar = (self._cal, self._cal_i, self._cal_heads, self._cal_heap, self._cal_buckets, self._cal_inv_mass)
-            arrays = state + calendar + scratch
-            self._kernel, self._kernel_args = step_exact, arrays
-            if HAVE_NUMBA:  # one packed array per call instead of twenty (see argpack)
-                self._kernel, self._kernel_args = step_exact_packed, (pack(arrays),)
-                self._frames_args = (EXACT, 0) + self._kernel_args
-        else:
-            arrays = state + (np.empty(substep_scratch_size(self._n), dtype=np.int64),)
-            flavour = (NAIVE if self.mode == "naive" else POSTERIORI, self.substeps)
-            self._kernel, self._kernel_args = step_substeps, flavour + arrays
-            if HAVE_NUMBA:
-                self._kernel, self._kernel_args = step_substeps_packed, flavour + (pack(arrays),)
-                self._frames_args = self._kernel_args
-        self._kernel_arrays = arrays  # (what a pack refers to, kept alive with it)
+        self._pack = pack(self._state, *self._mode_arrays, frames=True)
         self._sign = float(self._fparams[S_SIGN])  # the direction _fparams are set for (see step)
         self._forward = self._sign > 0.0 and self.scene.bounds is not None  # step's fast path applies
         self._live = LiveArrays(
@@ -534,15 +342,15 @@ class BatchSimulator:
     def _step(self, dt, copy, stacklevel=4):
         """:meth:`step`; with ``copy`` False, exact mode's impacts may come as a view of the impact
         buffer, valid until the next step (for :meth:`Simulator.step`, which converts them at once)."""
-        dt = _real_number(dt, "dt")
-        if self._forward and 0.0 < dt <= _MAX_MAGNITUDE:  # the common case, checked in one test
-            rows = self._kernel(*self._kernel_args, dt, START_STEP)
+        dt = real_number(dt, "dt")
+        if self._forward and 0.0 < dt <= MAX_MAGNITUDE:  # the common case, checked in one test
+            rows = self._kernel(self._pack, dt, START_STEP)
             if rows >= 0:  # no scene stalled or reached the event cap
                 return self._take_impacts(rows, copy) if rows else _NO_IMPACTS
             return self._finish(self._run(dt, first_done=True), 1.0, stacklevel)
-        _check_seconds(dt, "dt")
+        check_seconds(dt, "dt")
         if self.scene.bounds is None:
-            self._check_reach(dt)
+            check_reach(self._pos, self._vel, dt, self._label)
         e = self.scene.elasticity
         if dt < 0.0 and e == 0.0:
             raise ValueError(
@@ -597,8 +405,8 @@ class BatchSimulator:
         """:meth:`frames`, with ``out`` checked against ``shapes_of(self, n)`` (the shapes the
         caller documents; its arrays are then viewed with the batch axis). Called straight from
         each public ``frames``, so that a warning names their caller."""
-        dt = _real_number(dt, "dt")
-        _check_seconds(dt, "dt")
+        dt = real_number(dt, "dt")
+        check_seconds(dt, "dt")
         if isinstance(n, (bool, np.bool_)) or not isinstance(n, numbers.Integral) or n < 0:
             raise ValueError(f"n: must be a whole number of steps (0 or more), got {n!r}")
         n = int(n)
@@ -611,16 +419,16 @@ class BatchSimulator:
         f = 0
         buffer = None  # the compiled loop's copy of the impacts
         while f < n:
-            if not (HAVE_NUMBA and self._forward and 0.0 < dt <= _MAX_MAGNITUDE):
-                # backwards, without a border, or without numba: a step as step takes it (which
-                # may make the next ones forward steps with a border)
+            if not (self._forward and 0.0 < dt <= MAX_MAGNITUDE):
+                # backwards or without a border: a step as step takes it (which may make the next
+                # ones forward steps with a border)
                 pieces.append(self._step(dt, True, stacklevel=5))
-                record_frame(f, self._balls, self._time, times, positions, velocities)
+                record_frame(f, self._balls, self._time, times, *self._frame_rows(positions, velocities))
                 f += 1
                 continue
             if buffer is None:
                 buffer = np.empty(len(self._imp), dtype=IMPACT_DTYPE)
-            f, stepped, rows = step_frames(*self._frames_args, dt, f, n, times, positions, velocities, buffer, 0)
+            f, stepped, rows = self._run_frames(dt, f, n, times, positions, velocities, buffer)
             if rows:
                 pieces.append(buffer[:rows].copy())
             if f == n:
@@ -632,10 +440,28 @@ class BatchSimulator:
                 buffer = np.empty(2 * len(buffer), dtype=IMPACT_DTYPE)
             else:
                 pieces.append(self._finish(self._run(dt, first_done=True), 1.0, stacklevel=4))
-            record_frame(f, self._balls, self._time, times, positions, velocities)
+            record_frame(f, self._balls, self._time, times, *self._frame_rows(positions, velocities))
             f += 1
         impacts = np.concatenate(pieces) if pieces else _NO_IMPACTS.copy()
         return Frames(times, positions, velocities, impacts)
+
+    @staticmethod
+    def _frame_rows(positions, velocities):
+        """(F, B, N, 2) frames as the kernels record them: (F, B * N, 2) views."""
+        f, b, n, _ = positions.shape
+        return positions.reshape(f, b * n, 2), velocities.reshape(f, b * n, 2)
+
+    def _run_frames(self, dt, first, n, times, positions, velocities, buffer):
+        """Frames ``first`` to ``n - 1`` in one call of the kernel (see ``frames.frames_kernel``),
+        the impacts into ``buffer``. Returns ``(f, stepped, rows)``: every frame was recorded if
+        ``f == n``; else frame ``f`` was not, and ``stepped`` says whether its step was taken (its
+        impacts did not fit ``buffer``) or needs completing; ``rows`` of ``buffer`` were written."""
+        request = np.zeros(len(FRAME_FIELDS), dtype=np.int64)
+        request[FRAME_FIRST] = first
+        request[FRAME_LAST] = n
+        out = FramesOut(request, times, *self._frame_rows(positions, velocities), buffer)
+        self._kernel(with_frames(self._pack, self._spec.frames_slot, out), dt, RUN_FRAMES)
+        return int(request[FRAME_STOPPED_AT]), bool(request[FRAME_STEPPED]), int(request[FRAME_ROWS])
 
     def _finish(self, chunks, sign, stacklevel):
         """Warn about scenes that reached the event cap; the step's impacts as one array.
@@ -655,24 +481,14 @@ class BatchSimulator:
         out = np.concatenate(chunks)  # a stalled step: a scene's impacts may span chunks
         return out[np.lexsort((sign * out["time"], out["scene"]))]
 
-    def _check_reach(self, dt):
-        """Without a border, a step of ``dt`` must keep every ball within the representable range."""
-        reach = np.abs(self._pos).max(-1) + np.hypot(self._vel[..., 0], self._vel[..., 1]) * abs(dt)
-        if not (reach <= _MAX_MAGNITUDE).all():
-            s, i = np.argwhere(~(reach <= _MAX_MAGNITUDE))[0]
-            raise ValueError(
-                f"dt: a step of {dt:g} s would take {self._label(s, i).rstrip(': ')} beyond "
-                f"{_MAX_MAGNITUDE:g} m (no border), where positions are no longer representable"
-            )
-
     def _run(self, dt_abs, first_done=False):
         """Run the mode's kernel until every scene has stepped ``dt_abs``; the impacts in chunks,
         one per call (a call stops the scenes that find the impact buffer full, which the next
         call resumes). ``first_done``: the step's first call was made already."""
         chunks = []
-        kernel, args, n_imp = self._kernel, self._kernel_args, self._n_imp
+        kernel, n_imp = self._kernel, self._n_imp
         if not first_done:
-            kernel(*args, dt_abs, START_STEP)
+            kernel(self._pack, dt_abs, START_STEP)
         while True:  # each call resets n_imp[0] and fills the impact buffer from row 0
             rows = n_imp[0]
             if rows:
@@ -681,14 +497,14 @@ class BatchSimulator:
                 return chunks
             if not rows:  # not even one sub-step's worst case fits: a bigger buffer
                 self._alloc_work(2 * len(self._imp))
-                kernel, args, n_imp = self._kernel, self._kernel_args, self._n_imp
-            kernel(*args, dt_abs, RESUME)
+                n_imp = self._n_imp
+            kernel(self._pack, dt_abs, RESUME)
 
     def _take_impacts(self, rows, copy=True):
         """A copy of the first ``rows`` impact records (a view of them if not ``copy``, in exact
         mode). Exact mode records each scene's impacts in the order they happen, scenes in order;
         the cheap modes' reconstructed times need sorting within each scene."""
-        if self.mode == "exact":
+        if self._spec.sorted_impacts:
             if not copy:
                 return self._imp[:rows]
             # (numpy copies structured arrays slowly: a byte copy is several times cheaper)
@@ -788,35 +604,8 @@ class BatchSimulator:
         the function this calls.)
         """
         if check:
-            dv = _real_array(dv, [(self._n_scenes, self._n, 2)], "nudge", lambda index: self._label(*index[:2]))
-            # one cheap test on the common path; find the culprit only when there is one
-            if not (np.abs(dv) <= _MAX_MAGNITUDE).all():
-                s, i = np.argwhere(~(np.abs(dv) <= _MAX_MAGNITUDE).all(-1))[0]
-                raise ValueError(
-                    f"{self._label(s, i)}nudge must be finite, within {_MAX_MAGNITUDE:g} m/s, got {tuple(dv[s, i])}"
-                )
-            if self.scene.dimension == 1 and dv[..., 1].any():
-                s, i = np.argwhere(dv[..., 1] != 0.0)[0]
-                raise ValueError(f"{self._label(s, i)}nudge y must be 0 in a 1D scene, got {dv[s, i, 1]}")
-            self._check_nudged_speeds(dv)
+            dv = checked_nudge(dv, self.scene, self._vel, self._mass, self._label)
         apply_impulses(self._balls, self._body, dv, self.scene.sticky)
-
-    def _check_nudged_speeds(self, dv: np.ndarray) -> None:
-        """The speeds a nudge can give stay representable (bounded through the clusters' spin by the
-        largest change of any of their members: a rigid impulse moves no point faster than that)."""
-        if self.scene.sticky:
-            most = np.abs(dv).max(axis=(1, 2), keepdims=True)[..., 0]
-            limit = np.abs(self._vel).max(-1) + np.broadcast_to(most, self._mass.shape) * self._n
-        else:
-            limit = np.abs(self._vel + dv).max(-1)
-        with np.errstate(over="ignore"):
-            bad = ~(limit <= _MAX_MAGNITUDE / 2) | ~np.isfinite(self._mass * limit * limit)
-        if bad.any():
-            s, i = np.argwhere(bad)[0]
-            raise ValueError(
-                f"{self._label(s, i)}nudge {tuple(dv[s, i])} would give a speed beyond the representable "
-                f"range (speeds up to {_MAX_MAGNITUDE:g} m/s, finite kinetic energy)"
-            )
 
     def set_scenes(
         self,
@@ -833,15 +622,15 @@ class BatchSimulator:
         ``radii`` default to those the scenes had. Validated like the constructor; on error
         nothing changes.
         """
-        time = _real_number(time, "time")
-        _check_seconds(time, "time")
+        time = real_number(time, "time")
+        check_seconds(time, "time")
         idx = np.arange(self._n_scenes)[index]
         idx = np.atleast_1d(idx)
         if masses is None:
             masses = self._mass[idx]
         if radii is None:
             radii = self._radius[idx]
-        pos, vel, m, r = self._checked_balls(idx, positions, velocities, masses, radii)
+        pos, vel, m, r = checked_balls(self.scene, self._label, idx, self._n, positions, velocities, masses, radii)
         self._pos[idx] = pos
         self._vel[idx] = vel
         self._mass[idx] = m
@@ -928,41 +717,36 @@ class BatchSimulator:
             np.copyto(getattr(self, name), getattr(other, name))
         for field in (S_ELASTICITY, S_SIGN):  # (the direction of time the state is kept for)
             self._fparams[field] = other._fparams[field]
-        if self.mode == "exact":
-            for name in ("_cal", "_cal_i", "_cal_heads", "_cal_heap", "_cal_buckets", "_cal_inv_mass"):
-                np.copyto(getattr(self, name), getattr(other, name))
+        if self._spec.persistent:
+            for mine, theirs in zip(self._mode_arrays[0], other._mode_arrays[0], strict=True):
+                np.copyto(mine, theirs)
         self._sign = other._sign
         self._forward = other._forward
 
+    #: What a copy or a pickle rebuilds rather than carries: work space, and what is bound to it.
+    _REBUILT = (
+        "_imp", "_imp_bytes", "_n_imp", "_kernel", "_state", "_pack", "_sign", "_forward", "_live", "_pos", "_vel",
+        "_mass", "_inv_mass", "_radius", "_omega", "_label", "_spec",
+    )  # fmt: skip
+
     def __getstate__(self):
-        state = self.__dict__.copy()
-        for key in (
-            "_imp",
-            "_imp_bytes",
-            "_n_imp",
-            "_kernel",
-            "_kernel_args",
-            "_kernel_arrays",
-            "_sign",
-            "_forward",
-            "_live",
-            "_pos",
-            "_vel",
-            "_mass",
-            "_inv_mass",
-            "_radius",
-            "_omega",
-        ):
-            state.pop(key)
-        state.pop("_frames_args", None)  # (made with the kernel's pack, with numba only)
+        state = {key: value for key, value in self.__dict__.items() if key not in self._REBUILT}
+        if self._spec.persistent:  # (exact mode's calendar persists; its work space is made anew)
+            state["_mode_arrays"] = self._mode_arrays[:1]
+        else:
+            state["_mode_arrays"] = ()
         return state
 
     def __setstate__(self, state):
         self.__dict__.update(state)
+        self._spec = MODE_REGISTRY[self._mode]
         # a copy or an unpickled array has numpy's alignment
-        self._balls = _aligned_copy(self._balls)
-        self._cal = _aligned_copy(self._cal)
-        self._cal_heap = _aligned_copy(self._cal_heap)
+        self._balls = aligned_copy(self._balls)
+        fresh = self._spec.arrays(self._n_scenes, self._n)
+        kept = tuple(type(b)(*(aligned_copy(a) for a in b)) for b in self._mode_arrays)
+        self._mode_arrays = kept + fresh[len(kept) :]
+        self._kernel = self._spec.kernel(self.scene, self._n)
+        self._label = Labels(self._n_scenes)
         self._bind_views()
         self._alloc_work()
 
@@ -1101,21 +885,15 @@ def _impact_list(rows: np.ndarray) -> list[Impact]:
 def warm_up() -> None:
     """Compile (or load from numba's on-disk cache) every engine kernel, so later steps are timed fairly.
 
-    Numba compiles a kernel at its first call, which can take tens of seconds on a cold cache; call
-    this before timing anything. One tiny scene per mode and flavour reaches every kernel (numba
-    compiles a kernel's whole call graph at once). Without numba it only runs those scenes.
+    Numba compiles a kernel at its first call; call this before timing anything. The stepping kernel
+    of every mode and kind of scene is compiled by its signature (none is run); one tiny scene then
+    reaches the kernels that Python calls itself (the start-state checks, nudges, frames). Without
+    numba it only runs that scene.
     """
-    pos, vel = [[-0.5, 0.0], [0.5, 0.0]], [[1.0, 0.0], [-1.0, 0.0]]
-    scenes = (
-        Scene(),
-        Scene(bounds=None),
-        Scene(dimension=1, bounds=(-2.0, -0.55, 2.0, 0.55)),
-        Scene(elasticity=0.0, inelastic="stick"),
-    )
-    for scene in scenes:
-        for mode, substeps in (("naive", 1), ("posteriori", 2), ("exact", 1)):
-            sim = Simulator(scene, pos, vel, [1.0, 2.0], mode=mode, substeps=substeps)
-            sim.nudge([[0.1, 0.0], [0.0, 0.0]])
-            for dt in (0.3, 0.3, 2.0):
-                sim.step(dt)
-            sim.frames(0.3, 2)
+    for spec in MODE_REGISTRY.values():
+        for kernel in spec.kernels():
+            compile_for(kernel, pack_arrays([np.zeros(1)]), 1.0, START_STEP)
+    sim = Simulator(Scene(), [[-0.5, 0.0], [0.5, 0.0]], [[1.0, 0.0], [-1.0, 0.0]], [1.0, 2.0])
+    sim.nudge([[0.1, 0.0], [0.0, 0.0]])
+    sim.frames(0.3, 2)
+    sim.step(-0.3)

@@ -487,7 +487,7 @@ def task_kernel(
     """Score a step's impacts, update target state, and write reward, flags and observation.
 
     ``imp`` is the engine's impact record array for the batch (sorted by scene then time);
-    ``balls`` (the per-ball state, ``engine.motion.BALL_FIELDS``), ``sim_time`` and ``clusters``
+    ``balls`` (the per-ball state, ``engine.layout.BALL``), ``sim_time`` and ``clusters``
     are the engine's state after the step. ``flags`` holds one ``ROW_*`` code per scene.
     In cluster mode ``body`` mirrors the engine's cluster roots through the step (see
     ``_score_impacts``); at the end it is set to the engine's ``clusters``.

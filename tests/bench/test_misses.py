@@ -65,9 +65,9 @@ def test_a_small_gas_misses_nothing_in_a_large_cache_and_its_records_in_a_tiny_o
         if kib == 2048:  # every array fits, and every line was fetched before the count
             assert row["misses_per_event"] == {} and row["sites"] == []
         else:
-            assert row["misses_per_event"]["cal_rec"] > 1.0
+            assert row["misses_per_event"]["rec"] > 1.0
             by_array = {}
             for site in row["sites"]:
                 by_array[site["array"]] = by_array.get(site["array"], 0.0) + site["per_event"]
             assert by_array == pytest.approx(row["misses_per_event"])
-            assert any(s["array"] == "cal_rec" and s["site"].startswith("exact._pair_gap:") for s in row["sites"])
+            assert any(s["array"] == "rec" and s["site"].startswith("trajectories.pair_gap:") for s in row["sites"])

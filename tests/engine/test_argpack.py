@@ -7,13 +7,14 @@ import pytest
 
 from collision_env.engine import Scene, Simulator
 from collision_env.engine._jit import HAVE_NUMBA
-from collision_env.engine.argpack import SLOT, pack
+from collision_env.engine.argpack import SLOT, pack_arrays
+from collision_env.engine.state import STATE_SLOT, State
 
 
 def test_a_pack_holds_each_array_address_and_shape():
     a = np.zeros((2, 3, 4))
     b = np.zeros(5, dtype=np.int32)
-    h = pack((a, b))
+    h = pack_arrays((a, b))
     assert h.dtype == np.int64 and len(h) == 2 * SLOT
     assert list(h[:SLOT]) == [a.ctypes.data, 2, 3, 4]
     assert list(h[SLOT:]) == [b.ctypes.data, 5, 0, 0]
@@ -24,7 +25,7 @@ def test_a_pack_holds_each_array_address_and_shape():
 )
 def test_only_c_contiguous_arrays_of_one_to_three_dimensions_are_packed(array):
     with pytest.raises(ValueError, match="array 0 must be a C-contiguous array"):
-        pack((array,))
+        pack_arrays((array,))
 
 
 @pytest.mark.skipif(not HAVE_NUMBA, reason="the packed call is numba's")
@@ -39,9 +40,10 @@ def test_a_pack_follows_its_arrays_when_the_impact_buffer_grows():
     reference = Simulator(Scene(), pos, sim.velocities, np.ones(n), np.full(n, 0.05), mode="naive")
     small = sim.batch
     small._alloc_work(64)  # far fewer rows than a step records
-    address = small._kernel_args[-1][6 * SLOT]  # (slot 6: the impact buffer)
+    slot = (STATE_SLOT + State._fields.index("imp")) * SLOT  # (the impact buffer's slot)
+    address = small._pack[slot]
     got, want = small.step(0.5), reference.batch.step(0.5)
-    assert small._kernel_args[-1][6 * SLOT] == small._imp.ctypes.data != address
+    assert small._pack[slot] == small._imp.ctypes.data != address
     assert len(got) == len(want) > 64
     np.testing.assert_array_equal(got, want)
     np.testing.assert_array_equal(sim.positions, reference.positions)

@@ -14,8 +14,9 @@ import pytest
 
 import collision_env.engine.simulator as simulator_module
 from collision_env.engine import BatchSimulator, Scene, Simulator
+from collision_env.engine.broadphase import GRID_MIN_BALLS
+from collision_env.engine.exact import calendar
 from collision_env.engine.exact.calendar import QUEUE_MIN_BALLS
-from collision_env.engine.exact.grid import GRID_MIN_BALLS
 from collision_env.engine.layout import W_QUEUE_FAR, W_QUEUE_HEAP, W_QUEUE_RING
 
 
@@ -109,16 +110,16 @@ def test_a_large_scene_queues_most_events_in_time_buckets():
     queue = sim.batch._work_i[0]
     assert queue[W_QUEUE_HEAP] + queue[W_QUEUE_RING] + queue[W_QUEUE_FAR] == LARGE
     assert queue[W_QUEUE_HEAP] < LARGE / 20 < queue[W_QUEUE_RING]
-    assert sim.batch._cal_buckets.shape == (1, LARGE // 2 + 1)
+    assert sim.batch._mode_arrays[0].buckets.shape == (1, LARGE // 2 + 1)
 
 
 def test_a_large_scene_steps_bit_for_bit_as_with_a_heap_of_every_ball(monkeypatch):
     """The time buckets change where events wait, never the order they come in."""
     scene, pos, vel, radii = gas(LARGE)
     sim = Simulator(scene, pos, vel, np.ones(LARGE), radii=radii)
-    monkeypatch.setattr(simulator_module, "bucket_count", lambda n: 0)
+    monkeypatch.setattr(calendar, "bucket_count", lambda n: 0)
     heap = Simulator(scene, pos, vel, np.ones(LARGE), radii=radii)
-    assert heap.batch._cal_buckets.shape == (1, 1) and sim.batch._cal_buckets.shape[1] > 1
+    assert heap.batch._mode_arrays[0].buckets.shape == (1, 1) and sim.batch._mode_arrays[0].buckets.shape[1] > 1
     dv = np.zeros((LARGE, 2))
     dv[:: LARGE // 7] = (0.4, -0.9)
     for frame in range(12):
@@ -210,7 +211,7 @@ def test_memory_and_construction_are_linear_in_the_balls():
     scene, pos, vel, radii = gas(n)
     sim = Simulator(scene, pos, vel, np.ones(n), radii=radii)
     arrays = [v for v in vars(sim.batch).values() if isinstance(v, np.ndarray)]
-    arrays += [a for a in sim.batch._kernel_arrays if isinstance(a, np.ndarray)]
+    arrays += [a for bundle in sim.batch._mode_arrays for a in bundle]  # (the calendar and work space)
     per_ball = sum({id(a): a.nbytes for a in arrays}.values()) / n
     assert per_ball < 2048
     assert GRID_MIN_BALLS < n

@@ -8,7 +8,6 @@ import warnings
 import numpy as np
 import pytest
 
-import collision_env.engine.simulator as simulator_module
 from collision_env.engine import BatchSimulator, EventCapWarning, Scene, Simulator
 from tests.engine.test_calendar import gas
 
@@ -17,18 +16,16 @@ FIELDS = ["scene", "time", "ball", "other", "wall", "x", "y", "speed"]
 
 @pytest.fixture
 def loop_exits(monkeypatch):
-    """Where each call of the compiled loop stopped: ``(frame, stepped)`` (see ``frames.step_frames``)."""
-    if not simulator_module.HAVE_NUMBA:
-        pytest.skip("the compiled loop is numba's")
+    """Where each call of the compiled loop stopped: ``(frame, stepped)`` (see ``frames.frames_kernel``)."""
     exits = []
-    compiled = simulator_module.step_frames
+    compiled = BatchSimulator._run_frames
 
-    def spy(*args):
-        result = compiled(*args)
+    def spy(self, *args):
+        result = compiled(self, *args)
         exits.append((result[0], result[1]))
         return result
 
-    monkeypatch.setattr(simulator_module, "step_frames", spy)
+    monkeypatch.setattr(BatchSimulator, "_run_frames", spy)
     return exits
 
 
@@ -55,8 +52,11 @@ def assert_frames_are_a_step_loop(sim, loop, dt, n):
     np.testing.assert_array_equal(sim.time, loop.time)
     np.testing.assert_array_equal(sim.cap_reached, loop.cap_reached)
     assert sim.stats == loop.stats
-    for name in ("_cal", "_cal_i", "_cal_heap", "_cal_buckets", "_body", "_clock"):  # the calendar and clusters too
+    for name in ("_body", "_clock"):  # the clusters and clocks too
         np.testing.assert_array_equal(getattr(sim, name), getattr(loop, name))
+    if sim._spec.persistent:  # and exact mode's calendar
+        for mine, theirs in zip(sim._mode_arrays[0], loop._mode_arrays[0], strict=True):
+            np.testing.assert_array_equal(mine, theirs)
     return rec
 
 

@@ -21,6 +21,8 @@ def test_each_field_has_the_constant_of_its_position(name):
         "SCENE_I": "S_",
         "WORK_F": "W_",
         "WORK_I": "W_",
+        "COUNTERS": "",
+        "FRAME_FIELDS": "FRAME_",
     }[name]
     assert len(set(fields)) == len(fields)
     for position, field in enumerate(fields):
@@ -34,9 +36,10 @@ def test_engine_arrays_are_as_wide_as_their_layouts():
     sim = Simulator(Scene(), [[0.0, 0.0], [1.0, 0.0]], [[1.0, 0.0], [0.0, 0.0]], [1.0, 1.0])
     b = sim.batch
     assert b._balls.shape[-1] == len(layout.BALL)
-    assert b._cal.dtype == layout.CAL_RECORD
-    assert b._cal_i.shape[-1] == len(layout.CAL_I)
-    assert b._cal_heap.shape[-1] == len(layout.HEAP)
+    calendar = b._mode_arrays[0]
+    assert calendar.rec.dtype == layout.CAL_RECORD
+    assert calendar.ci.shape[-1] == len(layout.CAL_I)
+    assert calendar.heap.shape[-1] == len(layout.HEAP)
     assert b._fparams.shape == (len(layout.SCENE_F),)
     assert b._iparams.shape == (len(layout.SCENE_I),)
     assert b._work_f.shape[-1] == len(layout.WORK_F)
@@ -53,5 +56,5 @@ def test_a_calendar_record_is_one_cache_line():
     sim = Simulator(
         Scene(), np.stack([np.linspace(-1.8, 1.8, n), np.zeros(n)], 1), np.zeros((n, 2)), np.ones(n), np.full(n, 0.01)
     )
-    for cal in (sim.batch._cal, sim.copy().batch._cal):
+    for cal in (sim.batch._mode_arrays[0].rec, sim.copy().batch._mode_arrays[0].rec):
         assert cal.ctypes.data % 64 == 0

@@ -1,7 +1,8 @@
 """Exact mode's event calendar: one pending event per ball, in a two-level event queue.
 
-This is the sorter of an event-driven simulation (the scheduler is ``exact.step_exact``, the
-neighbour search is :mod:`collision_env.engine.grid`). Following Lubachevsky (1991) and
+This is the sorter of an event-driven simulation (the scheduler is
+:mod:`~collision_env.engine.exact.scheduler`, the neighbour search
+:mod:`~collision_env.engine.exact.grid`). Following Lubachevsky (1991) and
 Smallenburg (2022, "Efficient event-driven simulations of hard spheres", EPJE 45:22), each ball
 holds only its earliest known event: a wall, a partner ball, or the crossing of a grid-cell
 boundary. The queue orders balls by event time, and simultaneous events as a scan of the balls in
@@ -23,6 +24,11 @@ when a step ends), so no large absolute time enters it.
 The per-ball fields live in one scene's calendar records ``rec`` (``layout.CAL_RECORD``: the event
 time and the change counter) and its int32 rows ``ci`` (``layout.CAL_I``: what the event is, the
 partner's count, where it is queued); the queue itself in an :class:`EventQueue`.
+
+A scene without buckets (fewer than :data:`QUEUE_MIN_BALLS` balls) keeps every ball in the heap;
+its scheduler calls the operations of :data:`HEAP_QUEUE`, which do what their two-level
+counterparts (:data:`BUCKET_QUEUE`) do on such a queue without the bucket code, so that a small
+scene never compiles it.
 """
 
 from __future__ import annotations
@@ -59,12 +65,12 @@ EV_CROSS = -5
 EV_NONE = -9
 
 
-@njit(inline="always")
+@njit
 def is_wall(code):
     return EV_CROSS < code <= EV_WALL
 
 
-@njit(inline="always")
+@njit
 def is_crossing(code):
     return EV_NONE < code <= EV_CROSS
 
@@ -73,7 +79,7 @@ def is_crossing(code):
 _LAST = 1 << 62
 
 
-@njit(inline="always")
+@njit
 def order_key(ball, code):
     """Where ``ball``'s event ``code`` stands among events at the same instant: ``(lead, rank)``.
 
@@ -90,7 +96,7 @@ def order_key(ball, code):
     return ball, _LAST if is_crossing(code) else _LAST + 1
 
 
-@njit(inline="always")
+@njit
 def earlier(t, code, t_other, code_other, ball):
     """For ``ball``: candidate event ``(t, code)`` comes strictly before ``(t_other, code_other)``."""
     if t != t_other:
@@ -100,7 +106,7 @@ def earlier(t, code, t_other, code_other, ball):
     return lead < lead_other or (lead == lead_other and rk < rk_other)
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def _before(ta, a, tb, b, ci):
     """Ball ``a``'s event at ``ta`` comes before ball ``b``'s at ``tb`` (ties: see
     :func:`order_key`, then the ball)."""
@@ -174,24 +180,24 @@ def heap_rows(n):
 
 # The heap lives in ``hp`` (``layout.HEAP``: the event time and the ball of each slot), so that
 # sifting reads neighbouring rows instead of chasing every ball's own row.
-@njit(inline="always")
+@njit(refcount=False)
 def _place(slot, ball, t, ci, hp):
     hp[slot + HEAP_OFFSET, H_TIME] = t
     hp[slot + HEAP_OFFSET, H_BALL] = ball
     ci[ball, C_QUEUE_SLOT] = slot
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def _ball_at(slot, hp):
     return np.int64(hp[slot + HEAP_OFFSET, H_BALL])
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def _time_at(slot, hp):
     return hp[slot + HEAP_OFFSET, H_TIME]
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def _sift_up(slot, rec, ci, hp):
     ball = _ball_at(slot, hp)
     t = rec[ball]["event_time"]
@@ -207,14 +213,14 @@ def _sift_up(slot, rec, ci, hp):
     return slot
 
 
-@njit(inline="always")
+@njit
 def _earlier_of(ca, ta, cb, tb):
     """Of two children ``(slot, time)``, the one whose time comes first (``a`` on a tie; ties are
     settled by :func:`_first_child`'s full order)."""
     return (cb, tb) if tb < ta else (ca, ta)
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def _first_child(first, n, ci, hp):
     """The child slot (of ``first`` ... ``first + ARITY - 1``) whose event comes first, and its time."""
     if first + ARITY <= n:
@@ -246,7 +252,7 @@ def _first_child(first, n, ci, hp):
     return child, t_child
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def _sift_down(slot, n, ci, hp):
     """Move the ball at ``slot`` down to its place in a heap of ``n`` (its time is the one held in
     the heap; a ball already in place is not written again, so ordering a heap that is in order
@@ -268,14 +274,14 @@ def _sift_down(slot, n, ci, hp):
         _place(slot, ball, t, ci, hp)
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def _heapify(n, ci, hp):
     """Order a heap of ``n`` from scratch (Floyd's O(n) construction), from the times it holds."""
     for slot in range((n - 2) // ARITY, -1, -1):
         _sift_down(slot, n, ci, hp)
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def _heap_push(ball, t, rec, ci, q):
     size = q.qi[W_QUEUE_HEAP]
     _place(size, ball, t, ci, q.hp)
@@ -283,7 +289,7 @@ def _heap_push(ball, t, rec, ci, q):
     _sift_up(size, rec, ci, q.hp)
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def _vacate(slot, size, ci, hp):
     """Take the event at ``slot`` out of a heap of ``size``: the last event fills its place, out of
     order until the caller sifts it or re-orders the heap. Returns the new size."""
@@ -293,18 +299,18 @@ def _vacate(slot, size, ci, hp):
     return size
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def _ring_size(q):
     return q.buckets.shape[0] - 1
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def _heap_size(rec, q):
     """Events in the heap: every ball's without buckets (read without touching the counts)."""
     return rec.shape[0] if _ring_size(q) == 0 else q.qi[W_QUEUE_HEAP]
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def _position(t, q):
     """Where an event at step time ``t`` is queued: -1 the heap, ``0 .. R - 1`` a bucket of the
     ring, ``R`` the far list (R = 0: no buckets, always the heap)."""
@@ -320,7 +326,7 @@ def _position(t, q):
     return ring  # (also an event that never comes, t = inf)
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def _link(ball, p, ci, q):
     """Put ``ball``'s event at the front of list ``p`` (a bucket, or the far list)."""
     head = q.buckets[p]
@@ -333,7 +339,7 @@ def _link(ball, p, ci, q):
     q.qi[W_QUEUE_FAR if p == _ring_size(q) else W_QUEUE_RING] += 1
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def _unlink(ball, ci, q):
     """Take ``ball``'s event out of its list."""
     p = -1 - ci[ball, C_QUEUE_SLOT]
@@ -348,7 +354,7 @@ def _unlink(ball, ci, q):
     q.qi[W_QUEUE_FAR if p == _ring_size(q) else W_QUEUE_RING] -= 1
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def _file(ball, p, rec, ci, q):
     """Queue ``ball``'s event (in no list yet) at position ``p`` (see :func:`_position`)."""
     if p < 0:
@@ -357,7 +363,13 @@ def _file(ball, p, rec, ci, q):
         _link(ball, p, ci, q)
 
 
-@njit(inline="always")
+@njit(refcount=False)
+def heap_schedule(ball, rec, ci, q):
+    """:func:`schedule` in a queue without buckets (a heap of every ball)."""
+    _sift_down(_sift_up(ci[ball, C_QUEUE_SLOT], rec, ci, q.hp), rec.shape[0], ci, q.hp)
+
+
+@njit(refcount=False)
 def schedule(ball, rec, ci, q):
     """Move ``ball``'s event to its place in the queue after its time changed (either way)."""
     t = rec[ball]["event_time"]
@@ -378,7 +390,7 @@ def schedule(ball, rec, ci, q):
     _sift_down(_sift_up(slot, rec, ci, q.hp), size, ci, q.hp)
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def _release_far(rec, ci, q):
     """Sort the far list's events that the ring now reaches into the ring (or the heap), and note
     the bucket at which to do so next (before any event left in the far list is due)."""
@@ -394,7 +406,7 @@ def _release_far(rec, ci, q):
         ball = nxt
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def _open_next_bucket(rec, ci, q):
     """Move the next bucket's events into the heap; when the ring is empty, start the buckets anew
     at the far list's first event instead of stepping through empty ones. Returns False if
@@ -440,14 +452,14 @@ def _open_next_bucket(rec, ci, q):
     return True
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def prefetch_int_row(ball, ci):
     """Ask for ``ball``'s int row (both ends: a row of seven int32 may straddle two cache lines)."""
     prefetch(ci, (ball, 0))
     prefetch(ci, (ball, ci.shape[1] - 1))
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def walk_next_bucket(cursor, rec, ci, q):
     """One step down the list of the bucket that opens next, asking for the rows of the ball it
     reaches. Opening a bucket chases its list, one dependent load per ball, each a miss at 10^5
@@ -466,6 +478,12 @@ def walk_next_bucket(cursor, rec, ci, q):
     return ball
 
 
+@njit
+def no_walk(cursor, rec, ci, q):
+    """:func:`walk_next_bucket` in a queue without buckets: there is no bucket to walk."""
+    return -1
+
+
 # Called where the heap ran empty, once per bucket (and never without buckets): a call of its own,
 # so that the event loop that inlines ``next_ball`` stays small.
 @njit(refcount=False)
@@ -477,7 +495,13 @@ def _refill_heap(rec, ci, q):
     return True
 
 
-@njit(inline="always")
+@njit(refcount=False)
+def heap_first(rec, ci, q):
+    """:func:`next_ball` in a queue without buckets (a heap of every ball)."""
+    return _ball_at(0, q.hp)
+
+
+@njit(refcount=False)
 def next_ball(rec, ci, q):
     """The ball whose event comes first (-1: none is queued but events that never come)."""
     if _heap_size(rec, q) == 0 and not _refill_heap(rec, ci, q):
@@ -485,7 +509,7 @@ def next_ball(rec, ci, q):
     return _ball_at(0, q.hp)
 
 
-@njit(inline="always")
+@njit
 def _width(total, finite):
     """A bucket width for ``finite`` events whose times lie ``total`` seconds ahead in all: about
     :data:`EVENTS_PER_BUCKET` events per bucket, if each ball's next event is as far ahead as their
@@ -494,7 +518,7 @@ def _width(total, finite):
     return width if 0.0 < width < INF else INF
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def bucket_width(n, now, rec):
     """A bucket width for a scene's events from step time ``now`` (inf, every finite time in the
     heap, when no finite event lies ahead)."""
@@ -508,7 +532,22 @@ def bucket_width(n, now, rec):
     return _width(total, finite)
 
 
-@njit(inline="always")
+@njit(refcount=False)
+def build_queue(n, now, rec, ci, q):
+    """Queue every ball's event afresh (their times are set), from step time ``now``, in buckets of
+    the width their times call for (:func:`bucket_width`)."""
+    reset_queue(n, now, bucket_width(n, now, rec), rec, ci, q)
+
+
+@njit(refcount=False)
+def heap_build(n, now, rec, ci, q):
+    """:func:`build_queue` in a queue without buckets: every ball's event in the heap."""
+    for i in range(n):
+        _place(i, i, rec[i]["event_time"], ci, q.hp)
+    _heapify(n, ci, q.hp)
+
+
+@njit(refcount=False)
 def reset_queue(n, now, width, rec, ci, q):
     """Queue every ball's event afresh (their times are set), in buckets of ``width`` seconds
     from step time ``now`` (a ring-less queue ignores it)."""
@@ -561,7 +600,28 @@ def _refile(n, rec, ci, q):
     return moved
 
 
-@njit(inline="always")
+@njit(refcount=False)
+def _rebase_heap(size, t, hp):
+    """Subtract ``t`` from the heap's times; True if round-off made a node and its parent tie (see
+    :func:`rebase_queue`)."""
+    disorder = False
+    for slot in range(size):
+        row = slot + HEAP_OFFSET
+        hp[row, H_TIME] -= t
+        if slot > 0:
+            above = _time_at((slot - 1) // ARITY, hp)
+            disorder = disorder or (hp[row, H_TIME] == above and above < INF)
+    return disorder
+
+
+@njit(refcount=False)
+def heap_rebase(n, t, rec, ci, q):
+    """:func:`rebase_queue` in a queue without buckets."""
+    if _rebase_heap(n, t, q.hp):
+        _heapify(n, ci, q.hp)
+
+
+@njit(refcount=False)
 def rebase_queue(n, t, rec, ci, q):
     """Make the queue's times relative to step time ``t``, after every ball's event time was (the
     caller's): the heap's times and the buckets' base are rebased the same way. Round-off can move
@@ -569,22 +629,15 @@ def rebase_queue(n, t, rec, ci, q):
     (which the tie rule, :func:`order_key`, may order the other way): such events are moved and
     the heap is re-ordered, which is rare. Subtracting the same number keeps every other pair in
     order."""
-    hp = q.hp
-    disorder = False
-    for slot in range(_heap_size(rec, q)):
-        row = slot + HEAP_OFFSET
-        hp[row, H_TIME] -= t
-        if slot > 0:
-            above = _time_at((slot - 1) // ARITY, hp)
-            disorder = disorder or (hp[row, H_TIME] == above and above < INF)
+    disorder = _rebase_heap(_heap_size(rec, q), t, q.hp)
     if _ring_size(q) > 0:
         q.qf[W_QUEUE_BASE] -= t
         disorder = _refile(n, rec, ci, q) or disorder
     if disorder:
-        _heapify(_heap_size(rec, q), ci, hp)
+        _heapify(_heap_size(rec, q), ci, q.hp)
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def set_event(ball, t, code, stamp, rec, ci):
     """Give ``ball`` the pending event ``(t, code)`` (``stamp``: the partner's change count);
     the caller queues it (:func:`schedule`, or :func:`reset_queue` for every ball)."""
@@ -593,8 +646,26 @@ def set_event(ball, t, code, stamp, rec, ci):
     ci[ball, C_EVENT_STAMP] = stamp
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def is_stale(ball, rec, ci):
     """A pair event whose partner's trajectory changed after it was predicted."""
     other = ci[ball, C_EVENT_OTHER]
     return other >= 0 and rec[other]["changes"] != ci[ball, C_EVENT_STAMP]
+
+
+class QueueOps(NamedTuple):
+    """The event queue's operations as the scheduler calls them, for one kind of queue: build it
+    afresh, move an event after its time changed, the ball whose event comes first, rebase its
+    times at a step's end, and a step of the walk ahead of the next bucket."""
+
+    build: object
+    schedule: object
+    first: object
+    rebase: object
+    walk: object
+
+
+#: A heap of every ball (scenes of fewer than :data:`QUEUE_MIN_BALLS` balls), and Paul's two-level
+#: queue of a heap and time buckets.
+HEAP_QUEUE = QueueOps(heap_build, heap_schedule, heap_first, heap_rebase, no_walk)
+BUCKET_QUEUE = QueueOps(build_queue, schedule, next_ball, rebase_queue, walk_next_bucket)

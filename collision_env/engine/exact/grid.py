@@ -1,99 +1,43 @@
-"""The broad phase: a uniform grid of cells over the scene, so that a ball meets only its neighbours.
+"""Exact mode's neighbour search: each ball's cell, kept current by cell-crossing events.
 
-Cells are at least one largest ball diameter wide, so two balls that touch are always in the same
-or adjacent cells, and a prediction looks at the 3 x 3 block of cells around the ball instead of
-every ball (Rapaport 1980; Isobe 1999; Smallenburg 2022). In exact mode a ball's cell is kept up
-to date by cell-crossing events (the ball leaves its cell at a predicted time, like any other
-event); in the cheap modes the grid is rebuilt at every sub-step, which is O(N).
-
-Cells are numbered ``cy * nx + cx``. The grid covers the border, or, without one, the box around
-the balls' starting positions; the outermost cells reach to infinity (positions are clamped), so
-a ball far outside still has a cell and the neighbour rule still holds. There are at most a few
-cells per ball, so the grid costs O(N) memory.
-
-The grid is used only where it pays (the model-only-what-is-needed rule): with fewer than
-:data:`GRID_MIN_BALLS` balls, in stick scenes, or when ball pairs are not modelled, the grid has
-one cell and the neighbours of a ball are all the others.
-
-Exact mode's cell lists are doubly linked, so a ball leaves its cell in O(1): a ball's
-``cell_next`` is in its calendar record (``layout.CAL_RECORD``, read for every neighbour), its
-``cell`` and ``cell_prev`` in its int32 row (``layout.CAL_I``); the first ball of cell c is
-``heads[c]``, in an int32 array of its own (the heads of a 3 x 3 block share a few cache lines).
+The grid is laid out by :mod:`~collision_env.engine.broadphase`; here a ball leaves its cell at a
+predicted time, like any other event (:func:`crossing`), and moves to the neighbour it enters.
+Cell lists are doubly linked, so a ball leaves its cell in O(1): a ball's ``cell_next`` is in its
+calendar record (``layout.CAL_RECORD``, read for every neighbour), its ``cell`` and ``cell_prev``
+in its int32 row (``layout.CAL_I``); the first ball of cell c is ``heads[c]``, in an int32 array of
+its own (the heads of a 3 x 3 block share a few cache lines).
 """
 
 from __future__ import annotations
 
 import math
-
-import numpy as np
+from typing import NamedTuple
 
 from .._jit import njit
-from ..layout import (
-    C_CELL,
-    C_CELL_PREV,
-    W_GRID_HX,
-    W_GRID_HY,
-    W_GRID_NX,
-    W_GRID_NY,
-    W_GRID_X0,
-    W_GRID_Y0,
-)
+from ..broadphase import cell_of
+from ..layout import C_CELL, C_CELL_PREV, W_GRID_HX, W_GRID_HY, W_GRID_NX, W_GRID_NY, W_GRID_X0, W_GRID_Y0
 
-#: Scenes with fewer balls keep one cell (every ball is every other's neighbour): below this size
-#: the grid's bookkeeping costs more than the pairs it saves (measured by the engine benchmark).
-GRID_MIN_BALLS = 64
-#: Balls per cell exact mode's grid aims at, and the most cells it has per ball (cells are never
-#: narrower than a diameter): fewer cells cost more pair predictions per event, more cells more
-#: cell crossings (measured by the scale benchmark).
-EXACT_BALLS_PER_CELL = 0.3
-EXACT_CELLS_PER_BALL = 4
-#: The cheap modes' grid: cells at least two diameters wide, up to this many per ball.
-CHEAP_CELLS_PER_BALL = 4
-#: Cells are this much wider than the largest diameter, so that round-off in a ball's position at
-#: a cell boundary can never hide a neighbour.
-CELL_MARGIN = 1.0 + 1e-6
+#: Directions a ball leaves its cell in (crossing codes), and ``NO_CROSSING``.
+CROSS_LEFT, CROSS_RIGHT, CROSS_DOWN, CROSS_UP = 0, 1, 2, 3
+NO_CROSSING = -1
 
 
-def grid_geometry(bounds, positions, radii, use_grid, reach=1.0, balls_per_cell=1.0, cells_per_ball=1):
-    """Per-scene grid ``(x0, y0, hx, hy)`` and ``(nx, ny)`` for ``(B, N, 2)`` positions and
-    ``(B, N)`` radii; scenes with ``use_grid`` False get a single cell. The cells are at least
-    ``reach * CELL_MARGIN`` largest diameters wide, hold about ``balls_per_cell`` balls each, and
-    number at most ``cells_per_ball`` per ball. The cheap modes use ``reach = 2``: their grid is
-    built before a sub-step's overlaps are pushed apart, and a pushed ball must still find the
-    balls it now overlaps. Exact mode uses :data:`EXACT_BALLS_PER_CELL` and
-    :data:`EXACT_CELLS_PER_BALL`."""
-    n_scenes, n = radii.shape
-    if bounds is not None:
-        lo = np.broadcast_to(np.array(bounds[:2], dtype=np.float64), (n_scenes, 2))
-        hi = np.broadcast_to(np.array(bounds[2:], dtype=np.float64), (n_scenes, 2))
-    else:
-        r = radii[..., None]
-        lo = (positions - r).min(axis=1)
-        hi = (positions + r).max(axis=1)
-    size = hi - lo
-    sigma = 2.0 * reach * radii.max(axis=1) * CELL_MARGIN
-    # about one ball per cell, but never narrower than a diameter
-    width = np.maximum(sigma, np.sqrt(balls_per_cell * size[:, 0] * size[:, 1] / n))
-    most = cells_per_ball * n
-    counts = np.ones((n_scenes, 2), dtype=np.int64)
-    if use_grid:
-        for axis in range(2):
-            c = np.floor(size[:, axis] / width)
-            counts[:, axis] = np.clip(np.nan_to_num(c, nan=1.0, posinf=1.0), 1, most).astype(np.int64)
-        # a thin box: cells along its long axis alone
-        while np.any(counts[:, 0] * counts[:, 1] > most):
-            over = counts[:, 0] * counts[:, 1] > most
-            big = np.argmax(counts, axis=1)
-            counts[over, big[over]] -= 1
-    cell = np.where(counts > 1, size / counts, np.inf)  # one cell along an axis: no boundary there
-    return np.concatenate([lo, cell], axis=1), counts
+class GridGeometry(NamedTuple):
+    """A scene's grid (``broadphase.grid_geometry``): its origin, cell sizes and cell counts."""
+
+    x0: float  #: m
+    y0: float  #: m
+    hx: float  #: cell width, m (inf: one cell along x)
+    hy: float  #: cell height, m
+    nx: int  #: cells along x
+    ny: int  #: cells along y
 
 
 @njit(inline="always")
 def scene_geometry(work_f, work_i, sc):
-    """Scene ``sc``'s grid ``(x0, y0, hx, hy, nx, ny)``, as :func:`grid_geometry` laid it out in the
-    per-scene work arrays (``layout.WORK_F``/``WORK_I``)."""
-    return (
+    """Scene ``sc``'s grid, as :func:`~collision_env.engine.broadphase.grid_geometry` laid it out in
+    the per-scene work arrays (``layout.WORK_F``/``WORK_I``)."""
+    return GridGeometry(
         work_f[sc, W_GRID_X0],
         work_f[sc, W_GRID_Y0],
         work_f[sc, W_GRID_HX],
@@ -105,27 +49,20 @@ def scene_geometry(work_f, work_i, sc):
 
 @njit(inline="always")
 def has_cells(geo):
-    """The grid ``geo`` (:func:`scene_geometry`) has more than one cell: the scene uses it."""
-    return geo[4] * geo[5] > 1
+    """The grid has more than one cell: the scene uses it."""
+    return geo.nx * geo.ny > 1
 
 
 @njit(inline="always")
-def _axis_cell(x, x0, h, n_cells):
-    f = (x - x0) / h
-    if not f > 0.0:  # (also the one-cell case, h = inf)
-        return 0
-    if f >= n_cells:
-        return n_cells - 1
-    return int(f)
+def near_border(c, geo):
+    """Cell ``c`` is one of the grid's outermost (or the only one): a ball elsewhere is at least a
+    cell's width, more than its radius, from every wall."""
+    cx = c % geo.nx
+    cy = c // geo.nx
+    return cx == 0 or cx == geo.nx - 1 or cy == 0 or cy == geo.ny - 1
 
 
-@njit(inline="always")
-def cell_of(x, y, x0, y0, hx, hy, nx, ny):
-    """The cell holding point ``(x, y)`` (clamped into the grid)."""
-    return _axis_cell(y, y0, hy, ny) * nx + _axis_cell(x, x0, hx, nx)
-
-
-@njit(inline="always")
+@njit(refcount=False)
 def link(i, c, rec, ci, heads):
     """Put ball ``i`` at the front of cell ``c``'s list."""
     head = heads[c]
@@ -137,7 +74,7 @@ def link(i, c, rec, ci, heads):
     heads[c] = i
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def unlink(i, rec, ci, heads):
     """Take ball ``i`` out of its cell's list."""
     prev = ci[i, C_CELL_PREV]
@@ -150,7 +87,7 @@ def unlink(i, rec, ci, heads):
         ci[nxt, C_CELL_PREV] = prev
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def move_to_cell(i, c, rec, ci, heads):
     """Move ball ``i`` into cell ``c`` (nothing to do if it is there already)."""
     if c != ci[i, C_CELL]:
@@ -158,142 +95,51 @@ def move_to_cell(i, c, rec, ci, heads):
         link(i, c, rec, ci, heads)
 
 
-@njit(inline="always")
-def fill_cells(n, rec, ci, heads, x0, y0, hx, hy, nx, ny):
+@njit(refcount=False)
+def fill_cells(n, rec, ci, heads, geo):
     """Empty every cell and put every ball in the cell of its calendar position."""
-    for c in range(nx * ny):
+    for c in range(geo.nx * geo.ny):
         heads[c] = -1
     for i in range(n - 1, -1, -1):
-        link(i, cell_of(rec[i]["x"], rec[i]["y"], x0, y0, hx, hy, nx, ny), rec, ci, heads)
+        link(i, cell_of(rec[i]["x"], rec[i]["y"], geo.x0, geo.y0, geo.hx, geo.hy, geo.nx, geo.ny), rec, ci, heads)
 
 
-@njit(inline="always")
-def block(c, nx, ny):
-    """The 3 x 3 block of cells around cell ``c``: ``(cx0, cx1, cy0, cy1)``, inclusive."""
-    cx = c % nx
-    cy = c // nx
-    return max(cx - 1, 0), min(cx + 1, nx - 1), max(cy - 1, 0), min(cy + 1, ny - 1)
-
-
-@njit(inline="always")
-def crossing(x, y, vx, vy, c, x0, y0, hx, hy, nx, ny):
+@njit
+def crossing(x, y, vx, vy, c, geo):
     """Time until a ball at ``(x, y)`` moving at ``(vx, vy)`` leaves cell ``c`` for a neighbour, and
-    the direction (0: -x, 1: +x, 2: -y, 3: +y; -1: it never does). The outermost cells reach to
-    infinity, so there is no crossing out of the grid."""
+    the direction (``CROSS_*``, or ``NO_CROSSING``). The outermost cells reach to infinity, so
+    there is no crossing out of the grid."""
+    x0, y0, hx, hy, nx, ny = geo
     cx = c % nx
     cy = c // nx
     best = math.inf
-    direction = -1
+    direction = NO_CROSSING
     if vx > 0.0 and cx < nx - 1:
         best = max((x0 + (cx + 1) * hx - x) / vx, 0.0)
-        direction = 1
+        direction = CROSS_RIGHT
     elif vx < 0.0 and cx > 0:
         best = max((x0 + cx * hx - x) / vx, 0.0)
-        direction = 0
+        direction = CROSS_LEFT
     if vy > 0.0 and cy < ny - 1:
         t = max((y0 + (cy + 1) * hy - y) / vy, 0.0)
         if t < best:
             best = t
-            direction = 3
+            direction = CROSS_UP
     elif vy < 0.0 and cy > 0:
         t = max((y0 + cy * hy - y) / vy, 0.0)
         if t < best:
             best = t
-            direction = 2
+            direction = CROSS_DOWN
     return best, direction
 
 
-@njit(inline="always")
+@njit
 def neighbour_cell(c, direction, nx):
     """The cell a ball enters when it leaves cell ``c`` in ``direction``."""
-    if direction == 0:
+    if direction == CROSS_LEFT:
         return c - 1
-    if direction == 1:
+    if direction == CROSS_RIGHT:
         return c + 1
-    if direction == 2:
+    if direction == CROSS_DOWN:
         return c - nx
     return c + nx
-
-
-@njit
-def first_overlap(pos, radius, rtol):
-    """The first pair ``(i, j)``, ``i < j`` in lexicographic order, whose disks overlap by more than
-    ``rtol`` of their radii sum, or ``(-1, -1)``; O(N) expected time on a grid of the balls' box."""
-    n = pos.shape[0]
-    if n < 2:
-        return -1, -1
-    x0 = pos[0, 0]
-    y0 = pos[0, 1]
-    x1 = x0
-    y1 = y0
-    r_max = 0.0
-    for i in range(n):
-        x0 = min(x0, pos[i, 0])
-        x1 = max(x1, pos[i, 0])
-        y0 = min(y0, pos[i, 1])
-        y1 = max(y1, pos[i, 1])
-        r_max = max(r_max, radius[i])
-    h = 2.0 * r_max * CELL_MARGIN
-    nx = min(max(int((x1 - x0) / h), 1), n)
-    ny = min(max(int((y1 - y0) / h), 1), max(n // nx, 1))
-    hx = (x1 - x0) / nx if nx > 1 else math.inf
-    hy = (y1 - y0) / ny if ny > 1 else math.inf
-    hx = max(hx, h)
-    hy = max(hy, h)
-    head = np.full(nx * ny, -1, dtype=np.int64)
-    nxt = np.empty(n, dtype=np.int64)
-    cell = np.empty(n, dtype=np.int64)
-    for i in range(n - 1, -1, -1):
-        c = cell_of(pos[i, 0], pos[i, 1], x0, y0, hx, hy, nx, ny)
-        cell[i] = c
-        nxt[i] = head[c]
-        head[c] = i
-    best_i = -1
-    best_j = -1
-    for i in range(n):
-        cx0, cx1, cy0, cy1 = block(cell[i], nx, ny)
-        for cy in range(cy0, cy1 + 1):
-            for cx in range(cx0, cx1 + 1):
-                j = head[cy * nx + cx]
-                while j >= 0:
-                    if j > i:
-                        dx = pos[j, 0] - pos[i, 0]
-                        dy = pos[j, 1] - pos[i, 1]
-                        sigma = radius[i] + radius[j]
-                        if math.sqrt(dx * dx + dy * dy) < sigma * (1.0 - rtol):
-                            if best_i < 0 or j < best_j:
-                                best_i = i
-                                best_j = j
-                    j = nxt[j]
-        if best_i >= 0:
-            return best_i, best_j
-    return -1, -1
-
-
-# ---------------------------------------------------------------------------- cheap modes
-@njit(inline="always")
-def later_neighbours(i, n, head, nxt, cell, nx, ny, out):
-    """The balls ``j > i`` in the 3 x 3 cells around ball ``i``, ascending, into ``out``; returns
-    how many. With one cell that is every ``j > i``, so the cheap modes visit pairs in the same
-    index order with or without a grid."""
-    m = 0
-    if nx * ny == 1:
-        for j in range(i + 1, n):
-            out[m] = j
-            m += 1
-        return m
-    cx0, cx1, cy0, cy1 = block(cell[i], nx, ny)
-    for cy in range(cy0, cy1 + 1):
-        for cx in range(cx0, cx1 + 1):
-            j = head[cy * nx + cx]
-            while j >= 0:
-                if j > i:
-                    # insertion into the sorted prefix (a handful of neighbours)
-                    q = m
-                    while q > 0 and out[q - 1] > j:
-                        out[q] = out[q - 1]
-                        q -= 1
-                    out[q] = j
-                    m += 1
-                j = nxt[j]
-    return m

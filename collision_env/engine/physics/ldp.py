@@ -1,7 +1,7 @@
 """Least-distance programming: the closest point of a polyhedral cone, for unending contact cascades.
 
 Exact mode resolves a group of touching balls by sequential pairwise impulses (see
-``exact._resolve_contact_group``). Where that cascade converges only geometrically at a rate set
+``exact.contacts.cascade``). Where that cascade converges only geometrically at a rate set
 by a mass ratio (a light ball pressed between a wall and a ball 1e12 times heavier needs about
 1e12 sweeps), the engine jumps to its limit instead: the velocities closest to the current ones,
 in the kinetic-energy metric, at which every contact of the group separates. That is a

@@ -18,11 +18,7 @@ from __future__ import annotations
 import math
 
 from .._jit import njit
-from ..layout import B_INV_MASS, B_MASS, B_OMEGA, B_RADIUS, B_VX, B_X, BALL
-
-#: Last axis of the (B, N, 8) per-ball state, laid out as ``layout.BALL``: position (2),
-#: velocity (2), mass, 1 / mass, radius, and the angular velocity of the cluster the ball roots.
-BALL_FIELDS = len(BALL)
+from ..layout import B_INV_MASS, B_MASS, B_OMEGA, B_RADIUS, B_VX, B_X
 
 
 @njit(inline="always")
@@ -97,7 +93,7 @@ def advance_body(root, dt, pos, vel, mass, body, omega):
             vel[k, 1] = vcy + w * rx
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def advance_all(dt, pos, vel, mass, body, omega, any_rotating):
     """Move every ball on by ``dt``: straight lines, and rigid rotation for spinning clusters."""
     n = pos.shape[0]
@@ -111,7 +107,7 @@ def advance_all(dt, pos, vel, mass, body, omega, any_rotating):
                 advance_body(r, dt, pos, vel, mass, body, omega)
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def has_rotation(body, omega):
     for r in range(body.shape[0]):
         if body[r] == r and omega[r] != 0.0:

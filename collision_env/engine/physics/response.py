@@ -18,7 +18,7 @@ tiny speed from the balls it involves, and from nothing else:
 where ``s`` is the fastest of the two balls just before the impact (the ball alone for a wall
 impact) or, inside a contact group resolved at one instant, the group's kinetic-energy speed
 ``sqrt(sum m v^2 / max m)`` when the group is formed (see :func:`group_threshold` and
-``exact._resolve_contact_group``). Defaults: ``collapse_ratio`` = 1e-9,
+``exact.contacts.cascade``). Defaults: ``collapse_ratio`` = 1e-9,
 ``collapse_floor`` = 0 m/s. ``u_min`` is far below anything measurable and, at 1e-9 of the speeds
 involved, far above their round-off (2.2e-16 of them), so a pair set apart at ``u_min`` really
 separates. The rule
@@ -32,7 +32,7 @@ separates. The rule
 
 A cascade that the rule does not end quickly because it converges at a rate set by a mass ratio
 (a light ball pressed between a wall and a far heavier ball) is replaced by its limit after a
-fixed number of sweeps, whatever the ratio: see ``exact._settle_contact_group``.
+fixed number of sweeps, whatever the ratio: see ``exact.contacts.settle``.
 
 Energy: the rule can add at most ``1/2 mu u_min^2`` to a collision whose closing speed was below
 ``u_min``. With ``u_min = collapse_ratio * s`` that is at most ``collapse_ratio^2`` (1e-18) of the
@@ -57,12 +57,13 @@ from __future__ import annotations
 import math
 
 from .._jit import njit
+from .walls import heads_into, wall_axis
 
 #: Closing speeds up to this many ulps of a group's fastest speed are round-off, not collisions.
 _ROUNDOFF_SPEED = 8.0 * 2.0**-52
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def elastic_threshold(vel, collapse_ratio, collapse_floor):
     """``u_min`` for one scene of the cheap modes: ``collapse_ratio`` times the speed of the scene's
     slowest moving ball (a pair that collides has at least one ball that fast, so the rule adds at
@@ -75,7 +76,7 @@ def elastic_threshold(vel, collapse_ratio, collapse_floor):
     return max(collapse_ratio * math.sqrt(slowest), collapse_floor) if slowest < math.inf else collapse_floor
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def impact_threshold(i, j, vel, collapse_ratio, collapse_floor):
     """``u_min`` of an impact of ball ``i`` with ball ``j`` (``j < 0``: a wall), from their speeds."""
     fastest = vel[i, 0] * vel[i, 0] + vel[i, 1] * vel[i, 1]
@@ -84,7 +85,7 @@ def impact_threshold(i, j, vel, collapse_ratio, collapse_floor):
     return max(collapse_ratio * math.sqrt(fastest), collapse_floor)
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def group_threshold(group, size, vel, inv_mass, collapse_ratio, collapse_floor):
     """``u_min`` of a contact group (its balls are ``group[:size]``): ``collapse_ratio`` times the
     group's kinetic-energy speed ``sqrt(sum m v^2 / max m)``, or a few ulps of its fastest ball's
@@ -105,13 +106,13 @@ def group_threshold(group, size, vel, inv_mass, collapse_ratio, collapse_floor):
     return max(collapse_ratio * math.sqrt(energy2 * heaviest_inv), _ROUNDOFF_SPEED * math.sqrt(fastest), collapse_floor)
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def separation_speed(closing_speed, e, u_min):
     """Normal speed at which a collision leaves the pair separating (see the regulariser)."""
     return e * closing_speed if closing_speed > u_min else u_min
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def ball_ball(i, j, pos, vel, inv_mass, e, u_min):
     """Apply the impulse between balls ``i`` and ``j``. Returns the closing speed (0: no impulse)."""
     dx = pos[j, 0] - pos[i, 0]
@@ -135,13 +136,12 @@ def ball_ball(i, j, pos, vel, inv_mass, e, u_min):
     return -u
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def ball_wall(i, wall, vel, e, u_min):
     """Reflect the normal component of ball ``i``'s velocity off ``wall``. Returns the closing speed."""
-    axis = 0 if wall < 2 else 1
+    axis = wall_axis(wall)
     vn = vel[i, axis]
-    into = vn < 0.0 if wall % 2 == 0 else vn > 0.0
-    if not into:
+    if not heads_into(wall, vn):
         return 0.0
     out = separation_speed(abs(vn), e, u_min)
     vel[i, axis] = out if vn < 0.0 else -out
@@ -196,7 +196,7 @@ def merge_bodies(i, j, pos, vel, mass, body, omega):
     return root
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def stop_body(i, vel, body, omega):
     """A stuck ball or cluster touching a wall stops dead and comes apart (PhET)."""
     root = body[i]

@@ -26,6 +26,7 @@ import math
 from .._jit import njit
 from .motion import position_at
 from .tolerance import contact_tolerance
+from .walls import WALL_BOTTOM, WALL_LEFT, WALL_RIGHT, wall_axis, wall_count
 
 INF = math.inf
 
@@ -39,7 +40,7 @@ CA_RTOL = 1e-12
 _CA_ROUNDOFF_SHARE = 0.25
 
 
-@njit(inline="always")
+@njit
 def toi_pair(dx, dy, dvx, dvy, sigma):
     """Time until two balls in straight-line motion touch, or inf."""
     b = dx * dvx + dy * dvy
@@ -56,7 +57,7 @@ def toi_pair(dx, dy, dvx, dvy, sigma):
     return c / (-b + math.sqrt(disc))
 
 
-@njit(inline="always")
+@njit
 def toi_wall_axis(x, v, r, lo, hi):
     """Time until a ball moving along one axis touches the wall it heads for, and that wall.
 
@@ -72,20 +73,19 @@ def toi_wall_axis(x, v, r, lo, hi):
     return INF, -1
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def toi_wall(x, y, vx, vy, r, bounds, dim):
-    """First wall a ball in straight-line motion touches: ``(t, wall)``, wall 0..3 or -1.
-
-    Wall codes: 0 left, 1 right, 2 bottom, 3 top. On an exact tie (a corner) the x wall comes
+    """First wall a ball in straight-line motion touches: ``(t, wall)``, a wall code
+    (:mod:`~collision_env.engine.physics.walls`) or -1. On an exact tie (a corner) the x wall comes
     first; the y wall then follows at the same instant, so both components flip.
     """
     t, side = toi_wall_axis(x, vx, r, bounds[0], bounds[2])
-    wall = side
+    wall = WALL_LEFT + side if side >= 0 else -1
     if dim == 2:
         ty, sy = toi_wall_axis(y, vy, r, bounds[1], bounds[3])
         if ty < t:
             t = ty
-            wall = 2 + sy
+            wall = WALL_BOTTOM + sy
     return t, wall
 
 
@@ -103,11 +103,11 @@ def _pair_gap(tau, ki, kj, sigma):
 @njit(refcount=False)
 def _wall_gap(tau, k, r, wall, bounds):
     x, y, vx, vy = position_at(tau, k[0], k[1], k[2], k[3], k[4], k[5], k[6])
-    if wall == 0:
+    if wall == WALL_LEFT:
         return (x - r) - bounds[0], vx
-    if wall == 1:
+    if wall == WALL_RIGHT:
         return (bounds[2] - r) - x, -vx
-    if wall == 2:
+    if wall == WALL_BOTTOM:
         return (y - r) - bounds[1], vy
     return (bounds[3] - r) - y, -vy
 
@@ -184,9 +184,8 @@ def ca_wall(k, r, bounds, dim, horizon):
     spin = abs(k[6]) * math.hypot(k[4], k[5])
     coord = max(abs(k[0]), abs(k[1]), abs(bounds[0]), abs(bounds[1]), abs(bounds[2]), abs(bounds[3]))
     tol = _CA_ROUNDOFF_SHARE * contact_tolerance(r, coord + math.hypot(k[4], k[5]), CA_RTOL)
-    n_walls = 4 if dim == 2 else 2
-    for wall in range(n_walls):
-        normal_speed = abs(k[2]) if wall < 2 else abs(k[3])
+    for wall in range(wall_count(dim)):
+        normal_speed = abs(k[2]) if wall_axis(wall) == 0 else abs(k[3])
         t = _ca_solve(False, k, k, r, wall, bounds, normal_speed + spin, min(horizon, best), tol)
         if t < best:
             best = t

@@ -11,6 +11,8 @@ be a millimetre.
 
 from __future__ import annotations
 
+import math
+
 from .._jit import njit
 
 #: Contact tolerance relative to the feature size (radii, diameters).
@@ -21,14 +23,31 @@ ROUNDOFF_ULPS = 8.0
 EPS = 2.0**-52
 
 
-@njit(inline="always")
+@njit
 def roundoff(coord):
     """The round-off (m) of a gap computed from coordinates of magnitude up to ``coord``."""
     return ROUNDOFF_ULPS * EPS * coord
 
 
-@njit(inline="always")
+@njit
 def contact_tolerance(length, coord, rtol):
     """Largest gap (m) that counts as contact between features of size ``length`` (m), computed
     from coordinates of magnitude up to ``coord`` (m): ``rtol * length`` or the round-off."""
     return max(rtol * length, roundoff(coord))
+
+
+@njit(inline="always")
+def coordinate_size(i, pos):
+    """Magnitude of ball ``i``'s coordinates (what the round-off of its gaps is relative to)."""
+    return max(abs(pos[i, 0]), abs(pos[i, 1]))
+
+
+@njit(refcount=False)
+def balls_touch(a, k, pos, radius):
+    """Balls ``a`` and ``k`` touch within the contact tolerance (:func:`contact_tolerance`: 1e-9 of
+    the radii, or the round-off of their coordinates)."""
+    dx = pos[k, 0] - pos[a, 0]
+    dy = pos[k, 1] - pos[a, 1]
+    sigma = radius[a] + radius[k]
+    tol = contact_tolerance(sigma, max(coordinate_size(a, pos), coordinate_size(k, pos)), CONTACT_RTOL)
+    return math.sqrt(dx * dx + dy * dy) - sigma <= tol

@@ -18,12 +18,14 @@ from __future__ import annotations
 import math
 
 from .._jit import njit
-from ..exact.grid import later_neighbours
-from ..exact.scheduler import EVENTS, PAIR_TESTS, WALL_TESTS, record, wall_point
+from ..layout import EVENTS, PAIR_TESTS, WALL_TESTS
+from ..physics.impacts import record
 from ..physics.response import ball_ball, ball_wall, merge_bodies, stop_body
+from ..physics.walls import heads_into, wall_of, wall_point
+from .cells import later_neighbours
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def body_inverse_mass(i, mass, body, sticky):
     """1 / the mass of ball ``i``'s cluster (of the ball alone unless the scene is a stick one)."""
     if not sticky:
@@ -36,7 +38,7 @@ def body_inverse_mass(i, mass, body, sticky):
     return 1.0 / m_tot
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def shift_body(i, dx, dy, pos, body, sticky):
     """Move ball ``i``'s cluster (the ball alone unless the scene is a stick one) by (dx, dy)."""
     if not sticky:
@@ -50,104 +52,88 @@ def shift_body(i, dx, dy, pos, body, sticky):
             pos[k, 1] += dy
 
 
-@njit(inline="always")
-def contain(sc, t_abs, pos, vel, radius, body, omega, bounds, dim, e, u_min, sticky, imp, n_imp, counters):
+@njit(refcount=False)
+def contain(sc, t_abs, u_min, b, ph, state):
     """Put every ball that ended up past a wall back on it; reflect it if it still moves outward."""
-    n = pos.shape[0]
-    n_axes = 2 if dim == 2 else 1
-    for i in range(n):
-        counters[WALL_TESTS] += 1
+    pos, vel, radius, bounds = b.pos, b.vel, b.radius, ph.bounds
+    n_axes = 2 if ph.dim == 2 else 1
+    for i in range(pos.shape[0]):
+        state.counters[WALL_TESTS] += 1
         for axis in range(n_axes):
             lo = bounds[axis] + radius[i]
             hi = bounds[axis + 2] - radius[i]
             x = pos[i, axis]
             if x < lo:
-                wall = 2 * axis
+                wall = wall_of(axis, False)
                 push = lo - x
             elif x > hi:
-                wall = 2 * axis + 1
+                wall = wall_of(axis, True)
                 push = hi - x
             else:
                 continue
             if axis == 0:
-                shift_body(i, push, 0.0, pos, body, sticky)
+                shift_body(i, push, 0.0, pos, b.body, ph.sticky)
             else:
-                shift_body(i, 0.0, push, pos, body, sticky)
+                shift_body(i, 0.0, push, pos, b.body, ph.sticky)
             v = vel[i, axis]
-            if (v < 0.0) if wall % 2 == 0 else (v > 0.0):
-                if sticky:
-                    stop_body(i, vel, body, omega)
+            if heads_into(wall, v):
+                if ph.sticky:
+                    stop_body(i, vel, b.body, b.omega)
                     speed = abs(v)
                 else:
-                    speed = ball_wall(i, wall, vel, e, u_min)
-                cx, cy = wall_point(i, wall, pos, radius, bounds)
-                record(imp, n_imp, sc, t_abs, i, -1, wall, cx, cy, speed)
-                counters[EVENTS] += 1
+                    speed = ball_wall(i, wall, vel, ph.e, u_min)
+                cx, cy = wall_point(i, wall, pos, bounds)
+                record(state.imp, state.n_imp, sc, t_abs, i, -1, wall, cx, cy, speed)
+                state.counters[EVENTS] += 1
 
 
-@njit(inline="always")
-def resolve_naive(
-    sc,
-    t_abs,
-    pos,
-    vel,
-    mass,
-    inv_mass,
-    radius,
-    body,
-    omega,
-    bounds,
-    dim,
-    e,
-    u_min,
-    has_walls,
-    pairs,
-    sticky,
-    imp,
-    n_imp,
-    counters,
-    cells,
-):
-    """Resolve the overlaps at the end of a sub-step; ``cells`` is the sub-step's broad phase
-    (``substep.cell_lists``): pairs come from it in index order."""
-    n = pos.shape[0]
-    head, nxt, cell, near, cells_x, cells_y = cells
-    if pairs:
+@njit(refcount=False)
+def _resolve_pair(sc, t_abs, i, j, u_min, b, ph, state):
+    """Resolve an overlap of balls ``i`` and ``j``, if they overlap."""
+    pos, vel, radius, body, sticky = b.pos, b.vel, b.radius, b.body, ph.sticky
+    state.counters[PAIR_TESTS] += 1
+    dx = pos[j, 0] - pos[i, 0]
+    dy = pos[j, 1] - pos[i, 1]
+    sigma = radius[i] + radius[j]
+    if dx * dx + dy * dy > sigma * sigma * (1.0 + 1e-12):  # (spares the root of far pairs)
+        return
+    dist = math.sqrt(dx * dx + dy * dy)
+    if dist >= sigma:
+        return
+    if dist > 0.0:
+        nx = dx / dist
+        ny = dy / dist
+    else:
+        nx = 1.0
+        ny = 0.0
+    closing = (vel[j, 0] - vel[i, 0]) * nx + (vel[j, 1] - vel[i, 1]) * ny
+    wi = body_inverse_mass(i, b.mass, body, sticky)
+    wj = body_inverse_mass(j, b.mass, body, sticky)
+    overlap = sigma - dist
+    shift_body(i, -overlap * wi / (wi + wj) * nx, -overlap * wi / (wi + wj) * ny, pos, body, sticky)
+    shift_body(j, overlap * wj / (wi + wj) * nx, overlap * wj / (wi + wj) * ny, pos, body, sticky)
+    if closing < 0.0:
+        x = pos[i, 0] + radius[i] * nx
+        y = pos[i, 1] + radius[i] * ny
+        if sticky:
+            merge_bodies(i, j, pos, vel, b.mass, body, b.omega)
+            speed = -closing
+        else:
+            speed = ball_ball(i, j, pos, vel, b.inv_mass, ph.e, u_min)
+        record(state.imp, state.n_imp, sc, t_abs, i, j, -1, x, y, speed)
+        state.counters[EVENTS] += 1
+
+
+@njit(refcount=False)
+def resolve(sc, t_abs, h, u_min, b, ph, state, cells):
+    """Resolve the overlaps at the end of a sub-step of ``h`` seconds ending at ``t_abs``; ``cells``
+    is the sub-step's broad phase (``cells.cell_lists``): pairs come from it in index order."""
+    n = b.pos.shape[0]
+    if ph.pairs:
         for i in range(n):
-            for q in range(later_neighbours(i, n, head, nxt, cell, cells_x, cells_y, near)):
-                j = near[q]
-                if body[i] == body[j]:
-                    continue
-                counters[PAIR_TESTS] += 1
-                dx = pos[j, 0] - pos[i, 0]
-                dy = pos[j, 1] - pos[i, 1]
-                sigma = radius[i] + radius[j]
-                if dx * dx + dy * dy > sigma * sigma * (1.0 + 1e-12):  # (spares the root of far pairs)
-                    continue
-                dist = math.sqrt(dx * dx + dy * dy)
-                if dist >= sigma:
-                    continue
-                if dist > 0.0:
-                    nx = dx / dist
-                    ny = dy / dist
-                else:
-                    nx = 1.0
-                    ny = 0.0
-                closing = (vel[j, 0] - vel[i, 0]) * nx + (vel[j, 1] - vel[i, 1]) * ny
-                wi = body_inverse_mass(i, mass, body, sticky)
-                wj = body_inverse_mass(j, mass, body, sticky)
-                overlap = sigma - dist
-                shift_body(i, -overlap * wi / (wi + wj) * nx, -overlap * wi / (wi + wj) * ny, pos, body, sticky)
-                shift_body(j, overlap * wj / (wi + wj) * nx, overlap * wj / (wi + wj) * ny, pos, body, sticky)
-                if closing < 0.0:
-                    x = pos[i, 0] + radius[i] * nx
-                    y = pos[i, 1] + radius[i] * ny
-                    if sticky:
-                        merge_bodies(i, j, pos, vel, mass, body, omega)
-                        speed = -closing
-                    else:
-                        speed = ball_ball(i, j, pos, vel, inv_mass, e, u_min)
-                    record(imp, n_imp, sc, t_abs, i, j, -1, x, y, speed)
-                    counters[EVENTS] += 1
-    if has_walls:
-        contain(sc, t_abs, pos, vel, radius, body, omega, bounds, dim, e, u_min, sticky, imp, n_imp, counters)
+            for q in range(later_neighbours(i, n, cells)):
+                j = cells.near[q]
+                if b.body[i] != b.body[j]:
+                    _resolve_pair(sc, t_abs, i, j, u_min, b, ph, state)
+    if ph.has_walls:
+        contain(sc, t_abs, u_min, b, ph, state)

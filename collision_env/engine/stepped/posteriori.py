@@ -12,7 +12,7 @@ happened, rewind to it, respond there, and re-advance by the same time with the 
   projection-weighted mix of the two crossing times (a known error, pinned by a test and measured
   by the benchmarks).
 
-Reconstructed times are clamped into the sub-step, and a final :func:`naive.contain` pass puts
+Reconstructed times are clamped into the sub-step, and a final :func:`~.naive.contain` pass puts
 any ball still past a wall back on it, so no ball ends a step outside the border. What remains
 wrong is the trade this mode makes: one collision per pair per step, pairs handled in index order
 rather than time order, corners approximated, and tunnelling when a step jumps a whole contact.
@@ -23,14 +23,16 @@ from __future__ import annotations
 import math
 
 from .._jit import njit
-from ..exact.grid import later_neighbours
-from ..exact.scheduler import EVENTS, PAIR_TESTS, WALL_TESTS, record, wall_point
+from ..layout import EVENTS, PAIR_TESTS, WALL_TESTS
+from ..physics.impacts import record
 from ..physics.motion import advance_body
 from ..physics.response import ball_ball, ball_wall, merge_bodies, stop_body
+from ..physics.walls import wall_of, wall_point
+from .cells import later_neighbours
 from .naive import contain, shift_body
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def _move(i, dt, pos, vel, mass, body, omega, sticky):
     """Move ball ``i``'s body by ``dt`` (negative: rewind), leaving the other balls in place (the
     ball alone unless the scene is a stick one)."""
@@ -48,7 +50,7 @@ def _move(i, dt, pos, vel, mass, body, omega, sticky):
                 pos[k, 1] += vel[k, 1] * dt
 
 
-@njit(refcount=False)
+@njit
 def overlap_time_pair(dx, dy, dvx, dvy, sigma):
     """How long ago an overlapping pair touched: the non-negative root of PhET's quadratic."""
     a = dvx * dvx + dvy * dvy
@@ -62,7 +64,7 @@ def overlap_time_pair(dx, dy, dvx, dvy, sigma):
     return c / (b - sq)
 
 
-@njit(inline="always")
+@njit(refcount=False)
 def overlap_time_border(x, y, vx, vy, r, bounds, dim):
     """PhET's ``|ds|^2 / (v . ds)``, with the overshoot vector ``ds`` it uses."""
     cx = min(max(x, bounds[0] + r), bounds[2] - r)
@@ -74,93 +76,83 @@ def overlap_time_border(x, y, vx, vy, r, bounds, dim):
     return t, dsx, dsy
 
 
-@njit(inline="always")
-def resolve_posteriori(
-    sc,
-    t_end,
-    sign,
-    h,
-    pos,
-    vel,
-    mass,
-    inv_mass,
-    radius,
-    body,
-    omega,
-    bounds,
-    dim,
-    e,
-    u_min,
-    has_walls,
-    pairs,
-    sticky,
-    imp,
-    n_imp,
-    counters,
-    cells,
-):
-    """Reconstruct and resolve the collisions of a sub-step; ``cells`` is the sub-step's broad
-    phase (``substep.cell_lists``): pairs come from it in index order."""
-    n = pos.shape[0]
-    head, nxt, cell, near, cells_x, cells_y = cells
-    if pairs:
-        for i in range(n):
-            for q in range(later_neighbours(i, n, head, nxt, cell, cells_x, cells_y, near)):
-                j = near[q]
-                if body[i] == body[j]:
-                    continue
-                counters[PAIR_TESTS] += 1
-                dx = pos[j, 0] - pos[i, 0]
-                dy = pos[j, 1] - pos[i, 1]
-                sigma = radius[i] + radius[j]
-                if dx * dx + dy * dy >= sigma * sigma:
-                    continue
-                t = overlap_time_pair(dx, dy, vel[j, 0] - vel[i, 0], vel[j, 1] - vel[i, 1], sigma)
-                t = min(max(t, 0.0), h)
-                _move(i, -t, pos, vel, mass, body, omega, sticky)
-                _move(j, -t, pos, vel, mass, body, omega, sticky)
-                dx = pos[j, 0] - pos[i, 0]
-                dy = pos[j, 1] - pos[i, 1]
-                dist = math.sqrt(dx * dx + dy * dy)
-                closing = (vel[j, 0] - vel[i, 0]) * dx + (vel[j, 1] - vel[i, 1]) * dy
-                if closing < 0.0 and dist > 0.0:
-                    x = pos[i, 0] + radius[i] * dx / dist
-                    y = pos[i, 1] + radius[i] * dy / dist
-                    if sticky:
-                        merge_bodies(i, j, pos, vel, mass, body, omega)
-                        speed = -closing / dist
-                    else:
-                        speed = ball_ball(i, j, pos, vel, inv_mass, e, u_min)
-                    record(imp, n_imp, sc, t_end - sign * t, i, j, -1, x, y, speed)
-                    counters[EVENTS] += 1
-                _move(i, t, pos, vel, mass, body, omega, sticky)
-                if body[j] != body[i]:
-                    _move(j, t, pos, vel, mass, body, omega, sticky)
-    if has_walls:
-        for i in range(n):
-            counters[WALL_TESTS] += 1
-            t, dsx, dsy = overlap_time_border(pos[i, 0], pos[i, 1], vel[i, 0], vel[i, 1], radius[i], bounds, dim)
-            if dsx == 0.0 and dsy == 0.0:
+@njit(refcount=False)
+def _resolve_pair(sc, t_end, h, i, j, u_min, b, ph, state):
+    """Reconstruct and resolve the collision of balls ``i`` and ``j``, if they overlap."""
+    pos, vel, mass, radius, body, omega, sticky = b.pos, b.vel, b.mass, b.radius, b.body, b.omega, ph.sticky
+    state.counters[PAIR_TESTS] += 1
+    dx = pos[j, 0] - pos[i, 0]
+    dy = pos[j, 1] - pos[i, 1]
+    sigma = radius[i] + radius[j]
+    if dx * dx + dy * dy >= sigma * sigma:
+        return
+    t = overlap_time_pair(dx, dy, vel[j, 0] - vel[i, 0], vel[j, 1] - vel[i, 1], sigma)
+    t = min(max(t, 0.0), h)
+    _move(i, -t, pos, vel, mass, body, omega, sticky)
+    _move(j, -t, pos, vel, mass, body, omega, sticky)
+    dx = pos[j, 0] - pos[i, 0]
+    dy = pos[j, 1] - pos[i, 1]
+    dist = math.sqrt(dx * dx + dy * dy)
+    closing = (vel[j, 0] - vel[i, 0]) * dx + (vel[j, 1] - vel[i, 1]) * dy
+    if closing < 0.0 and dist > 0.0:
+        x = pos[i, 0] + radius[i] * dx / dist
+        y = pos[i, 1] + radius[i] * dy / dist
+        if sticky:
+            merge_bodies(i, j, pos, vel, mass, body, omega)
+            speed = -closing / dist
+        else:
+            speed = ball_ball(i, j, pos, vel, b.inv_mass, ph.e, u_min)
+        record(state.imp, state.n_imp, sc, t_end - ph.sign * t, i, j, -1, x, y, speed)
+        state.counters[EVENTS] += 1
+    _move(i, t, pos, vel, mass, body, omega, sticky)
+    if body[j] != body[i]:
+        _move(j, t, pos, vel, mass, body, omega, sticky)
+
+
+@njit(refcount=False)
+def _resolve_border(sc, t_end, h, i, u_min, b, ph, state):
+    """Reconstruct and resolve ball ``i``'s collision with the border, if it is past it."""
+    pos, vel, body, sticky = b.pos, b.vel, b.body, ph.sticky
+    state.counters[WALL_TESTS] += 1
+    t, dsx, dsy = overlap_time_border(pos[i, 0], pos[i, 1], vel[i, 0], vel[i, 1], b.radius[i], ph.bounds, ph.dim)
+    if dsx == 0.0 and dsy == 0.0:
+        return
+    t = min(max(t, 0.0), h)
+    t_abs = t_end - ph.sign * t
+    shift_body(i, -t * vel[i, 0], -t * vel[i, 1], pos, body, sticky)
+    for axis in range(2):
+        ds = dsx if axis == 0 else dsy
+        if ds == 0.0:
+            continue
+        wall = wall_of(axis, ds > 0.0)
+        v = vel[i, axis]
+        if sticky:
+            if v == 0.0:
                 continue
-            t = min(max(t, 0.0), h)
-            t_abs = t_end - sign * t
-            shift_body(i, -t * vel[i, 0], -t * vel[i, 1], pos, body, sticky)
-            for axis in range(2):
-                ds = dsx if axis == 0 else dsy
-                if ds == 0.0:
-                    continue
-                wall = 2 * axis + (1 if ds > 0.0 else 0)
-                v = vel[i, axis]
-                if sticky:
-                    if v == 0.0:
-                        continue
-                    stop_body(i, vel, body, omega)
-                    speed = abs(v)
-                else:
-                    speed = ball_wall(i, wall, vel, e, u_min)
-                if speed > 0.0:
-                    x, y = wall_point(i, wall, pos, radius, bounds)
-                    record(imp, n_imp, sc, t_abs, i, -1, wall, x, y, speed)
-                    counters[EVENTS] += 1
-            shift_body(i, t * vel[i, 0], t * vel[i, 1], pos, body, sticky)
-        contain(sc, t_end, pos, vel, radius, body, omega, bounds, dim, e, u_min, sticky, imp, n_imp, counters)
+            stop_body(i, vel, body, b.omega)
+            speed = abs(v)
+        else:
+            speed = ball_wall(i, wall, vel, ph.e, u_min)
+        if speed > 0.0:
+            x, y = wall_point(i, wall, pos, ph.bounds)
+            record(state.imp, state.n_imp, sc, t_abs, i, -1, wall, x, y, speed)
+            state.counters[EVENTS] += 1
+    shift_body(i, t * vel[i, 0], t * vel[i, 1], pos, body, sticky)
+
+
+@njit(refcount=False)
+def resolve(sc, t_end, h, u_min, b, ph, state, cells):
+    """Reconstruct and resolve the collisions of a sub-step of ``h`` seconds ending at ``t_end``;
+    ``cells`` is the sub-step's broad phase (``cells.cell_lists``): pairs come from it in index
+    order."""
+    n = b.pos.shape[0]
+    if ph.pairs:
+        for i in range(n):
+            for q in range(later_neighbours(i, n, cells)):
+                j = cells.near[q]
+                if b.body[i] != b.body[j]:
+                    _resolve_pair(sc, t_end, h, i, j, u_min, b, ph, state)
+    if ph.has_walls:
+        for i in range(n):
+            _resolve_border(sc, t_end, h, i, u_min, b, ph, state)
+        contain(sc, t_end, u_min, b, ph, state)

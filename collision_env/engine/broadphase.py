@@ -1,0 +1,152 @@
+"""The broad phase every mode shares: a uniform grid of cells over the scene, so that a ball meets
+only its neighbours.
+
+Cells are at least one largest ball diameter wide, so two balls that touch are always in the same
+or adjacent cells, and a ball's neighbours are in the 3 x 3 block of cells around it (Rapaport
+1980; Isobe 1999; Smallenburg 2022). Cells are numbered ``cy * nx + cx``. The grid covers the
+border, or, without one, the box around the balls' starting positions; the outermost cells reach
+to infinity (positions are clamped), so a ball far outside still has a cell and the neighbour rule
+still holds. There are at most a few cells per ball, so the grid costs O(N) memory.
+
+The grid is used only where it pays (the model-only-what-is-needed rule): with fewer than
+:data:`GRID_MIN_BALLS` balls, in stick scenes, or when ball pairs are not modelled, the grid has
+one cell and the neighbours of a ball are all the others. How each mode keeps its balls in cells
+is its own: exact mode's lists follow cell-crossing events (:mod:`~collision_env.engine.exact.grid`),
+the cheap modes rebuild theirs at every sub-step (:mod:`~collision_env.engine.stepped.cells`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ._jit import njit
+
+#: Scenes with fewer balls keep one cell (every ball is every other's neighbour): below this size
+#: the grid's bookkeeping costs more than the pairs it saves (measured by the engine benchmark).
+GRID_MIN_BALLS = 64
+#: Balls per cell exact mode's grid aims at, and the most cells it has per ball (cells are never
+#: narrower than a diameter): fewer cells cost more pair predictions per event, more cells more
+#: cell crossings (measured by the scale benchmark).
+EXACT_BALLS_PER_CELL = 0.3
+EXACT_CELLS_PER_BALL = 4
+#: The cheap modes' grid: cells at least two diameters wide, up to this many per ball.
+CHEAP_CELLS_PER_BALL = 4
+#: Cells are this much wider than the largest diameter, so that round-off in a ball's position at
+#: a cell boundary can never hide a neighbour.
+CELL_MARGIN = 1.0 + 1e-6
+
+
+def grid_geometry(bounds, positions, radii, use_grid, reach=1.0, balls_per_cell=1.0, cells_per_ball=1):
+    """Per-scene grid ``(x0, y0, hx, hy)`` and ``(nx, ny)`` for ``(B, N, 2)`` positions and
+    ``(B, N)`` radii; scenes with ``use_grid`` False get a single cell. The cells are at least
+    ``reach * CELL_MARGIN`` largest diameters wide, hold about ``balls_per_cell`` balls each, and
+    number at most ``cells_per_ball`` per ball. The cheap modes use ``reach = 2``: their grid is
+    built before a sub-step's overlaps are pushed apart, and a pushed ball must still find the
+    balls it now overlaps. Exact mode uses :data:`EXACT_BALLS_PER_CELL` and
+    :data:`EXACT_CELLS_PER_BALL`."""
+    n_scenes, n = radii.shape
+    if bounds is not None:
+        lo = np.broadcast_to(np.array(bounds[:2], dtype=np.float64), (n_scenes, 2))
+        hi = np.broadcast_to(np.array(bounds[2:], dtype=np.float64), (n_scenes, 2))
+    else:
+        r = radii[..., None]
+        lo = (positions - r).min(axis=1)
+        hi = (positions + r).max(axis=1)
+    size = hi - lo
+    sigma = 2.0 * reach * radii.max(axis=1) * CELL_MARGIN
+    # about one ball per cell, but never narrower than a diameter
+    width = np.maximum(sigma, np.sqrt(balls_per_cell * size[:, 0] * size[:, 1] / n))
+    most = cells_per_ball * n
+    counts = np.ones((n_scenes, 2), dtype=np.int64)
+    if use_grid:
+        for axis in range(2):
+            c = np.floor(size[:, axis] / width)
+            counts[:, axis] = np.clip(np.nan_to_num(c, nan=1.0, posinf=1.0), 1, most).astype(np.int64)
+        # a thin box: cells along its long axis alone
+        while np.any(counts[:, 0] * counts[:, 1] > most):
+            over = counts[:, 0] * counts[:, 1] > most
+            big = np.argmax(counts, axis=1)
+            counts[over, big[over]] -= 1
+    cell = np.where(counts > 1, size / counts, np.inf)  # one cell along an axis: no boundary there
+    return np.concatenate([lo, cell], axis=1), counts
+
+
+@njit(inline="always")
+def _axis_cell(x, x0, h, n_cells):
+    f = (x - x0) / h
+    if not f > 0.0:  # (also the one-cell case, h = inf)
+        return 0
+    if f >= n_cells:
+        return n_cells - 1
+    return int(f)
+
+
+@njit
+def cell_of(x, y, x0, y0, hx, hy, nx, ny):
+    """The cell holding point ``(x, y)`` (clamped into the grid)."""
+    return _axis_cell(y, y0, hy, ny) * nx + _axis_cell(x, x0, hx, nx)
+
+
+@njit
+def block(c, nx, ny):
+    """The 3 x 3 block of cells around cell ``c``: ``(cx0, cx1, cy0, cy1)``, inclusive."""
+    cx = c % nx
+    cy = c // nx
+    return max(cx - 1, 0), min(cx + 1, nx - 1), max(cy - 1, 0), min(cy + 1, ny - 1)
+
+
+@njit
+def first_overlap(pos, radius, rtol):
+    """The first pair ``(i, j)``, ``i < j`` in lexicographic order, whose disks overlap by more than
+    ``rtol`` of their radii sum, or ``(-1, -1)``; O(N) expected time on a grid of the balls' box."""
+    n = pos.shape[0]
+    if n < 2:
+        return -1, -1
+    x0 = pos[0, 0]
+    y0 = pos[0, 1]
+    x1 = x0
+    y1 = y0
+    r_max = 0.0
+    for i in range(n):
+        x0 = min(x0, pos[i, 0])
+        x1 = max(x1, pos[i, 0])
+        y0 = min(y0, pos[i, 1])
+        y1 = max(y1, pos[i, 1])
+        r_max = max(r_max, radius[i])
+    h = 2.0 * r_max * CELL_MARGIN
+    nx = min(max(int((x1 - x0) / h), 1), n)
+    ny = min(max(int((y1 - y0) / h), 1), max(n // nx, 1))
+    hx = (x1 - x0) / nx if nx > 1 else math.inf
+    hy = (y1 - y0) / ny if ny > 1 else math.inf
+    hx = max(hx, h)
+    hy = max(hy, h)
+    head = np.full(nx * ny, -1, dtype=np.int64)
+    nxt = np.empty(n, dtype=np.int64)
+    cell = np.empty(n, dtype=np.int64)
+    for i in range(n - 1, -1, -1):
+        c = cell_of(pos[i, 0], pos[i, 1], x0, y0, hx, hy, nx, ny)
+        cell[i] = c
+        nxt[i] = head[c]
+        head[c] = i
+    best_i = -1
+    best_j = -1
+    for i in range(n):
+        cx0, cx1, cy0, cy1 = block(cell[i], nx, ny)
+        for cy in range(cy0, cy1 + 1):
+            for cx in range(cx0, cx1 + 1):
+                j = head[cy * nx + cx]
+                while j >= 0:
+                    if j > i:
+                        dx = pos[j, 0] - pos[i, 0]
+                        dy = pos[j, 1] - pos[i, 1]
+                        sigma = radius[i] + radius[j]
+                        if math.sqrt(dx * dx + dy * dy) < sigma * (1.0 - rtol):
+                            if best_i < 0 or j < best_j:
+                                best_i = i
+                                best_j = j
+                    j = nxt[j]
+        if best_i >= 0:
+            return best_i, best_j
+    return -1, -1

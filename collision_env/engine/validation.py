@@ -1,0 +1,236 @@
+"""Checks of everything a user hands the engine, before anything changes.
+
+Every public entry point of :class:`~collision_env.engine.BatchSimulator` runs its input through
+these functions first, so that bad input raises a ``ValueError`` naming the ball and the field and
+leaves the state as it was. Values are type-checked (numpy scalar types are numbers; booleans,
+strings and complex numbers are refused), and values the engine cannot represent are refused too
+(positions and speeds beyond :data:`MAX_MAGNITUDE`, masses whose inverse overflows, radii below
+float64's resolution at the scene's coordinates, a ball with no room to move in the box, a step
+that would fly a ball out of range).
+"""
+
+from __future__ import annotations
+
+import numbers
+from collections.abc import Callable
+
+import numpy as np
+
+from .broadphase import first_overlap
+from .physics.tolerance import CONTACT_RTOL, EPS, roundoff
+from .scene import CONSTANT_RADIUS, Scene, radius_from_mass
+
+#: Relative tolerance for "touching" in the start-state checks (exact contact is allowed).
+START_CONTACT_RTOL = 1e-12
+#: Largest position (m), speed (m/s) and |dt| (s) accepted: squares and sums of these stay finite in
+#: float64 (the time-of-impact kernels square separations and relative velocities).
+MAX_MAGNITUDE = 1e150
+#: A radius must span this many units in the last place of the scene's coordinates: contact is then
+#: resolved to better than 1e-4 of the radius (``tolerance.contact_tolerance``) anywhere in the scene.
+MIN_RADIUS_ULPS = 2.0**16
+
+
+def is_real(x) -> bool:
+    """A real number that is not a boolean (Python or numpy scalar types alike)."""
+    return isinstance(x, numbers.Real) and not isinstance(x, (bool, np.bool_))
+
+
+def real_number(value, field: str) -> float:
+    """``value`` as a float: a real number (numpy scalar types included), not a boolean or a string."""
+    if isinstance(value, float):  # the common case (np.float64 too), at the cost of one test
+        return value
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value[()]
+    if not is_real(value):
+        raise ValueError(
+            f"{field}: expected a number (real, not a boolean or a string), got {value!r} ({type(value).__name__})"
+        )
+    return float(value)
+
+
+def positive_integer(value, field: str) -> int:
+    """``value`` as an int: a whole number of at least 1 (not a boolean)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral) or value < 1:
+        raise ValueError(f"{field}: must be a positive integer, got {value!r}")
+    return int(value)
+
+
+def check_seconds(value: float, field: str) -> None:
+    """A time or a step (s), already a float: finite and at most :data:`MAX_MAGNITUDE`."""
+    if not abs(value) <= MAX_MAGNITUDE:
+        raise ValueError(f"{field}: must be finite and at most {MAX_MAGNITUDE:g} s, got {value}")
+
+
+def real_array(value, shapes: list, field: str, where: Callable) -> np.ndarray:
+    """A float64 copy of ``value``: real numbers (no booleans, strings or complex numbers) in one of
+    ``shapes``. ``where(index)`` names the ball of an element (for the error message)."""
+    if isinstance(value, np.ndarray) and value.dtype.kind in "iuf":
+        arr = value.astype(np.float64)
+    else:
+        try:
+            obj = np.array(value, dtype=object)
+        except ValueError:
+            raise ValueError(
+                f"{field}: expected real numbers of shape {' or '.join(map(str, shapes))}, got a ragged sequence"
+            ) from None
+        if obj.shape in shapes:
+            for index, x in np.ndenumerate(obj):
+                if not is_real(x):
+                    raise ValueError(
+                        f"{where(index)}{field} must be real numbers (not booleans, strings or complex), "
+                        f"got {x!r} ({type(x).__name__})"
+                    )
+        arr = obj.astype(np.float64) if obj.shape in shapes else obj
+    if arr.shape not in shapes:
+        raise ValueError(f"{field}: expected shape {' or '.join(map(str, shapes))}, got {arr.shape}")
+    return arr
+
+
+class Labels:
+    """How errors name a ball: ``"scene s, ball i: "`` in a batch, ``"ball i: "`` in a batch of one."""
+
+    def __init__(self, n_scenes: int):
+        self.n_scenes = n_scenes
+
+    def __call__(self, sc, ball=None) -> str:
+        where = f"scene {sc}, " if self.n_scenes > 1 else ""
+        return f"{where}ball {ball}: " if ball is not None else (f"scene {sc}: " if self.n_scenes > 1 else "")
+
+
+def checked_balls(scene: Scene, label: Labels, scenes, n: int, positions, velocities, masses, radii) -> tuple:
+    """Validate and return float64 copies ``(pos, vel, mass, radius)`` of the balls of ``scenes``
+    (indices into the batch), ``n`` balls each (raises ValueError)."""
+    k = len(scenes)
+
+    def where(index):
+        return label(scenes[index[0]], index[1]) if len(index) > 1 else label(scenes[0], index[0])
+
+    pos = real_array(positions, [(k, n, 2)], "positions", where)
+    vel = real_array(velocities, [(k, n, 2)], "velocities", where)
+    if masses is None:
+        raise ValueError(f"masses: expected shape ({n},) or ({k}, {n}), got None")
+    m = np.broadcast_to(real_array(masses, [(n,), (k, n)], "masses", where), (k, n)).copy()
+    if radii is None:
+        r = radius_from_mass(m)
+    elif isinstance(radii, str):
+        if radii != "constant":
+            raise ValueError(f"radii: expected None, 'constant' or an array, got {radii!r}")
+        r = np.full((k, n), CONSTANT_RADIUS)
+    else:
+        r = np.broadcast_to(real_array(radii, [(n,), (k, n)], "radii", where), (k, n)).copy()
+
+    def fail(mask, message):
+        bad = np.argwhere(mask)
+        if len(bad):
+            s, i = bad[0][0], bad[0][1]
+            raise ValueError(label(scenes[s], i) + message(s, i))
+
+    big = MAX_MAGNITUDE
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        speed = np.hypot(vel[..., 0], vel[..., 1])
+        fail(
+            ~(np.abs(pos) <= big).all(-1),
+            lambda s, i: f"position must be finite, within {big:g} m, got {tuple(pos[s, i])}",
+        )
+        fail(
+            ~(np.abs(vel) <= big).all(-1) | ~(speed <= big),
+            lambda s, i: f"velocity must be finite, speed within {big:g} m/s, got {tuple(vel[s, i])}",
+        )
+        fail(
+            ~(np.isfinite(m) & (m > 0) & np.isfinite(1.0 / m)),
+            lambda s, i: f"mass must be positive and finite, with a finite inverse, got {m[s, i]}",
+        )
+        fail(
+            ~np.isfinite(0.5 * m * speed * speed),
+            lambda s, i: f"velocity {tuple(vel[s, i])} gives mass {m[s, i]} a kinetic energy beyond float64",
+        )
+    fail(~(np.isfinite(r) & (r > 0) & (r <= big)), lambda s, i: f"radius must be positive and finite, got {r[s, i]}")
+    # the coordinates' magnitude in each scene: the border, or the balls' own extent
+    extent = np.max(np.abs(pos) + r[..., None], axis=(1, 2))
+    if scene.bounds is not None:
+        extent = np.maximum(extent, max(abs(v) for v in scene.bounds))
+    smallest = MIN_RADIUS_ULPS * EPS * extent
+    fail(
+        r < smallest[:, None],
+        lambda s, i: (
+            f"radius {r[s, i]:.6g} m is too small for float64 to resolve its "
+            f"contacts at coordinates of {extent[s]:.6g} m "
+            f"(at least {smallest[s]:.3g} m)"
+        ),
+    )
+    if scene.dimension == 1:
+        fail(pos[..., 1] != 0.0, lambda s, i: f"position y must be 0 in a 1D scene, got {pos[s, i, 1]}")
+        fail(vel[..., 1] != 0.0, lambda s, i: f"velocity y must be 0 in a 1D scene, got {vel[s, i, 1]}")
+    if scene.bounds is not None:
+        xmin, ymin, xmax, ymax = scene.bounds
+        # a ball needs room to move across the box: more than the contact tolerance of the walls
+        for lo, hi, name in ((xmin, xmax, "width"), (ymin, ymax, "height"))[: scene.dimension]:
+            room = (hi - lo) - 2.0 * r
+            fail(
+                room <= CONTACT_RTOL * 2.0 * r + roundoff(extent[:, None]),
+                lambda s, i, size=hi - lo, name=name: (
+                    f"radius {r[s, i]:.6g} m leaves no room to move: its "
+                    f"diameter is the box {name} {size:.6g} m or more"
+                ),
+            )
+        tol = START_CONTACT_RTOL * r + roundoff(np.abs(pos).max(-1))
+        out = (pos[..., 0] - r < xmin - tol) | (pos[..., 0] + r > xmax + tol)
+        if scene.dimension == 2:
+            out |= (pos[..., 1] - r < ymin - tol) | (pos[..., 1] + r > ymax + tol)
+        fail(
+            out,
+            lambda s, i: (
+                f"position must keep the ball inside the reflecting border {scene.bounds}, "
+                f"got {tuple(pos[s, i])} with radius {r[s, i]:.6g}"
+            ),
+        )
+    if scene.ball_collisions and n > 1:
+        for s_ in range(k):
+            i, j = first_overlap(pos[s_], r[s_], START_CONTACT_RTOL)
+            if i >= 0:
+                dist = float(np.hypot(*(pos[s_, i] - pos[s_, j])))
+                raise ValueError(
+                    f"{label(scenes[s_], i)}position overlaps ball {j} "
+                    f"(centres {dist:.6g} m apart, radii sum to {r[s_, i] + r[s_, j]:.6g} m)"
+                )
+    return pos, vel, m, r
+
+
+def check_reach(pos: np.ndarray, vel: np.ndarray, dt: float, label: Labels) -> None:
+    """Without a border, a step of ``dt`` must keep every ball within the representable range."""
+    reach = np.abs(pos).max(-1) + np.hypot(vel[..., 0], vel[..., 1]) * abs(dt)
+    if not (reach <= MAX_MAGNITUDE).all():
+        s, i = np.argwhere(~(reach <= MAX_MAGNITUDE))[0]
+        raise ValueError(
+            f"dt: a step of {dt:g} s would take {label(s, i).rstrip(': ')} beyond "
+            f"{MAX_MAGNITUDE:g} m (no border), where positions are no longer representable"
+        )
+
+
+def checked_nudge(dv, scene: Scene, vel, mass, label: Labels) -> np.ndarray:
+    """``dv`` as a float64 ``(B, N, 2)`` velocity change: finite, 0 along y in 1D, and giving speeds
+    that stay representable (bounded through the clusters' spin by the largest change of any of
+    their members: a rigid impulse moves no point faster than that)."""
+    n_scenes, n = mass.shape
+    dv = real_array(dv, [(n_scenes, n, 2)], "nudge", lambda index: label(*index[:2]))
+    # one cheap test on the common path; find the culprit only when there is one
+    if not (np.abs(dv) <= MAX_MAGNITUDE).all():
+        s, i = np.argwhere(~(np.abs(dv) <= MAX_MAGNITUDE).all(-1))[0]
+        raise ValueError(f"{label(s, i)}nudge must be finite, within {MAX_MAGNITUDE:g} m/s, got {tuple(dv[s, i])}")
+    if scene.dimension == 1 and dv[..., 1].any():
+        s, i = np.argwhere(dv[..., 1] != 0.0)[0]
+        raise ValueError(f"{label(s, i)}nudge y must be 0 in a 1D scene, got {dv[s, i, 1]}")
+    if scene.sticky:
+        most = np.abs(dv).max(axis=(1, 2), keepdims=True)[..., 0]
+        limit = np.abs(vel).max(-1) + np.broadcast_to(most, mass.shape) * n
+    else:
+        limit = np.abs(vel + dv).max(-1)
+    with np.errstate(over="ignore"):
+        bad = ~(limit <= MAX_MAGNITUDE / 2) | ~np.isfinite(mass * limit * limit)
+    if bad.any():
+        s, i = np.argwhere(bad)[0]
+        raise ValueError(
+            f"{label(s, i)}nudge {tuple(dv[s, i])} would give a speed beyond the representable "
+            f"range (speeds up to {MAX_MAGNITUDE:g} m/s, finite kinetic energy)"
+        )
+    return dv
