@@ -15,6 +15,8 @@ Every section is a module with a ``main(argv)``, runnable on its own
   memory per disk, and the validity of each run.
 - :mod:`.misses`: the cache lines an event of that gas misses, by array, counted on the Python path
   through a model of one cache (where the cost per event of a large gas comes from).
+- :mod:`.compile`: the CPU seconds numba takes with empty caches: a first step, a first env step,
+  every kernel.
 
 What they share:
 
@@ -33,4 +35,5 @@ SECTIONS: dict[str, tuple[str, str]] = {
     "extremes": ("collision_env.bench.extremes", "every mode over the stress grid"),
     "scale": ("collision_env.bench.scale", "exact mode on gases of 10^2 to 10^5 disks: events/s, memory, validity"),
     "misses": ("collision_env.bench.misses", "cache lines missed per event of a gas, by array (a cache model)"),
+    "compile": ("collision_env.bench.compile", "CPU seconds numba takes with empty caches, per kernel family"),
 }

@@ -290,8 +290,10 @@ def njit(func=None, *, refcount=True, label=None, **options):
         return lambda f: njit(f, refcount=refcount, label=label, **options)
     if not HAVE_NUMBA:
         return func
-    # set explicitly, so that a kernel called from a ``refcount=False`` one does not inherit it
+    # set explicitly, so that a kernel called from a ``refcount=False`` (or ``forceinline``) one does
+    # not inherit it
     options["_nrt"] = bool(refcount)
+    options.setdefault("forceinline", False)
     if not (_in_package(func) or Path(func.__code__.co_filename).is_file()):
         return _numba.njit(nogil=True, **options)(func)  # (no file to key a cache on: ``python -c``)
     dispatcher = _KernelDispatcher(

@@ -83,13 +83,13 @@ def _axis_cell(x, x0, h, n_cells):
     return int(f)
 
 
-@njit
+@njit(forceinline=True)
 def cell_of(x, y, x0, y0, hx, hy, nx, ny):
     """The cell holding point ``(x, y)`` (clamped into the grid)."""
     return _axis_cell(y, y0, hy, ny) * nx + _axis_cell(x, x0, hx, nx)
 
 
-@njit
+@njit(forceinline=True)
 def block(c, nx, ny):
     """The 3 x 3 block of cells around cell ``c``: ``(cx0, cx1, cy0, cy1)``, inclusive."""
     cx = c % nx

@@ -77,7 +77,7 @@ def frames_kernel(step, label: str, frames_slot: int):
     from ``first`` up to ``last``; its ``stopped_at`` and ``stepped`` say where the run stopped,
     ``stopped_at = last`` when every frame was recorded). ``label``: what the compile notice calls it."""
 
-    @njit(label=label)
+    @njit(refcount=False, label=label)
     def kernel(h, dt, start):
         frames = start == RUN_FRAMES
         first, last = 0, 1

@@ -18,7 +18,7 @@ import numpy as np
 from .broadphase import CHEAP_CELLS_PER_BALL, EXACT_BALLS_PER_CELL, EXACT_CELLS_PER_BALL
 from .exact import scheduler
 from .scene import Scene
-from .state import EXACT_FRAMES_SLOT, SUBSTEP_FRAMES_SLOT, SubstepScratch, aligned_zeros
+from .state import EXACT_FRAMES_SLOT, SUBSTEP_FRAMES_SLOT, SubstepScratch
 from .stepped import cells, substep
 
 
@@ -29,7 +29,7 @@ class Mode(NamedTuple):
     summary: str  #: one line: what the mode does
     substeps: bool  #: takes sub-steps (its speed knob); exact mode takes only 1
     kernel: Callable  #: ``kernel(scene, n)``: the compiled stepping kernel for scenes of n balls
-    arrays: Callable  #: ``arrays(n_scenes, n)``: the bundles the kernel takes after the state
+    arrays: Callable  #: ``arrays(scene, n_scenes, n)``: the bundles the kernel takes after the state
     persistent: bool  #: the first of them persists from step to step (exact mode's calendar)
     frames_slot: int  #: where a pack holds a frames run's bundle (``state.FramesOut``)
     grid: dict  #: how ``broadphase.grid_geometry`` lays out its grid
@@ -42,15 +42,15 @@ def _exact_kind(scene: Scene, n: int) -> scheduler.Kind:
     return scheduler.scene_kind(scene.sticky, scene.elasticity, n)
 
 
-def _exact_arrays(n_scenes: int, n: int) -> tuple:
-    return scheduler.calendar_arrays(n_scenes, n, aligned_zeros), scheduler.exact_scratch(n)
+def _exact_arrays(scene: Scene, n_scenes: int, n: int) -> tuple:
+    return scheduler.calendar_arrays(_exact_kind(scene, n), n_scenes, n), scheduler.exact_scratch(n)
 
 
 def _exact_rows(scene: Scene, n: int, uses_grid: bool) -> int:
     return max(4096, 2 * scheduler.impacts_per_event(n, _exact_kind(scene, n).cascades))
 
 
-def _substep_arrays(n_scenes: int, n: int) -> tuple:
+def _substep_arrays(scene: Scene, n_scenes: int, n: int) -> tuple:
     return (SubstepScratch(np.empty(cells.scratch_size(n), dtype=np.int64)),)
 
 

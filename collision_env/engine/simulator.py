@@ -266,7 +266,7 @@ class BatchSimulator:
         self._work_i = np.zeros((n_scenes, len(WORK_I)), dtype=np.int64)
         # the mode's own arrays (exact mode's event calendar and grid, kept from step to step, and work
         # space), and its kernel for this kind of scene
-        self._mode_arrays = spec.arrays(n_scenes, n)
+        self._mode_arrays = spec.arrays(scene, n_scenes, n)
         self._kernel = spec.kernel(scene, n)
         self._invalidate(np.arange(n_scenes))
         self._alloc_work()
@@ -742,7 +742,7 @@ class BatchSimulator:
         self._spec = MODE_REGISTRY[self._mode]
         # a copy or an unpickled array has numpy's alignment
         self._balls = aligned_copy(self._balls)
-        fresh = self._spec.arrays(self._n_scenes, self._n)
+        fresh = self._spec.arrays(self.scene, self._n_scenes, self._n)
         kept = tuple(type(b)(*(aligned_copy(a) for a in b)) for b in self._mode_arrays)
         self._mode_arrays = kept + fresh[len(kept) :]
         self._kernel = self._spec.kernel(self.scene, self._n)

@@ -38,7 +38,6 @@ from .layout import (
     S_XMIN,
     S_YMAX,
 )
-from .physics.motion import ball_views
 
 #: How a call of a stepping kernel starts: it resumes the scenes a full impact buffer stopped,
 #: starts a step (exact mode re-predicts the balls that changed since the last step), starts the
@@ -134,10 +133,12 @@ class Physics(NamedTuple):
 
 
 @njit(inline="always")
-def scene_balls(state, sc):
-    """Scene ``sc``'s :class:`SceneBalls` (views of the batch's state)."""
-    pos, vel, mass, inv_mass, radius, omega = ball_views(state.balls)
-    return SceneBalls(pos[sc], vel[sc], mass[sc], inv_mass[sc], radius[sc], state.body[sc], omega[sc])
+def scene_balls(views, body, sc):
+    """Scene ``sc``'s :class:`SceneBalls`, from the batch's ``ball_views`` and cluster roots (made once
+    per call of a kernel, not per scene: a view of the (B, N, 8) state costs as much as a small
+    scene's arithmetic)."""
+    pos, vel, mass, inv_mass, radius, omega = views
+    return SceneBalls(pos[sc], vel[sc], mass[sc], inv_mass[sc], radius[sc], body[sc], omega[sc])
 
 
 @njit(inline="always")

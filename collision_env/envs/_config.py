@@ -18,7 +18,7 @@ import numpy as np
 
 from collision_env.engine import MODES
 from collision_env.engine.scene import PLAY_AREA_1D, PLAY_AREA_2D, WALL_NAMES, radius_from_mass
-from collision_env.envs._layout import BALL_OBS, GLOBAL_OBS, PREDICTED_OBS, TARGET_OBS
+from collision_env.envs.task.layout import BALL_OBS, GLOBAL_OBS, PREDICTED_OBS, TARGET_OBS
 
 OBSERVATIONS = ("plain", "predicted")
 OBSERVED_BALLS = ("all", "controlled")
@@ -31,7 +31,7 @@ SCORERS = ("any", "controlled", "others", "cluster")
 LAYOUTS = ("random", "rack")
 RADIUS_RULES = ("mass", "constant")
 
-#: Number of observation entries per ball, per target slot and global (the layouts in ``_layout``).
+#: Number of observation entries per ball, per target slot and global (the layouts in ``task.layout``).
 BALL_FEATURES = len(BALL_OBS)
 TARGET_FEATURES = len(TARGET_OBS)
 GLOBAL_FEATURES = len(GLOBAL_OBS)

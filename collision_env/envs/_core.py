@@ -4,7 +4,8 @@
 (targets, scoring flags, step counters). Episodes are drawn by :class:`EpisodeSampler` from one
 ``np.random.Generator`` per scene, so a scene of the vector env and a single env seeded alike draw the
 same numbers in the same order. All physics happens in the engine; the core only turns actions into
-nudges and the engine's impact records into hits, reward and observations (see ``_kernels``).
+nudges and the engine's impact records into hits, reward and observations (the kernels of
+:mod:`collision_env.envs.task`).
 """
 
 from __future__ import annotations
@@ -13,10 +14,13 @@ import warnings
 
 import numpy as np
 
+from collision_env.engine.modes import MODES
 from collision_env.engine.scene import WALL_NAMES
-from collision_env.envs import _kernels as K
 from collision_env.envs._config import TaskConfig
-from collision_env.envs._layout import (
+from collision_env.envs.task.arrays import Engine, TaskParams, TaskState, pack
+from collision_env.envs.task.episodes import block_size, build_episodes
+from collision_env.envs.task.finish import task_kernel
+from collision_env.envs.task.layout import (
     EPISODE_FLOATS,
     EPISODE_INTS,
     PARAMS,
@@ -27,6 +31,8 @@ from collision_env.envs._layout import (
     TARGET_INTS,
     TARGET_PENDING,
 )
+from collision_env.envs.task.nudge import nudge_kernel
+from collision_env.envs.task.predict import predict_kernel
 
 
 class Impacts:
@@ -119,7 +125,7 @@ class Episodes:
 
 
 def packed(columns: tuple, dtype, **values) -> np.ndarray:
-    """A vector laid out as ``columns`` (a ``_layout`` layout) with every field given by name."""
+    """A vector laid out as ``columns`` (a ``task.layout`` layout) with every field given by name."""
     missing = sorted(set(columns._fields) - set(values))
     unknown = sorted(set(values) - set(columns._fields))
     if missing or unknown:
@@ -149,13 +155,13 @@ class EpisodeSampler:
     def __init__(self, cfg: TaskConfig):
         self.cfg = cfg
         n, k = cfg.n_balls, cfg.n_targets
-        self.M = K.block_size(n, k, PLACEMENT_TRIES)
+        self.block = block_size(n, k, PLACEMENT_TRIES)
         self.ctrl_mask = np.zeros(n, dtype=bool)
         self.ctrl_mask[list(cfg.controlled)] = True
         self.walls = np.array([WALL_NAMES.index(w) for w in cfg.target_walls], dtype=np.int64)
         xmin, ymin, xmax, ymax = cfg.bounds
         (speed_low, speed_high), (others_low, others_high) = cfg.speed_range, cfg.others_speed_range
-        self.E = packed(
+        self.episode_f = packed(
             EPISODE_FLOATS,
             np.float64,
             xmin=xmin,
@@ -170,7 +176,7 @@ class EpisodeSampler:
             window=-1.0 if cfg.window is None else cfg.window,
             time_limit=cfg.time_limit,
         )
-        self.F = packed(
+        self.episode_i = packed(
             EPISODE_INTS,
             np.int64,
             dimension=cfg.dimension,
@@ -180,29 +186,42 @@ class EpisodeSampler:
             tries=PLACEMENT_TRIES,
         )
 
-    def _build(self, U: np.ndarray) -> tuple:
+    def _build(self, uniforms: np.ndarray) -> tuple:
         cfg = self.cfg
-        r, n, k = U.shape[0], cfg.n_balls, cfg.n_targets
+        r, n, k = uniforms.shape[0], cfg.n_balls, cfg.n_targets
         lo = np.where(self.ctrl_mask, cfg.mass_range[0], cfg.others_mass_range[0])
         hi = np.where(self.ctrl_mask, cfg.mass_range[1], cfg.others_mass_range[1])
-        masses = lo + (hi - lo) * U[:, :n]
+        masses = lo + (hi - lo) * uniforms[:, :n]
         radii = cfg.radius_of(masses)
         pos = np.zeros((r, n, 2))
         vel = np.zeros((r, n, 2))
         t_wall = np.zeros((r, k), dtype=np.int64)
         t_geo = np.zeros((r, k, len(TARGET_GEOMETRY)))
         ok = np.zeros(r, dtype=bool)
-        K.build_episodes(U, self.ctrl_mask, self.walls, self.E, self.F, pos, vel, masses, radii, t_wall, t_geo, ok)
+        build_episodes(
+            uniforms,
+            self.ctrl_mask,
+            self.walls,
+            self.episode_f,
+            self.episode_i,
+            pos,
+            vel,
+            masses,
+            radii,
+            t_wall,
+            t_geo,
+            ok,
+        )
         return Episodes(pos, vel, masses, radii, t_wall, t_geo), ok
 
     def sample(self, rngs: list) -> Episodes:
-        U = np.empty((len(rngs), self.M))
+        uniforms = np.empty((len(rngs), self.block))
         for row, rng in enumerate(rngs):
-            U[row] = rng.random(self.M)
-        eps, ok = self._build(U)
+            uniforms[row] = rng.random(self.block)
+        eps, ok = self._build(uniforms)
         for row in np.flatnonzero(~ok):  # rare: draw fresh blocks for the rows that did not fit
             for _ in range(MAX_ATTEMPTS):
-                one, good = self._build(rngs[row].random(self.M)[None])
+                one, good = self._build(rngs[row].random(self.block)[None])
                 if good[0]:
                     for name in Episodes.__slots__:
                         getattr(eps, name)[row] = getattr(one, name)[0]
@@ -226,10 +245,12 @@ def sample_episode(cfg: TaskConfig, rng: np.random.Generator) -> Episodes:
 class TaskCore:
     """A batch of B task instances on one BatchSimulator.
 
-    The task state is packed into a few arrays (see ``_kernels``: ``S`` per-scene floats, ``C``
-    per-scene counters and flags, ``T`` per-target wall and status, ``t_geo`` per-target geometry,
-    ``body`` the cluster mirror), because each array a compiled kernel takes costs time to pass on
-    every step. The balls' state is the engine's own. The named properties below are views.
+    The task state is in a few packed arrays, named in :class:`~collision_env.envs.task.arrays.TaskState`
+    (``scene_f`` per-scene floats, ``scene_i`` per-scene counters and flags, ``targets`` each target's
+    wall and status, ``target_geo`` its segment and window, ``body`` the cluster mirror), handed to
+    the compiled kernels once, in one pack with the engine's arrays and the task's parameters,
+    because each array a kernel call takes costs time on every step. The balls' state is the
+    engine's own. The named properties below are views.
     """
 
     def __init__(self, cfg: TaskConfig, num_scenes: int):
@@ -246,7 +267,7 @@ class TaskCore:
             ball_collisions=cfg.ball_collisions,
         )
         xmin, ymin, xmax, ymax = cfg.bounds
-        self.P = packed(
+        params = packed(
             PARAMS,
             np.float64,
             xmin=xmin,
@@ -264,12 +285,11 @@ class TaskCore:
             max_speed=cfg.max_speed,
             action_cost=cfg.action_cost,
         )
-        self._cluster_scoring = cfg.scorers == "cluster"
-        self.Q = packed(
+        switches = packed(
             SWITCHES,
             np.int64,
             sequential=int(cfg.sequential),
-            cluster=int(self._cluster_scoring),
+            cluster=int(cfg.scorers == "cluster"),
             dimension=cfg.dimension,
             n_steps=cfg.n_steps,
             sticky=int(self.scene.sticky),
@@ -278,19 +298,19 @@ class TaskCore:
             velocity_control=int(cfg.control == "velocity"),
             predict_scoring=int(cfg.predicted_impact == "scoring"),
         )
-        self.ctrl = np.array(cfg.controlled, dtype=np.int64)
-        self.qual = cfg.scoring_mask
-        self.shown = cfg.shown_mask
+        controlled = np.array(cfg.controlled, dtype=np.int64)
+        self.params = TaskParams(params, switches, controlled, cfg.scoring_mask, cfg.shown_mask)
         self.obs_dim = cfg.obs_dim
         self.action_dim = cfg.action_dim
-
-        # task state, one row per scene
-        self.S = np.zeros((B, len(SCENE_FLOATS)))
-        self.C = np.zeros((B, len(SCENE_INTS)), dtype=np.int64)
-        self.T = np.zeros((B, Kt, len(TARGET_INTS)), dtype=np.int64)
-        self.t_geo = np.zeros((B, Kt, len(TARGET_GEOMETRY)))
-        self.body = np.tile(np.arange(N, dtype=np.int64), (B, 1))
-        self._dv = np.zeros((B, N, 2))  # scratch: the nudge (rewritten every step)
+        self.state = TaskState(
+            np.zeros((B, len(SCENE_FLOATS))),
+            np.zeros((B, len(SCENE_INTS)), dtype=np.int64),
+            np.zeros((B, Kt, len(TARGET_INTS)), dtype=np.int64),
+            np.zeros((B, Kt, len(TARGET_GEOMETRY))),
+            np.tile(np.arange(N, dtype=np.int64), (B, 1)),
+            np.zeros((B, N, 2)),
+            np.zeros((B, N), dtype=np.int64),
+        )
 
         # A placeholder layout drawn from a fixed seed builds the engine now, so that bad engine
         # arguments fail at construction; reset() overwrites every scene.
@@ -318,9 +338,24 @@ class TaskCore:
         # modes keep their sub-step length: the look-ahead takes as many sub-steps as the control steps
         # it spans would.
         self.ahead = None
-        if cfg.observe == "predicted" or self.Q[SWITCHES.aim_predicted]:
-            self.ahead = engine(1 if cfg.mode == "exact" else cfg.substeps * max(1, round(cfg.lookahead / cfg.dt)))
-        self._ahead_body = np.zeros((B, N), dtype=np.int64)
+        if cfg.observe == "predicted" or switches[SWITCHES.aim_predicted]:
+            ahead_substeps = cfg.substeps * max(1, round(cfg.lookahead / cfg.dt)) if MODES[cfg.mode].substeps else 1
+            self.ahead = engine(ahead_substeps)
+        self._pack = self._make_pack()
+
+    def _make_pack(self):
+        """The kernels' pack of the engine's arrays, the task state and its parameters."""
+        live = self.batch.live_arrays()
+        return pack(Engine(live.balls, live.time, live.clusters), self.state, self.params)
+
+    def __getstate__(self):
+        state = self.__dict__.copy()
+        del state["_pack"]  # (addresses: made again for the copy's arrays)
+        return state
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        self._pack = self._make_pack()
 
     @property
     def engines(self) -> tuple:
@@ -328,13 +363,19 @@ class TaskCore:
         return (self.batch,) if self.ahead is None else (self.batch, self.ahead)
 
     # views into the packed state (writable: they share memory with it)
-    t_wall = property(lambda self: self.T[..., TARGET_INTS.wall], doc="(B, K) target walls (engine wall codes).")
+    scene_f = property(lambda self: self.state.scene_f, doc="(B, len(SCENE_FLOATS)) per-scene floats.")
+    scene_i = property(lambda self: self.state.scene_i, doc="(B, len(SCENE_INTS)) per-scene counters and flags.")
+    target_geo = property(lambda self: self.state.target_geo, doc="(B, K, len(TARGET_GEOMETRY)) target segments.")
+    t_wall = property(lambda self: self.state.targets[..., TARGET_INTS.wall], doc="(B, K) target walls (wall codes).")
     t_status = property(
-        lambda self: self.T[..., TARGET_INTS.status],
-        doc="(B, K) 0 pending, 1 hit, 2 failed (``_layout.TARGET_PENDING`` ...).",
+        lambda self: self.state.targets[..., TARGET_INTS.status],
+        doc="(B, K) 0 pending, 1 hit, 2 failed (``task.layout.TARGET_PENDING`` ...).",
     )
-    cur = property(lambda self: self.C[:, SCENE_INTS.current], doc="(B,) index of the current (sequential) target.")
-    steps = property(lambda self: self.C[:, SCENE_INTS.steps], doc="(B,) control steps taken this episode.")
+    body = property(lambda self: self.state.body, doc="(B, N) the task's mirror of the engine's cluster roots.")
+    scoring = property(lambda self: self.params.scoring, doc="(N,) bool: the balls whose wall impacts score.")
+    cur = property(lambda self: self.state.scene_i[:, SCENE_INTS.current], doc="(B,) current (sequential) target.")
+    steps = property(lambda self: self.state.scene_i[:, SCENE_INTS.steps], doc="(B,) control steps this episode.")
+
     # the engine's state: live views, to read (the renderer and the scripted policies do, per sub-env)
     pos = property(lambda self: self.batch.live_arrays().positions, doc="(B, N, 2) ball centres, m.")
     vel = property(lambda self: self.batch.live_arrays().velocities, doc="(B, N, 2) ball velocities, m/s.")
@@ -344,12 +385,13 @@ class TaskCore:
 
     # ------------------------------------------------------------------------------------- #
     def _write_episode(self, idx: np.ndarray, eps: Episodes) -> None:
-        self.T[idx, :, TARGET_INTS.wall] = eps.t_wall
-        self.T[idx, :, TARGET_INTS.status] = TARGET_PENDING
-        self.t_geo[idx] = eps.t_geo
-        self.C[idx, SCENE_INTS.current] = 0
-        self.C[idx, SCENE_INTS.steps] = 0
-        self.body[idx] = np.arange(self.cfg.n_balls)
+        state = self.state
+        state.targets[idx, :, TARGET_INTS.wall] = eps.t_wall
+        state.targets[idx, :, TARGET_INTS.status] = TARGET_PENDING
+        state.target_geo[idx] = eps.t_geo
+        state.scene_i[idx, SCENE_INTS.current] = 0
+        state.scene_i[idx, SCENE_INTS.steps] = 0
+        state.body[idx] = np.arange(self.cfg.n_balls)
 
     def reset_scenes(self, idx: np.ndarray, rngs: list) -> None:
         """Draw a new episode for scenes ``idx`` (one generator each) and load it into the engine."""
@@ -375,41 +417,24 @@ class TaskCore:
     def advance(self, actions: np.ndarray, active: np.ndarray, dt: float) -> np.ndarray:
         """Nudge (actions (B, A) float64; inactive rows get none) and step the engine by dt.
 
-        Returns the engine's impact records; the nudge's size and cost per scene are in ``S``
-        (``nudge`` is the size, m/s). An action with NaN raises ValueError and changes nothing.
+        Returns the engine's impact records (read-only); the nudge's size per scene is in
+        ``scene_f`` (``nudge``, m/s). An action with NaN raises ValueError and changes nothing.
         """
-        live = self.batch.live_arrays()
-        # turns the actions into velocity changes and applies them (finite values, y = 0 in 1D)
-        bad = K.nudge_kernel(actions, active, live.balls, live.clusters, self.ctrl, self.P, self.Q, self._dv, self.S)
+        bad = nudge_kernel(self._pack, actions, active)
         if bad >= 0:
             where = f"sub-env {bad}: " if self.num_scenes > 1 else ""
             raise ValueError(f"{where}action contains NaN: {actions[bad].tolist()}")
-        return self.batch.step(dt)
+        imp = self.batch.step(dt)
+        imp.flags.writeable = False  # (the kernels take the records read-only: one compiled version)
+        return imp
 
     def finish(self, flags: np.ndarray, imp: np.ndarray, obs: np.ndarray) -> np.ndarray:
         """Run the task kernel on the engine's state after a step; returns ``obs`` (written in place).
 
-        ``flags``: one ``_layout.ROW_*`` code per scene. Reward, energy, targets hit and the end flags are
-        then in ``S`` and ``C`` (see :meth:`outputs`).
+        ``flags``: one ``task.layout.ROW_*`` code per scene. Reward, energy, targets hit and the end
+        flags are then in ``scene_f`` and ``scene_i`` (see :meth:`outputs`).
         """
-        live = self.batch.live_arrays()
-        K.task_kernel(
-            flags,
-            imp,
-            live.balls,
-            live.time,
-            live.clusters if self._cluster_scoring else self.body,
-            self.S,
-            self.C,
-            self.T,
-            self.t_geo,
-            self.body,
-            self.qual,
-            self.shown,
-            self.P,
-            self.Q,
-            obs,
-        )
+        task_kernel(self._pack, flags, imp, obs)
         if self.ahead is not None:
             self._predict(flags, obs)
         return obs
@@ -417,53 +442,41 @@ class TaskCore:
     def _predict(self, flags: np.ndarray, obs: np.ndarray) -> None:
         """Run a copy of the engine ``lookahead`` s ahead of every scene (no nudge): each ball's
         predicted next wall impact goes into the observation and/or the aiming potential
-        (``_kernels.predict_kernel``)."""
+        (``task.predict.predict_kernel``)."""
         from collision_env.engine import EventCapWarning
 
-        live = self.batch.live_arrays()
         self.ahead.load(self.batch)  # (its calendar too: nothing is predicted afresh)
         with warnings.catch_warnings():  # a capped look-ahead only predicts less far
             warnings.simplefilter("ignore", EventCapWarning)
             imp = self.ahead.step(self.cfg.lookahead)
-        K.predict_kernel(
-            flags,
-            imp,
-            live.time,
-            live.clusters,
-            self._ahead_body,
-            self.S,
-            self.C,
-            self.T,
-            self.t_geo,
-            self.qual,
-            self.shown,
-            self.P,
-            self.Q,
-            obs,
-        )
+        imp.flags.writeable = False
+        predict_kernel(self._pack, flags, imp, obs)
 
     def outputs(self) -> tuple:
         """Fresh ``(reward, terminated, truncated, success, targets_hit, energy, nudge)`` arrays (B,)."""
-        S, C, sf, si = self.S, self.C, SCENE_FLOATS, SCENE_INTS
+        scene_f, scene_i, sf, si = self.state.scene_f, self.state.scene_i, SCENE_FLOATS, SCENE_INTS
         return (
-            S[:, sf.reward].copy(),
-            C[:, si.terminated].astype(bool),
-            C[:, si.truncated].astype(bool),
-            C[:, si.success].astype(bool),
-            C[:, si.targets_hit].copy(),
-            S[:, sf.energy].copy(),
-            S[:, sf.nudge].copy(),
+            scene_f[:, sf.reward].copy(),
+            scene_i[:, si.terminated].astype(bool),
+            scene_i[:, si.truncated].astype(bool),
+            scene_i[:, si.success].astype(bool),
+            scene_i[:, si.targets_hit].copy(),
+            scene_f[:, sf.energy].copy(),
+            scene_f[:, sf.nudge].copy(),
         )
 
     def empty_impacts(self) -> np.ndarray:
-        """A fresh zero-length impact record array (the engine's dtype)."""
-        return np.empty(0, dtype=self.impact_dtype)
+        """A fresh zero-length impact record array (the engine's dtype; read-only, as the kernels take it)."""
+        out = np.empty(0, dtype=self.impact_dtype)
+        out.flags.writeable = False
+        return out
 
     # ------------------------------------------------------------------------------------- #
-    _TASK_FIELDS = ("S", "C", "T", "t_geo", "body")
+    #: The task state's fields that :meth:`get_state` carries (the rest is scratch).
+    _TASK_FIELDS = ("scene_f", "scene_i", "targets", "target_geo", "body")
 
     def get_state(self) -> dict:
-        state = {name: getattr(self, name).copy() for name in self._TASK_FIELDS}
+        state = {name: getattr(self.state, name).copy() for name in self._TASK_FIELDS}
         state["engine"] = self.batch.get_state()
         return state
 
@@ -474,11 +487,11 @@ class TaskCore:
         arrays = {}
         for name in self._TASK_FIELDS:  # check everything before changing anything
             arr = np.asarray(state[name])
-            if arr.shape != getattr(self, name).shape:
+            if arr.shape != getattr(self.state, name).shape:
                 raise ValueError(
-                    f"set_state: field {name!r} has shape {arr.shape}, expected {getattr(self, name).shape}"
+                    f"set_state: field {name!r} has shape {arr.shape}, expected {getattr(self.state, name).shape}"
                 )
             arrays[name] = arr
         self.batch.set_state(state["engine"])
         for name, arr in arrays.items():
-            np.copyto(getattr(self, name), arr, casting="unsafe")
+            np.copyto(getattr(self.state, name), arr, casting="unsafe")

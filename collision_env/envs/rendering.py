@@ -18,7 +18,7 @@ import os
 import numpy as np
 
 from collision_env.engine.scene import WALL_BOTTOM, WALL_LEFT, WALL_RIGHT
-from collision_env.envs._layout import TARGET_FAILED, TARGET_GEOMETRY, TARGET_HIT, TARGET_PENDING
+from collision_env.envs.task.layout import TARGET_FAILED, TARGET_GEOMETRY, TARGET_HIT, TARGET_PENDING
 
 #: Above this many balls, balls that are neither controlled nor scoring are drawn plain (a gas).
 CROWD = 16
@@ -117,7 +117,7 @@ class Renderer:
         s = y if wall in (WALL_LEFT, WALL_RIGHT) else x
         geo = TARGET_GEOMETRY
         for k in range(core.t_wall.shape[1]):
-            on_segment = abs(s - core.t_geo[b, k, geo.centre]) <= core.t_geo[b, k, geo.half_width]
+            on_segment = abs(s - core.target_geo[b, k, geo.centre]) <= core.target_geo[b, k, geo.half_width]
             if core.t_status[b, k] == TARGET_HIT and core.t_wall[b, k] == wall and on_segment:
                 return True
         return False
@@ -142,7 +142,7 @@ class Renderer:
             st = int(core.t_status[b, k])
             if cfg.sequential and st == TARGET_PENDING and k != cur:
                 continue  # later targets of a sequence are not shown yet
-            c, hw, t_open, t_close = core.t_geo[b, k]
+            c, hw, t_open, t_close = core.target_geo[b, k]
             if st == TARGET_HIT:
                 col = HIT
             elif st == TARGET_FAILED:
@@ -154,7 +154,7 @@ class Renderer:
 
         pos, vel, radii = core.pos[b], core.vel[b], core.radii[b]
         n = pos.shape[0]
-        featured = [n <= CROWD or i in cfg.controlled or bool(core.qual[i]) for i in range(n)]
+        featured = [n <= CROWD or i in cfg.controlled or bool(core.scoring[i]) for i in range(n)]
 
         # trails
         if self.trails and len(self._trail) > 1:
@@ -175,7 +175,7 @@ class Renderer:
                     pg.draw.line(surf, WALL, self._px(*pos[i]), self._px(*pos[j]), 4)
 
         # balls
-        qual = core.qual
+        qual = core.scoring
         cluster_mode = cfg.scorers == "cluster"
         for i in range(n):
             cx, cy = self._px(*pos[i])
@@ -230,7 +230,10 @@ class Renderer:
         bx, by, bw, bh = self.margin, 8, self.width - 2 * self.margin - 16 * n_t - 8, 10
         pg.draw.rect(surf, AREA, pg.Rect(bx, by, bw, bh))
         for k in range(n_t):
-            t_open, t_close = core.t_geo[b, k, TARGET_GEOMETRY.opens], core.t_geo[b, k, TARGET_GEOMETRY.closes]
+            t_open, t_close = (
+                core.target_geo[b, k, TARGET_GEOMETRY.opens],
+                core.target_geo[b, k, TARGET_GEOMETRY.closes],
+            )
             if t_open > -1e299:
                 u0 = bx + bw * max(0.0, t_open / cfg.time_limit)
                 u1 = bx + bw * min(1.0, t_close / cfg.time_limit)

@@ -34,8 +34,8 @@ from collections.abc import Callable
 import numpy as np
 
 from collision_env.engine.scene import WALL_BOTTOM, WALL_LEFT, WALL_RIGHT, WALL_TOP
-from collision_env.envs._kernels import capped_change
-from collision_env.envs._layout import TARGET_GEOMETRY, TARGET_HIT, TARGET_PENDING
+from collision_env.envs.task.layout import TARGET_GEOMETRY, TARGET_HIT, TARGET_PENDING
+from collision_env.envs.task.nudge import capped_change
 
 #: A plan: ``plan(t, env)`` is the nudge action for step ``t`` of the plan (converted for the env's
 #: control by :func:`as_env_action` when it is played).
@@ -44,7 +44,7 @@ Plan = Callable[[int, object], np.ndarray]
 
 def on_target(core, b: int, k: int, wall: int, x: float, y: float, t: float) -> bool:
     """Whether an impact at wall code ``wall``, point (x, y), time t lands on target k of scene b."""
-    c, hw, t_open, t_close = core.t_geo[b, k]
+    c, hw, t_open, t_close = core.target_geo[b, k]
     s = y if wall in (WALL_LEFT, WALL_RIGHT) else x
     return core.t_wall[b, k] == wall and abs(s - c) <= hw and t_open <= t <= t_close
 
@@ -150,7 +150,7 @@ class SteeringPolicy(AimingPolicy):
         if not pending:
             return action
         k = pending[0]
-        goal = _target_point(cfg, int(core.t_wall[0, k]), core.t_geo[0, k, TARGET_GEOMETRY.centre])
+        goal = _target_point(cfg, int(core.t_wall[0, k]), core.target_geo[0, k, TARGET_GEOMETRY.centre])
         for j, i in enumerate(cfg.controlled):
             if self.predicts_hit(i, np.zeros(2), [k]):
                 continue
@@ -253,7 +253,7 @@ def billiards_plans(env) -> list:
     pos, r = core.pos[0], core.radii[0]
     plans = []
     for k in np.flatnonzero(core.t_status[0] == TARGET_PENDING):
-        target = _target_point(cfg, int(core.t_wall[0, k]), core.t_geo[0, k, TARGET_GEOMETRY.centre])
+        target = _target_point(cfg, int(core.t_wall[0, k]), core.target_geo[0, k, TARGET_GEOMETRY.centre])
         for j in range(cfg.n_balls):
             if j in cfg.controlled:
                 continue

@@ -13,7 +13,7 @@ from numpy.typing import ArrayLike
 from collision_env.engine import BatchSimulator
 from collision_env.envs._config import PRESETS, TaskConfig, make_config
 from collision_env.envs._core import Impacts, TaskCore
-from collision_env.envs._layout import ROW_RESET, ROW_STEPPED, SCENE_FLOATS, SCENE_INTS
+from collision_env.envs.task.layout import ROW_RESET, ROW_STEPPED, SCENE_FLOATS, SCENE_INTS
 
 _CLASS_PRESET = "__class_preset__"
 
@@ -160,7 +160,7 @@ class CollisionTargetEnv(gym.Env):
 
     def _scalars(self) -> tuple:
         """This step's (reward, terminated, truncated, success, targets hit, energy, nudge) as Python values."""
-        S, C = self._core.S[0].tolist(), self._core.C[0].tolist()
+        S, C = self._core.scene_f[0].tolist(), self._core.scene_i[0].tolist()
         sf, si = SCENE_FLOATS, SCENE_INTS
         return (
             S[sf.reward],

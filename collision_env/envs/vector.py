@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike
 
 from collision_env.envs._config import TaskConfig, make_config
 from collision_env.envs._core import Impacts, TaskCore
-from collision_env.envs._layout import ROW_OBSERVE, ROW_RESET, ROW_SKIP, ROW_STEPPED
+from collision_env.envs.task.layout import ROW_OBSERVE, ROW_RESET, ROW_SKIP, ROW_STEPPED
 
 _CLASS_PRESET = "__class_preset__"
 _SCALAR_KEYS = ("event_cap", "nudge", "energy", "time", "targets_hit", "is_success")

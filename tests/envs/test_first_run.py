@@ -39,7 +39,7 @@ def test_the_hash_follows_every_kernel_source_and_nothing_else(tmp_path):
 
 def test_the_package_kernels_are_all_in_the_hash():
     names = {p.relative_to(_jit.PACKAGE_DIR).as_posix() for p in _jit.kernel_sources()}
-    assert {"engine/exact/scheduler.py", "engine/physics/toi.py", "engine/_jit.py", "envs/_kernels.py"} <= names
+    assert {"engine/exact/scheduler.py", "engine/physics/toi.py", "engine/_jit.py", "envs/task/finish.py"} <= names
     assert "envs/rendering.py" not in names
 
 

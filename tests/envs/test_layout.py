@@ -10,7 +10,7 @@ import pytest
 import collision_env
 from collision_env.engine import WALL_NAMES
 from collision_env.envs import REGISTERED, CollisionTargetEnv
-from collision_env.envs._layout import (
+from collision_env.envs.task.layout import (
     BALL_OBS,
     GLOBAL_OBS,
     PREDICTED_OBS,
@@ -159,14 +159,14 @@ def test_observation_entries_sit_where_the_layout_says(env_id):
         assert block[getattr(TARGET_OBS, f"wall_{wall}")] == 1.0 and block[TARGET_OBS.wall_left :][:4].sum() == 1.0
     tail = obs[-len(GLOBAL_OBS) :]
     assert tail[GLOBAL_OBS.steps_left] == pytest.approx(1 - int(core.steps[0]) / cfg.n_steps, abs=1e-6)
-    hit = int(core.C[0, SCENE_INTS.targets_hit])
+    hit = int(core.scene_i[0, SCENE_INTS.targets_hit])
     assert tail[GLOBAL_OBS.targets_left] == pytest.approx(1 - hit / cfg.n_targets, abs=1e-6)
 
 
 def test_architecture_notes_name_every_layout():
     from pathlib import Path
 
-    from collision_env.envs import _layout
+    from collision_env.envs.task import layout as _layout
 
     text = (Path(__file__).parents[2] / "ARCHITECTURE.md").read_text()
     names = [n for n, v in vars(_layout).items() if isinstance(v, tuple) and hasattr(type(v), "layout_rows")]

@@ -10,7 +10,7 @@ from gymnasium.utils.env_checker import check_env
 from gymnasium.vector import AutoresetMode
 
 from collision_env.envs import PRESET_IDS
-from collision_env.envs._layout import BALL_OBS, PREDICTED_OBS, SCENE_FLOATS, TARGET_GEOMETRY
+from collision_env.envs.task.layout import BALL_OBS, PREDICTED_OBS, SCENE_FLOATS, TARGET_GEOMETRY
 from tests.envs.test_vector import run_pair
 
 IDS = sorted(PRESET_IDS.values())
@@ -78,7 +78,7 @@ def test_hits_flag_says_whether_the_coasting_ball_scores():
         env.reset(seed=1)
         core = env.core
         k = int(core.cur[0])
-        wall, centre = int(core.t_wall[0, k]), core.t_geo[0, k, TARGET_GEOMETRY.centre]
+        wall, centre = int(core.t_wall[0, k]), core.target_geo[0, k, TARGET_GEOMETRY.centre]
         xmin, ymin, xmax, ymax = cfg.bounds
         r = core.radii[0, 0]
         spot = {0: (xmin + r, centre), 1: (xmax - r, centre), 2: (centre, ymin + r), 3: (centre, ymax - r)}[wall]
@@ -185,7 +185,7 @@ def test_predicted_aim_sees_through_ball_to_ball_transfer():
     vel[0, 0] = 1.5 * aim
     core.batch.set_scenes([0], core.pos[0][None].copy(), vel)
     env.step(np.zeros(2, np.float32))
-    phi = core.S[0, SCENE_FLOATS.phi]
+    phi = core.scene_f[0, SCENE_FLOATS.phi]
     assert -1.0 < phi <= 0.0
 
 
@@ -207,7 +207,7 @@ def test_scoring_prediction_looks_past_a_miss_for_the_impact_on_the_target():
         env.reset(seed=1)
         core = env.core
         k = int(core.cur[0])
-        wall, centre = int(core.t_wall[0, k]), core.t_geo[0, k, TARGET_GEOMETRY.centre]
+        wall, centre = int(core.t_wall[0, k]), core.target_geo[0, k, TARGET_GEOMETRY.centre]
         side = wall < 2  # a target on the left or right wall
         position = np.array([0.0, centre] if side else [centre, 0.0])
         away = np.array([1.0, 0.0] if side else [0.0, 1.0]) * (1.0 if wall % 2 == 0 else -1.0)
@@ -216,7 +216,7 @@ def test_scoring_prediction_looks_past_a_miss_for_the_impact_on_the_target():
         obs, *_ = env.step(zero)
         now = env.core.time[0]
         blocks[which] = block = _predicted(obs, 1)[0]
-        phis[which] = core.S[0, SCENE_FLOATS.phi]  # minus the distance from the nearest impact to the target
+        phis[which] = core.scene_f[0, SCENE_FLOATS.phi]  # minus the distance from the nearest impact to the target
         if which == "next":
             assert block[PREDICTED_OBS.hits] == 0.0
             continue

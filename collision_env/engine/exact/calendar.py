@@ -65,12 +65,12 @@ EV_CROSS = -5
 EV_NONE = -9
 
 
-@njit
+@njit(forceinline=True)
 def is_wall(code):
     return EV_CROSS < code <= EV_WALL
 
 
-@njit
+@njit(forceinline=True)
 def is_crossing(code):
     return EV_NONE < code <= EV_CROSS
 
@@ -79,7 +79,7 @@ def is_crossing(code):
 _LAST = 1 << 62
 
 
-@njit
+@njit(forceinline=True)
 def order_key(ball, code):
     """Where ``ball``'s event ``code`` stands among events at the same instant: ``(lead, rank)``.
 
@@ -96,7 +96,7 @@ def order_key(ball, code):
     return ball, _LAST if is_crossing(code) else _LAST + 1
 
 
-@njit
+@njit(forceinline=True)
 def earlier(t, code, t_other, code_other, ball):
     """For ``ball``: candidate event ``(t, code)`` comes strictly before ``(t_other, code_other)``."""
     if t != t_other:
@@ -106,7 +106,7 @@ def earlier(t, code, t_other, code_other, ball):
     return lead < lead_other or (lead == lead_other and rk < rk_other)
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _before(ta, a, tb, b, ci):
     """Ball ``a``'s event at ``ta`` comes before ball ``b``'s at ``tb`` (ties: see
     :func:`order_key`, then the ball)."""
@@ -180,24 +180,24 @@ def heap_rows(n):
 
 # The heap lives in ``hp`` (``layout.HEAP``: the event time and the ball of each slot), so that
 # sifting reads neighbouring rows instead of chasing every ball's own row.
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _place(slot, ball, t, ci, hp):
     hp[slot + HEAP_OFFSET, H_TIME] = t
     hp[slot + HEAP_OFFSET, H_BALL] = ball
     ci[ball, C_QUEUE_SLOT] = slot
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _ball_at(slot, hp):
     return np.int64(hp[slot + HEAP_OFFSET, H_BALL])
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _time_at(slot, hp):
     return hp[slot + HEAP_OFFSET, H_TIME]
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _sift_up(slot, rec, ci, hp):
     ball = _ball_at(slot, hp)
     t = rec[ball]["event_time"]
@@ -213,14 +213,14 @@ def _sift_up(slot, rec, ci, hp):
     return slot
 
 
-@njit
+@njit(forceinline=True)
 def _earlier_of(ca, ta, cb, tb):
     """Of two children ``(slot, time)``, the one whose time comes first (``a`` on a tie; ties are
     settled by :func:`_first_child`'s full order)."""
     return (cb, tb) if tb < ta else (ca, ta)
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _first_child(first, n, ci, hp):
     """The child slot (of ``first`` ... ``first + ARITY - 1``) whose event comes first, and its time."""
     if first + ARITY <= n:
@@ -252,7 +252,7 @@ def _first_child(first, n, ci, hp):
     return child, t_child
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _sift_down(slot, n, ci, hp):
     """Move the ball at ``slot`` down to its place in a heap of ``n`` (its time is the one held in
     the heap; a ball already in place is not written again, so ordering a heap that is in order
@@ -281,7 +281,7 @@ def _heapify(n, ci, hp):
         _sift_down(slot, n, ci, hp)
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _heap_push(ball, t, rec, ci, q):
     size = q.qi[W_QUEUE_HEAP]
     _place(size, ball, t, ci, q.hp)
@@ -289,7 +289,7 @@ def _heap_push(ball, t, rec, ci, q):
     _sift_up(size, rec, ci, q.hp)
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _vacate(slot, size, ci, hp):
     """Take the event at ``slot`` out of a heap of ``size``: the last event fills its place, out of
     order until the caller sifts it or re-orders the heap. Returns the new size."""
@@ -299,18 +299,18 @@ def _vacate(slot, size, ci, hp):
     return size
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _ring_size(q):
     return q.buckets.shape[0] - 1
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _heap_size(rec, q):
     """Events in the heap: every ball's without buckets (read without touching the counts)."""
     return rec.shape[0] if _ring_size(q) == 0 else q.qi[W_QUEUE_HEAP]
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _position(t, q):
     """Where an event at step time ``t`` is queued: -1 the heap, ``0 .. R - 1`` a bucket of the
     ring, ``R`` the far list (R = 0: no buckets, always the heap)."""
@@ -326,7 +326,7 @@ def _position(t, q):
     return ring  # (also an event that never comes, t = inf)
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _link(ball, p, ci, q):
     """Put ``ball``'s event at the front of list ``p`` (a bucket, or the far list)."""
     head = q.buckets[p]
@@ -339,7 +339,7 @@ def _link(ball, p, ci, q):
     q.qi[W_QUEUE_FAR if p == _ring_size(q) else W_QUEUE_RING] += 1
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _unlink(ball, ci, q):
     """Take ``ball``'s event out of its list."""
     p = -1 - ci[ball, C_QUEUE_SLOT]
@@ -354,7 +354,7 @@ def _unlink(ball, ci, q):
     q.qi[W_QUEUE_FAR if p == _ring_size(q) else W_QUEUE_RING] -= 1
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _file(ball, p, rec, ci, q):
     """Queue ``ball``'s event (in no list yet) at position ``p`` (see :func:`_position`)."""
     if p < 0:
@@ -363,13 +363,13 @@ def _file(ball, p, rec, ci, q):
         _link(ball, p, ci, q)
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def heap_schedule(ball, rec, ci, q):
     """:func:`schedule` in a queue without buckets (a heap of every ball)."""
     _sift_down(_sift_up(ci[ball, C_QUEUE_SLOT], rec, ci, q.hp), rec.shape[0], ci, q.hp)
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def schedule(ball, rec, ci, q):
     """Move ``ball``'s event to its place in the queue after its time changed (either way)."""
     t = rec[ball]["event_time"]
@@ -452,14 +452,14 @@ def _open_next_bucket(rec, ci, q):
     return True
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def prefetch_int_row(ball, ci):
     """Ask for ``ball``'s int row (both ends: a row of seven int32 may straddle two cache lines)."""
     prefetch(ci, (ball, 0))
     prefetch(ci, (ball, ci.shape[1] - 1))
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def walk_next_bucket(cursor, rec, ci, q):
     """One step down the list of the bucket that opens next, asking for the rows of the ball it
     reaches. Opening a bucket chases its list, one dependent load per ball, each a miss at 10^5
@@ -478,7 +478,7 @@ def walk_next_bucket(cursor, rec, ci, q):
     return ball
 
 
-@njit
+@njit(forceinline=True)
 def no_walk(cursor, rec, ci, q):
     """:func:`walk_next_bucket` in a queue without buckets: there is no bucket to walk."""
     return -1
@@ -495,13 +495,13 @@ def _refill_heap(rec, ci, q):
     return True
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def heap_first(rec, ci, q):
     """:func:`next_ball` in a queue without buckets (a heap of every ball)."""
     return _ball_at(0, q.hp)
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def next_ball(rec, ci, q):
     """The ball whose event comes first (-1: none is queued but events that never come)."""
     if _heap_size(rec, q) == 0 and not _refill_heap(rec, ci, q):
@@ -600,7 +600,7 @@ def _refile(n, rec, ci, q):
     return moved
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _rebase_heap(size, t, hp):
     """Subtract ``t`` from the heap's times; True if round-off made a node and its parent tie (see
     :func:`rebase_queue`)."""
@@ -614,14 +614,14 @@ def _rebase_heap(size, t, hp):
     return disorder
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def heap_rebase(n, t, rec, ci, q):
     """:func:`rebase_queue` in a queue without buckets."""
     if _rebase_heap(n, t, q.hp):
         _heapify(n, ci, q.hp)
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def rebase_queue(n, t, rec, ci, q):
     """Make the queue's times relative to step time ``t``, after every ball's event time was (the
     caller's): the heap's times and the buckets' base are rebased the same way. Round-off can move
@@ -637,7 +637,7 @@ def rebase_queue(n, t, rec, ci, q):
         _heapify(_heap_size(rec, q), ci, q.hp)
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def set_event(ball, t, code, stamp, rec, ci):
     """Give ``ball`` the pending event ``(t, code)`` (``stamp``: the partner's change count);
     the caller queues it (:func:`schedule`, or :func:`reset_queue` for every ball)."""
@@ -646,7 +646,7 @@ def set_event(ball, t, code, stamp, rec, ci):
     ci[ball, C_EVENT_STAMP] = stamp
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def is_stale(ball, rec, ci):
     """A pair event whose partner's trajectory changed after it was predicted."""
     other = ci[ball, C_EVENT_OTHER]

@@ -27,7 +27,7 @@ from . import calendar as cal
 from .trajectories import load
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _copy_kinematics(i, b, out):
     """Ball ``i``'s rigid kinematics (``motion.body_kinematics``) into ``out`` (7 floats)."""
     k = body_kinematics(i, b.pos, b.vel, b.mass, b.body, b.omega)
@@ -35,7 +35,7 @@ def _copy_kinematics(i, b, out):
         out[q] = k[q]
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _pair_time(i, k, now, horizon, b, wk):
     """When balls ``i`` and ``k`` (of different clusters) touch, from the ball state at ``now``."""
     pos, vel, body, omega = b.pos, b.vel, b.body, b.omega
@@ -54,7 +54,7 @@ def _pair_time(i, k, now, horizon, b, wk):
     )
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _wall_time(i, now, horizon, b, ph, wk):
     """When ball ``i`` first touches a wall, from the ball state at ``now``: ``(time, wall)``."""
     if b.omega[b.body[i]] != 0.0:
@@ -67,7 +67,7 @@ def _wall_time(i, now, horizon, b, ph, wk):
     return now + tau, wall
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def next_event(i, now, horizon, rebuild, b, cl, ph, wk):
     """Ball ``i``'s next event in a scene with a rotating cluster, from the ball state (which stick
     scenes keep at ``now``): ``(time, code, partner's change count)``, as the scheduler's
@@ -91,7 +91,7 @@ def next_event(i, now, horizon, rebuild, b, cl, ph, wk):
     return best_t, best_code, best_stamp
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def sync_all(t, b, rot, rec):
     """Bring every ball to step time ``t`` (rigid rotation for spinning clusters), in the ball state
     and in the records alike."""
@@ -102,7 +102,7 @@ def sync_all(t, b, rot, rec):
             load(k, t, rec, b.pos, b.vel, k)
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _list_cluster(root, body, involved):
     """The balls of the cluster rooted at ``root``, into ``involved``; returns how many."""
     n_inv = 0
@@ -113,7 +113,7 @@ def _list_cluster(root, body, involved):
     return n_inv
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def resolve_wall(sc, t_abs, bi, wall, b, ph, wk):
     """Ball ``bi`` meets ``wall`` (the whole ball state ``b``): if it touches it and moves into it,
     its cluster stops dead and comes apart. Returns how many balls' motion it changed (listed in
@@ -132,7 +132,7 @@ def resolve_wall(sc, t_abs, bi, wall, b, ph, wk):
     return n_inv
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def resolve_pair(sc, t_abs, bi, bj, b, wk):
     """Balls ``bi`` and ``bj`` meet (the whole ball state ``b``): if they touch and close, their
     clusters stick into one. Returns how many balls' motion it changed (listed in ``wk.pending``)."""

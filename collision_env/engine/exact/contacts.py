@@ -59,7 +59,7 @@ def cascade(sc, t_abs, i0, j0, b, ph, wk):
     return size
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _gather_group(i0, j0, pos, radius, pairs, group, in_group):
     """Every ball connected to the impact's balls through contacts, into ``group``, breadth first;
     returns how many."""
@@ -84,7 +84,7 @@ def _gather_group(i0, j0, pos, radius, pairs, group, in_group):
     return size
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _list_contacts(i0, j0, size, b, ph, wk):
     """The group's contacts, each once, in a fixed order (``wk.c_a``, ``wk.c_b``; ``wk.c_hit`` marks
     the impact's own); returns how many."""
@@ -110,7 +110,7 @@ def _list_contacts(i0, j0, size, b, ph, wk):
     return n_contacts
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _sweep(sc, t_abs, n_contacts, u_min, b, ph, wk):
     """Sweep the contacts, applying each one's impulse, until a sweep changes nothing (True) or
     :data:`MAX_SWEEPS` sweeps have (False)."""
@@ -132,7 +132,7 @@ def _sweep(sc, t_abs, n_contacts, u_min, b, ph, wk):
     return False
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _contact_normal(c, c_a, c_b, pos):
     """Unit normal of contact ``c``, pointing from ball ``c_a[c]`` to its partner (ball or wall)."""
     a = c_a[c]
@@ -145,7 +145,7 @@ def _contact_normal(c, c_a, c_b, pos):
     return wall_normal(-1 - other)
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _record_contact(sc, t_abs, c, speed, b, ph, wk):
     """Report contact ``c`` of a group the first time it takes an impulse."""
     if wk.c_hit[c]:

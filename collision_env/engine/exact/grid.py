@@ -62,7 +62,7 @@ def near_border(c, geo):
     return cx == 0 or cx == geo.nx - 1 or cy == 0 or cy == geo.ny - 1
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def link(i, c, rec, ci, heads):
     """Put ball ``i`` at the front of cell ``c``'s list."""
     head = heads[c]
@@ -74,7 +74,7 @@ def link(i, c, rec, ci, heads):
     heads[c] = i
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def unlink(i, rec, ci, heads):
     """Take ball ``i`` out of its cell's list."""
     prev = ci[i, C_CELL_PREV]
@@ -87,7 +87,7 @@ def unlink(i, rec, ci, heads):
         ci[nxt, C_CELL_PREV] = prev
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def move_to_cell(i, c, rec, ci, heads):
     """Move ball ``i`` into cell ``c`` (nothing to do if it is there already)."""
     if c != ci[i, C_CELL]:
@@ -104,7 +104,7 @@ def fill_cells(n, rec, ci, heads, geo):
         link(i, cell_of(rec[i]["x"], rec[i]["y"], geo.x0, geo.y0, geo.hx, geo.hy, geo.nx, geo.ny), rec, ci, heads)
 
 
-@njit
+@njit(forceinline=True)
 def crossing(x, y, vx, vy, c, geo):
     """Time until a ball at ``(x, y)`` moving at ``(vx, vy)`` leaves cell ``c`` for a neighbour, and
     the direction (``CROSS_*``, or ``NO_CROSSING``). The outermost cells reach to infinity, so
@@ -133,7 +133,7 @@ def crossing(x, y, vx, vy, c, geo):
     return best, direction
 
 
-@njit
+@njit(forceinline=True)
 def neighbour_cell(c, direction, nx):
     """The cell a ball enters when it leaves cell ``c`` in ``direction``."""
     if direction == CROSS_LEFT:

@@ -57,7 +57,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .._jit import njit, prefetch
-from ..broadphase import block, cell_of
+from ..broadphase import EXACT_CELLS_PER_BALL, block, cell_of
 from ..clock import finish_step
 from ..frames import frames_kernel
 from ..layout import (
@@ -81,7 +81,7 @@ from ..layout import (
     WALL_TESTS,
 )
 from ..physics.impacts import record
-from ..physics.motion import has_rotation
+from ..physics.motion import ball_views, has_rotation
 from ..physics.response import ball_ball, ball_wall, impact_threshold
 from ..physics.toi import INF, toi_pair
 from ..physics.walls import snap_to_wall, wall_point
@@ -91,6 +91,7 @@ from ..state import (
     START_STEP,
     Calendar,
     ExactScratch,
+    aligned_zeros,
     physics,
     scene_balls,
     unpack_calendar,
@@ -108,7 +109,7 @@ class Kind(NamedTuple):
 
     sticky: bool  #: form stick clusters (``inelastic="stick"`` at e = 0)
     cascades: bool  #: resolve contact groups at one instant (e < 1, slip)
-    buckets: bool  #: queue events in time buckets (``calendar.QUEUE_MIN_BALLS`` balls or more)
+    buckets: bool  #: queue events in time buckets (``calendar.QUEUE_MIN_BALLS`` balls or more, no clusters)
 
     @property
     def label(self) -> str:
@@ -118,26 +119,26 @@ class Kind(NamedTuple):
 
 
 def scene_kind(sticky: bool, elasticity: float, n: int) -> Kind:
-    """The :class:`Kind` of a scene of ``n`` balls (``sticky``: ``Scene.sticky``)."""
-    return Kind(bool(sticky), not sticky and elasticity < 1.0, cal.bucket_count(n) > 0)
+    """The :class:`Kind` of a scene of ``n`` balls (``sticky``: ``Scene.sticky``). Stick scenes keep
+    every event in the heap whatever their size: a cluster's events cost O(N) each (its members
+    move together), far more than a heap's levels, and the queue orders events alike either way."""
+    return Kind(bool(sticky), not sticky and elasticity < 1.0, not sticky and cal.bucket_count(n) > 0)
 
 
-#: Every kind a scene can be (stick scenes are never also of the contact-group kind).
-KINDS = tuple(Kind(s, c, q) for s in (False, True) for c in (False, True) for q in (False, True) if not (s and c))
+#: Every kind a scene can be (stick scenes have neither contact groups nor time buckets).
+KINDS = (*(Kind(False, c, q) for c in (False, True) for q in (False, True)), Kind(True, False, False))
 
 
 # ---------------------------------------------------------------------------- arrays
-def calendar_arrays(n_scenes: int, n: int, aligned_zeros) -> Calendar:
-    """A batch's :class:`~collision_env.engine.state.Calendar` (``aligned_zeros(shape, dtype)``
-    allocates cache-line-aligned zeros)."""
-    from ..broadphase import EXACT_CELLS_PER_BALL
-
+def calendar_arrays(kind: Kind, n_scenes: int, n: int) -> Calendar:
+    """The :class:`~collision_env.engine.state.Calendar` of a batch of ``n_scenes`` scenes of ``kind``
+    and ``n`` balls."""
     return Calendar(
         aligned_zeros((n_scenes, n), CAL_RECORD),
         np.zeros((n_scenes, n, len(CAL_I)), dtype=np.int32),
         np.zeros((n_scenes, EXACT_CELLS_PER_BALL * n), dtype=np.int32),
         aligned_zeros((n_scenes, cal.heap_rows(n), len(HEAP)), np.float64),
-        np.full((n_scenes, cal.bucket_count(n) + 1), -1, dtype=np.int32),
+        np.full((n_scenes, (cal.bucket_count(n) if kind.buckets else 0) + 1), -1, dtype=np.int32),
         np.zeros((n_scenes, n)),
     )
 
@@ -179,7 +180,7 @@ def begin_whole_scene(now, b, cl, geo, pending):
     return n
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def begin_changed_balls(b, cl, geo, pending):
     """List in ``pending`` the balls whose position or velocity changed since the last step ended
     (a nudge, an env's action, the negated velocities of a reversal of time): their records take
@@ -201,7 +202,7 @@ def begin_changed_balls(b, cl, geo, pending):
 
 
 # ---------------------------------------------------------------------------- predict
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _crossing_event(i, rec, ci, geo):
     """When ball ``i`` leaves its grid cell, and for which neighbour: ``(time, code)``."""
     r = rec[i]
@@ -209,7 +210,7 @@ def _crossing_event(i, rec, ci, geo):
     return (tau + r["ref_time"], cal.EV_CROSS - direction) if direction >= 0 else (INF, cal.EV_NONE)
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _partner_event(i, rebuild, best_t, best_code, b, ph, cl, geo, wk):
     """Ball ``i``'s earliest collision with a partner in the 3 x 3 cells around it (every other
     ball when the grid has one cell), if it comes before ``(best_t, best_code)``: the new best
@@ -238,7 +239,7 @@ def _partner_event(i, rebuild, best_t, best_code, b, ph, cl, geo, wk):
     return best_t, best_code, best_stamp
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def next_event(i, rebuild, b, cl, ph, geo, wk):
     """Ball ``i``'s next event in straight-line motion, from the records: the earliest of its wall,
     its cell crossing (found first: an early bound spares most pairs their time of impact) and its
@@ -265,7 +266,7 @@ def next_event(i, rebuild, b, cl, ph, geo, wk):
 
 
 # ---------------------------------------------------------------------------- pop and screen
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _verified_time(i, code, bounds, dim, rec):
     """The popped event's time, computed afresh from the records (a prediction from an earlier
     step carries the round-off of rebasing its time), or inf if it no longer happens."""
@@ -279,7 +280,7 @@ def _verified_time(i, code, bounds, dim, rec):
 RUN, PREDICT, RESCHEDULE = range(3)
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def screen(bi, t, now, ph, cl, geo, wk):
     """Look at ball ``bi``'s popped event (due at ``t``) before it is run.
 
@@ -319,7 +320,7 @@ def screen(bi, t, now, ph, cl, geo, wk):
 # measurable at 10^2 (scale benchmark). Asking for the records too, once the heads are in, cost more
 # at 10^2 than it saved at 10^5, with a branch per cell or without. (The queue's own walk ahead is
 # ``calendar.walk_next_bucket``.)
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _prefetch_heads(c, nx, heads):
     """Ask for the heads of the 3 x 3 cells around cell ``c`` (both ends of each row of three, which
     may straddle two cache lines; clamped to the array, since only the lines matter)."""
@@ -330,7 +331,7 @@ def _prefetch_heads(c, nx, heads):
         prefetch(heads, min(max(middle + 1, 0), last))
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def prefetch_popped(bi, cl, geo):
     """Ask for what ball ``bi``'s popped event reads first: its partner's record and int row, and
     the cell heads of the prediction that follows (around the cell it enters, for a crossing).
@@ -346,7 +347,7 @@ def prefetch_popped(bi, cl, geo):
             cal.prefetch_int_row(code, cl.ci)
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def prefetch_partner(bj, cl, geo):
     """Ask for the cell heads of pair partner ``bj``'s coming prediction (its cell is in its int row,
     which :func:`prefetch_popped` asked for)."""
@@ -355,7 +356,7 @@ def prefetch_partner(bj, cl, geo):
 
 
 # ---------------------------------------------------------------------------- resolve
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def resolve_wall(sc, t_abs, bi, li, wall, b, ph, wk):
     """Ball ``bi``, row ``li`` of ``b`` (the whole ball state, ``li = bi``, where contact groups
     may form; else the event's rows), meets ``wall``; it is listed in ``wk.pending``. Returns the
@@ -370,7 +371,7 @@ def resolve_wall(sc, t_abs, bi, li, wall, b, ph, wk):
     return speed
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def resolve_pair(sc, t_abs, bi, bj, li, lj, b, ph, wk):
     """Balls ``bi`` and ``bj``, rows ``li`` and ``lj`` of ``b`` (as in :func:`resolve_wall`), meet;
     they are listed in ``wk.pending``. Returns the closing speed (0: no impulse)."""
@@ -389,7 +390,7 @@ def resolve_pair(sc, t_abs, bi, bj, li, lj, b, ph, wk):
     return speed
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def invalidate(n_changed, now, ev, in_place, cl, wk):
     """The balls whose motion an event changed (``wk.pending``) take their new state into their
     records, from the rows the response changed (``ev``: the whole ball state if ``in_place``, else
@@ -402,7 +403,7 @@ def invalidate(n_changed, now, ev, in_place, cl, wk):
 
 
 # ---------------------------------------------------------------------------- finish
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def finish(t_end, b, rec):
     """End the step at step time ``t_end``: every ball there, in its record and in the ball state
     (events resolved on their own rows left the state behind), and the records' times made
@@ -417,7 +418,7 @@ def finish(t_end, b, rec):
         r["event_time"] -= t_end
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def finish_synced(t_end, rec):
     """:func:`finish` for a scene whose balls are all at ``t_end`` already (stick scenes)."""
     for i in range(rec.shape[0]):
@@ -425,7 +426,7 @@ def finish_synced(t_end, rec):
         rec[i]["event_time"] -= t_end
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def open_step(state, dt_abs, start):
     """Start a step of ``dt_abs`` for every scene (``start``: not :data:`RESUME`), or resume the
     scenes a full impact buffer stopped."""
@@ -441,7 +442,7 @@ def open_step(state, dt_abs, start):
     state.n_imp[2] = 0
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def close_scene(sc, t0, now, horizon_end, sign, dt_abs, state):
     """Scene ``sc`` stopped at step time ``now``: stalled (a full impact buffer: the next call goes
     on from there, as if nothing had stopped it), capped, or done; returns the step time it ends
@@ -602,11 +603,12 @@ def _step(kind: Kind):
         ph = physics(state.fparams, state.iparams)
         wk = work(state, unpack_exact_scratch(h))
         open_step(state, dt_abs, start)
+        views = ball_views(state.balls)
         for sc in range(state.time.shape[0]):
             if not state.work_i[sc, W_ACTIVE]:
                 continue
             state.work_i[sc, W_STALLED] = False
-            b = scene_balls(state, sc)
+            b = scene_balls(views, state.body, sc)
             cl = scene_calendar(calendar, state, sc)
             t0 = state.time[sc]
             horizon_end = state.work_f[sc, W_REMAINING]

@@ -22,7 +22,7 @@ from .._jit import njit
 from ..physics.toi import toi_pair, toi_wall
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def position_at(k, t, rec):
     """Where ball ``k`` is at step time ``t``."""
     r = rec[k]
@@ -30,7 +30,7 @@ def position_at(k, t, rec):
     return r["x"] + r["vx"] * dt, r["y"] + r["vy"] * dt
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def sync(k, t, rec):
     """Move ball ``k``'s record to step time ``t`` (straight-line motion)."""
     r = rec[k]
@@ -41,7 +41,7 @@ def sync(k, t, rec):
         r["ref_time"] = t
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def store(k, rec, pos, vel, row):
     """Ball ``k``'s record (position and velocity) into row ``row`` of a ball state."""
     r = rec[k]
@@ -51,7 +51,7 @@ def store(k, rec, pos, vel, row):
     vel[row, 1] = r["vy"]
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def load(k, t, rec, pos, vel, row):
     """Row ``row`` of a ball state into ball ``k``'s record, as of step time ``t``."""
     r = rec[k]
@@ -62,7 +62,7 @@ def load(k, t, rec, pos, vel, row):
     r["ref_time"] = t
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def take(k, row, t, cl, ev):
     """Ball ``k``, moved in its record to step time ``t``, into row ``row`` of an event's balls."""
     sync(k, t, cl.rec)
@@ -71,7 +71,7 @@ def take(k, row, t, cl, ev):
     ev.inv_mass[row] = cl.inv_mass[k]
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def sync_all(t, pos, vel, rec):
     """Bring every ball to step time ``t`` in straight-line motion, in the records and in the ball
     state alike."""
@@ -80,7 +80,7 @@ def sync_all(t, pos, vel, rec):
         store(k, rec, pos, vel, k)
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def pair_gap(i, k, rec):
     """Balls ``i`` and ``k`` at the later of their reference times ``tc``: ``(tc, dx, dy, dvx, dvy,
     sigma)``, the separation and relative velocity of ``k`` from ``i`` and the radii sum."""
@@ -92,7 +92,7 @@ def pair_gap(i, k, rec):
     return tc, xk - xi, yk - yi, rk["vx"] - ri["vx"], rk["vy"] - ri["vy"], ri["radius"] + rk["radius"]
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def pair_time(i, k, rec):
     """Step time at which balls ``i`` and ``k`` in straight-line motion meet (inf: never), computed
     from their records at the later of their reference times."""
@@ -100,7 +100,7 @@ def pair_time(i, k, rec):
     return tc + toi_pair(dx, dy, dvx, dvy, sigma)
 
 
-@njit
+@njit(forceinline=True)
 def not_before(dx, dy, dvx, dvy, sigma, span):
     """Two balls apart by ``(dx, dy)``, closing at ``(dvx, dvy)``, cannot touch within ``span``
     seconds: their time of impact is at least ``c / (-2 b)`` (``b = dr . dv < 0``, ``c = |dr|^2 -
@@ -112,7 +112,7 @@ def not_before(dx, dy, dvx, dvy, sigma, span):
     return b >= 0.0 or c * (1.0 - 1e-9) > -2.0 * b * span
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def wall_time(i, bounds, dim, rec):
     """Step time and code of the first wall ball ``i`` meets in straight-line motion."""
     r = rec[i]

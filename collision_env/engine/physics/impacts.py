@@ -5,7 +5,7 @@ from __future__ import annotations
 from .._jit import njit
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def record(imp, n_imp, scene, time, ball, other, wall, x, y, speed):
     """Append an impact to the record buffer ``imp``; ``n_imp[0]`` counts the rows filled.
     ``other`` is -1 for a wall impact, ``wall`` -1 for a ball-ball one."""

@@ -93,7 +93,7 @@ def advance_body(root, dt, pos, vel, mass, body, omega):
             vel[k, 1] = vcy + w * rx
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def advance_all(dt, pos, vel, mass, body, omega, any_rotating):
     """Move every ball on by ``dt``: straight lines, and rigid rotation for spinning clusters."""
     n = pos.shape[0]
@@ -107,7 +107,7 @@ def advance_all(dt, pos, vel, mass, body, omega, any_rotating):
                 advance_body(r, dt, pos, vel, mass, body, omega)
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def has_rotation(body, omega):
     for r in range(body.shape[0]):
         if body[r] == r and omega[r] != 0.0:

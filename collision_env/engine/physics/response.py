@@ -63,7 +63,7 @@ from .walls import heads_into, wall_axis
 _ROUNDOFF_SPEED = 8.0 * 2.0**-52
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def elastic_threshold(vel, collapse_ratio, collapse_floor):
     """``u_min`` for one scene of the cheap modes: ``collapse_ratio`` times the speed of the scene's
     slowest moving ball (a pair that collides has at least one ball that fast, so the rule adds at
@@ -76,7 +76,7 @@ def elastic_threshold(vel, collapse_ratio, collapse_floor):
     return max(collapse_ratio * math.sqrt(slowest), collapse_floor) if slowest < math.inf else collapse_floor
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def impact_threshold(i, j, vel, collapse_ratio, collapse_floor):
     """``u_min`` of an impact of ball ``i`` with ball ``j`` (``j < 0``: a wall), from their speeds."""
     fastest = vel[i, 0] * vel[i, 0] + vel[i, 1] * vel[i, 1]
@@ -85,7 +85,7 @@ def impact_threshold(i, j, vel, collapse_ratio, collapse_floor):
     return max(collapse_ratio * math.sqrt(fastest), collapse_floor)
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def group_threshold(group, size, vel, inv_mass, collapse_ratio, collapse_floor):
     """``u_min`` of a contact group (its balls are ``group[:size]``): ``collapse_ratio`` times the
     group's kinetic-energy speed ``sqrt(sum m v^2 / max m)``, or a few ulps of its fastest ball's
@@ -106,13 +106,13 @@ def group_threshold(group, size, vel, inv_mass, collapse_ratio, collapse_floor):
     return max(collapse_ratio * math.sqrt(energy2 * heaviest_inv), _ROUNDOFF_SPEED * math.sqrt(fastest), collapse_floor)
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def separation_speed(closing_speed, e, u_min):
     """Normal speed at which a collision leaves the pair separating (see the regulariser)."""
     return e * closing_speed if closing_speed > u_min else u_min
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def ball_ball(i, j, pos, vel, inv_mass, e, u_min):
     """Apply the impulse between balls ``i`` and ``j``. Returns the closing speed (0: no impulse)."""
     dx = pos[j, 0] - pos[i, 0]
@@ -136,7 +136,7 @@ def ball_ball(i, j, pos, vel, inv_mass, e, u_min):
     return -u
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def ball_wall(i, wall, vel, e, u_min):
     """Reflect the normal component of ball ``i``'s velocity off ``wall``. Returns the closing speed."""
     axis = wall_axis(wall)

@@ -40,7 +40,7 @@ CA_RTOL = 1e-12
 _CA_ROUNDOFF_SHARE = 0.25
 
 
-@njit
+@njit(forceinline=True)
 def toi_pair(dx, dy, dvx, dvy, sigma):
     """Time until two balls in straight-line motion touch, or inf."""
     b = dx * dvx + dy * dvy
@@ -57,7 +57,7 @@ def toi_pair(dx, dy, dvx, dvy, sigma):
     return c / (-b + math.sqrt(disc))
 
 
-@njit
+@njit(forceinline=True)
 def toi_wall_axis(x, v, r, lo, hi):
     """Time until a ball moving along one axis touches the wall it heads for, and that wall.
 
@@ -73,7 +73,7 @@ def toi_wall_axis(x, v, r, lo, hi):
     return INF, -1
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def toi_wall(x, y, vx, vy, r, bounds, dim):
     """First wall a ball in straight-line motion touches: ``(t, wall)``, a wall code
     (:mod:`~collision_env.engine.physics.walls`) or -1. On an exact tie (a corner) the x wall comes

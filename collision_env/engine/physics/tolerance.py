@@ -42,7 +42,7 @@ def coordinate_size(i, pos):
     return max(abs(pos[i, 0]), abs(pos[i, 1]))
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def balls_touch(a, k, pos, radius):
     """Balls ``a`` and ``k`` touch within the contact tolerance (:func:`contact_tolerance`: 1e-9 of
     the radii, or the round-off of their coordinates)."""

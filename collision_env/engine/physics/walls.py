@@ -73,7 +73,7 @@ def wall_normal(wall):
     return 0.0, 1.0
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def wall_point(i, wall, pos, bounds):
     """Where ball ``i`` touching ``wall`` touches it."""
     if wall_axis(wall) == 0:
@@ -81,7 +81,7 @@ def wall_point(i, wall, pos, bounds):
     return pos[i, 0], wall_line(wall, bounds)
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def wall_gap(i, wall, pos, radius, bounds):
     """The gap (m) between ball ``i`` and ``wall`` (negative: past it)."""
     if wall == WALL_LEFT:
@@ -93,7 +93,7 @@ def wall_gap(i, wall, pos, radius, bounds):
     return bounds[3] - radius[i] - pos[i, 1]
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def snap_to_wall(i, wall, pos, radius, bounds):
     """Put ball ``i`` exactly on the wall it touches (it is there up to round-off)."""
     if wall == WALL_LEFT:
@@ -106,7 +106,7 @@ def snap_to_wall(i, wall, pos, radius, bounds):
         pos[i, 1] = bounds[3] - radius[i]
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def wall_contact(i, wall, pos, radius, bounds):
     """Ball ``i`` touches ``wall`` within the contact tolerance (1e-9 of its diameter, or the
     round-off of its coordinates and the wall's)."""

@@ -25,7 +25,7 @@ from ..physics.walls import heads_into, wall_of, wall_point
 from .cells import later_neighbours
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def body_inverse_mass(i, mass, body, sticky):
     """1 / the mass of ball ``i``'s cluster (of the ball alone unless the scene is a stick one)."""
     if not sticky:
@@ -38,7 +38,7 @@ def body_inverse_mass(i, mass, body, sticky):
     return 1.0 / m_tot
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def shift_body(i, dx, dy, pos, body, sticky):
     """Move ball ``i``'s cluster (the ball alone unless the scene is a stick one) by (dx, dy)."""
     if not sticky:
@@ -52,7 +52,7 @@ def shift_body(i, dx, dy, pos, body, sticky):
             pos[k, 1] += dy
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def contain(sc, t_abs, u_min, b, ph, state):
     """Put every ball that ended up past a wall back on it; reflect it if it still moves outward."""
     pos, vel, radius, bounds = b.pos, b.vel, b.radius, ph.bounds
@@ -87,7 +87,7 @@ def contain(sc, t_abs, u_min, b, ph, state):
                 state.counters[EVENTS] += 1
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def _resolve_pair(sc, t_abs, i, j, u_min, b, ph, state):
     """Resolve an overlap of balls ``i`` and ``j``, if they overlap."""
     pos, vel, radius, body, sticky = b.pos, b.vel, b.radius, b.body, ph.sticky
@@ -124,7 +124,7 @@ def _resolve_pair(sc, t_abs, i, j, u_min, b, ph, state):
         state.counters[EVENTS] += 1
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def resolve(sc, t_abs, h, u_min, b, ph, state, cells):
     """Resolve the overlaps at the end of a sub-step of ``h`` seconds ending at ``t_abs``; ``cells``
     is the sub-step's broad phase (``cells.cell_lists``): pairs come from it in index order."""

@@ -12,7 +12,7 @@ from ..clock import finish_step
 from ..exact.grid import scene_geometry
 from ..frames import frames_kernel
 from ..layout import S_SUBSTEPS, W_ACTIVE, W_STALLED, W_SUBSTEP_START, W_SUBSTEPS_DONE
-from ..physics.motion import advance_all, has_rotation
+from ..physics.motion import advance_all, ball_views, has_rotation
 from ..physics.response import elastic_threshold
 from ..state import (
     RESUME,
@@ -29,7 +29,7 @@ from .cells import cell_lists, worst_case_impacts
 RESOLVERS = {"naive": naive.resolve, "posteriori": posteriori.resolve}
 
 
-@njit(refcount=False)
+@njit(refcount=False, forceinline=True)
 def open_step(state, start):
     """Start a step for every scene (``start``: not ``RESUME``), or resume the stalled ones."""
     state.n_imp[0] = 0
@@ -58,12 +58,13 @@ def _step(resolve):
         k_total = state.iparams[S_SUBSTEPS]
         h = dt_abs / k_total
         open_step(state, start)
+        views = ball_views(state.balls)
         n = state.balls.shape[1]
         for sc in range(state.time.shape[0]):
             if not state.work_i[sc, W_ACTIVE]:
                 continue
             state.work_i[sc, W_STALLED] = False
-            b = scene_balls(state, sc)
+            b = scene_balls(views, state.body, sc)
             geo = scene_geometry(state.work_f, state.work_i, sc)
             u_min = elastic_threshold(b.vel, ph.ratio, ph.floor)
             while state.work_i[sc, W_SUBSTEPS_DONE] < k_total:
