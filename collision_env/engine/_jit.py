@@ -264,6 +264,17 @@ if HAVE_NUMBA:
         def enable_caching(self):
             self._cache = _KernelCache(self.py_func, self.label)
 
+    class _InnerKernel(_KernelDispatcher):
+        """A kernel only other kernels call (``njit(python=False)``): compiled without the wrappers
+        that let Python call it, which for a kernel taking bundles of arrays cost more to compile
+        than the kernel itself. A call from Python is refused (it would find no wrapper to enter)."""
+
+        def __call__(self, *args, **kwargs):
+            raise TypeError(
+                f"{self.py_func.__module__}.{self.py_func.__qualname__} is compiled to be called from other kernels "
+                "only (njit(python=False)); in Python, call its .py_func"
+            )
+
 
 def _in_package(func) -> bool:
     try:
@@ -279,15 +290,16 @@ def compile_for(kernel, *example_args) -> None:
         kernel.compile(tuple(_numba.typeof(a) for a in example_args))
 
 
-def njit(func=None, *, refcount=True, label=None, **options):
+def njit(func=None, *, refcount=True, label=None, python=None, **options):
     """Compile ``func`` with numba in nopython mode (cached), or return it unchanged.
 
     Use bare (``@njit``) or with extra numba options (``@njit(inline="always")``);
     ``refcount=False`` and ``label`` (what the compile notice calls the kernel): see the module
-    docstring.
+    docstring. ``python=False``: only other kernels call it (no wrappers for calls from Python,
+    which are refused); the default for ``forceinline=True`` kernels, True otherwise.
     """
     if func is None:
-        return lambda f: njit(f, refcount=refcount, label=label, **options)
+        return lambda f: njit(f, refcount=refcount, label=label, python=python, **options)
     if not HAVE_NUMBA:
         return func
     # set explicitly, so that a kernel called from a ``refcount=False`` (or ``forceinline``) one does
@@ -296,7 +308,11 @@ def njit(func=None, *, refcount=True, label=None, **options):
     options.setdefault("forceinline", False)
     if not (_in_package(func) or Path(func.__code__.co_filename).is_file()):
         return _numba.njit(nogil=True, **options)(func)  # (no file to key a cache on: ``python -c``)
-    dispatcher = _KernelDispatcher(
+    if python is None:
+        python = not options["forceinline"]
+    if not python:
+        options.update(no_cpython_wrapper=True, no_cfunc_wrapper=True)
+    dispatcher = (_KernelDispatcher if python else _InnerKernel)(
         py_func=func,
         locals=options.pop("locals", {}),
         targetoptions={"nopython": True, "nogil": True, "boundscheck": None, **options},

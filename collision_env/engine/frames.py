@@ -52,7 +52,7 @@ def record_frame(f, balls, time, times, positions, velocities):
             velocities[f, row, 1] = balls[sc, i, B_VX + 1]
 
 
-@njit(refcount=False)
+@njit(refcount=False, python=False)
 def _take_frame(f, rows, state, out):
     """After frame ``f``'s step, which returned ``rows``: record the frame and its impacts (True),
     or note where the run stops (False): a step the caller must complete (``rows < 0``), or

@@ -125,6 +125,12 @@ IMPACT_DTYPE = np.dtype(
     ]
 )
 
+#: A ball's rigid-body kinematics (``motion.body_kinematics``), as exact mode's conservative
+#: advancement of rotating clusters takes it (float64): the centre of mass of the ball's cluster (m)
+#: and its velocity (m/s), the ball's offset from it (m), and the cluster's angular velocity (rad/s).
+KINEMATICS = ("cx", "cy", "vx", "vy", "dx", "dy", "omega")
+K_CX, K_CY, K_VX, K_VY, K_DX, K_DY, K_OMEGA = range(7)
+
 #: Work counters (``BatchSimulator.stats``), int64: pair predictions (or overlap tests), wall
 #: predictions, events, rotating-cluster predictions, grid-cell crossings, stale calendar entries
 #: re-predicted.
@@ -147,6 +153,7 @@ LAYOUTS = {
     "SCENE_I": SCENE_I,
     "WORK_F": WORK_F,
     "WORK_I": WORK_I,
+    "KINEMATICS": KINEMATICS,
     "COUNTERS": COUNTERS,
     "FRAME_FIELDS": FRAME_FIELDS,
 }

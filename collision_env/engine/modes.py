@@ -39,7 +39,7 @@ class Mode(NamedTuple):
 
 
 def _exact_kind(scene: Scene, n: int) -> scheduler.Kind:
-    return scheduler.scene_kind(scene.sticky, scene.elasticity, n)
+    return scheduler.scene_kind(scene.sticky, scene.elasticity)
 
 
 def _exact_arrays(scene: Scene, n_scenes: int, n: int) -> tuple:

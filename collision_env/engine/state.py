@@ -82,7 +82,7 @@ class ExactScratch(NamedTuple):
     c_a: np.ndarray  #: (C,) int64: a contact group's contacts, the lower ball
     c_b: np.ndarray  #: (C,) int64: ... the other ball (>= 0) or the wall (-1 - wall)
     c_hit: np.ndarray  #: (C,) bool: ... already reported
-    kinematics: np.ndarray  #: (2, 7) float64: two cluster members' rigid kinematics
+    kinematics: np.ndarray  #: (2, len(KINEMATICS)) float64: two cluster members' rigid kinematics
     event: np.ndarray  #: (1, 2, len(BALL)) float64: the two balls of an event, laid out as ``BALL``
     event_body: np.ndarray  #: (2,) int64: their cluster roots (the rows' own indices)
 

@@ -21,6 +21,7 @@ def test_each_field_has_the_constant_of_its_position(name):
         "SCENE_I": "S_",
         "WORK_F": "W_",
         "WORK_I": "W_",
+        "KINEMATICS": "K_",
         "COUNTERS": "",
         "FRAME_FIELDS": "FRAME_",
     }[name]

@@ -93,7 +93,10 @@ def test_a_kernel_called_with_a_literal_is_compiled_once_for_the_plain_type():
 
 @needs_numba
 def test_compiling_says_so_once_on_stderr_and_a_cached_run_says_nothing(tmp_path):
-    code = "from collision_env.engine.physics.toi import toi_pair\nprint(toi_pair(1.0, 0.0, -1.0, 0.0, 0.5))\n"
+    code = (
+        "from collision_env.engine.physics.tolerance import contact_tolerance\n"
+        "print(contact_tolerance(1.0, 2.0, 1e-9))\n"
+    )
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
     runs = [
         subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=300)

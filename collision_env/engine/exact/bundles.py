@@ -39,7 +39,7 @@ class Work(NamedTuple):
     c_a: np.ndarray  #: a contact group's contacts: the lower ball
     c_b: np.ndarray  #: ... and the other ball (>= 0) or the wall (-1 - wall)
     c_hit: np.ndarray  #: ... and whether it was reported already
-    ki: np.ndarray  #: a rotating cluster member's kinematics (7 floats)
+    ki: np.ndarray  #: a rotating cluster member's kinematics (``layout.KINEMATICS``)
     kj: np.ndarray  #: ... and its partner's
     event: SceneBalls  #: the two balls of an event, rows 0 and 1 (see ``scheduler.advance``)
 

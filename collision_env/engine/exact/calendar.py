@@ -65,12 +65,12 @@ EV_CROSS = -5
 EV_NONE = -9
 
 
-@njit(forceinline=True)
+@njit(inline="always")
 def is_wall(code):
     return EV_CROSS < code <= EV_WALL
 
 
-@njit(forceinline=True)
+@njit(inline="always")
 def is_crossing(code):
     return EV_NONE < code <= EV_CROSS
 
@@ -79,7 +79,7 @@ def is_crossing(code):
 _LAST = 1 << 62
 
 
-@njit(forceinline=True)
+@njit(inline="always")
 def order_key(ball, code):
     """Where ``ball``'s event ``code`` stands among events at the same instant: ``(lead, rank)``.
 
@@ -180,19 +180,19 @@ def heap_rows(n):
 
 # The heap lives in ``hp`` (``layout.HEAP``: the event time and the ball of each slot), so that
 # sifting reads neighbouring rows instead of chasing every ball's own row.
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def _place(slot, ball, t, ci, hp):
     hp[slot + HEAP_OFFSET, H_TIME] = t
     hp[slot + HEAP_OFFSET, H_BALL] = ball
     ci[ball, C_QUEUE_SLOT] = slot
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def _ball_at(slot, hp):
     return np.int64(hp[slot + HEAP_OFFSET, H_BALL])
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def _time_at(slot, hp):
     return hp[slot + HEAP_OFFSET, H_TIME]
 
@@ -213,7 +213,7 @@ def _sift_up(slot, rec, ci, hp):
     return slot
 
 
-@njit(forceinline=True)
+@njit(inline="always")
 def _earlier_of(ca, ta, cb, tb):
     """Of two children ``(slot, time)``, the one whose time comes first (``a`` on a tie; ties are
     settled by :func:`_first_child`'s full order)."""
@@ -274,7 +274,7 @@ def _sift_down(slot, n, ci, hp):
         _place(slot, ball, t, ci, hp)
 
 
-@njit(refcount=False)
+@njit(refcount=False, python=False)
 def _heapify(n, ci, hp):
     """Order a heap of ``n`` from scratch (Floyd's O(n) construction), from the times it holds."""
     for slot in range((n - 2) // ARITY, -1, -1):
@@ -299,12 +299,12 @@ def _vacate(slot, size, ci, hp):
     return size
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def _ring_size(q):
     return q.buckets.shape[0] - 1
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def _heap_size(rec, q):
     """Events in the heap: every ball's without buckets (read without touching the counts)."""
     return rec.shape[0] if _ring_size(q) == 0 else q.qi[W_QUEUE_HEAP]
@@ -390,7 +390,7 @@ def schedule(ball, rec, ci, q):
     _sift_down(_sift_up(slot, rec, ci, q.hp), size, ci, q.hp)
 
 
-@njit(refcount=False)
+@njit(refcount=False, python=False)
 def _release_far(rec, ci, q):
     """Sort the far list's events that the ring now reaches into the ring (or the heap), and note
     the bucket at which to do so next (before any event left in the far list is due)."""
@@ -406,7 +406,7 @@ def _release_far(rec, ci, q):
         ball = nxt
 
 
-@njit(refcount=False)
+@njit(refcount=False, python=False)
 def _open_next_bucket(rec, ci, q):
     """Move the next bucket's events into the heap; when the ring is empty, start the buckets anew
     at the far list's first event instead of stepping through empty ones. Returns False if
@@ -486,7 +486,7 @@ def no_walk(cursor, rec, ci, q):
 
 # Called where the heap ran empty, once per bucket (and never without buckets): a call of its own,
 # so that the event loop that inlines ``next_ball`` stays small.
-@njit(refcount=False)
+@njit(refcount=False, python=False)
 def _refill_heap(rec, ci, q):
     """Open buckets until the heap holds an event; False if none will ever come."""
     while q.qi[W_QUEUE_HEAP] == 0:
@@ -518,7 +518,7 @@ def _width(total, finite):
     return width if 0.0 < width < INF else INF
 
 
-@njit(refcount=False)
+@njit(refcount=False, python=False)
 def bucket_width(n, now, rec):
     """A bucket width for a scene's events from step time ``now`` (inf, every finite time in the
     heap, when no finite event lies ahead)."""
@@ -532,14 +532,14 @@ def bucket_width(n, now, rec):
     return _width(total, finite)
 
 
-@njit(refcount=False)
+@njit(refcount=False, python=False)
 def build_queue(n, now, rec, ci, q):
     """Queue every ball's event afresh (their times are set), from step time ``now``, in buckets of
     the width their times call for (:func:`bucket_width`)."""
     reset_queue(n, now, bucket_width(n, now, rec), rec, ci, q)
 
 
-@njit(refcount=False)
+@njit(refcount=False, python=False)
 def heap_build(n, now, rec, ci, q):
     """:func:`build_queue` in a queue without buckets: every ball's event in the heap."""
     for i in range(n):
@@ -574,7 +574,7 @@ def reset_queue(n, now, width, rec, ci, q):
 
 # Called once per step in scenes with buckets: a call of its own, so that small scenes do not
 # carry its code.
-@njit(refcount=False)
+@njit(refcount=False, python=False)
 def _refile(n, rec, ci, q):
     """After a rebase: move every event whose rebased time fell into another bucket, or into or
     out of the heap (the heap is left out of order: returns True if it changed)."""
@@ -637,7 +637,7 @@ def rebase_queue(n, t, rec, ci, q):
         _heapify(_heap_size(rec, q), ci, q.hp)
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def set_event(ball, t, code, stamp, rec, ci):
     """Give ``ball`` the pending event ``(t, code)`` (``stamp``: the partner's change count);
     the caller queues it (:func:`schedule`, or :func:`reset_queue` for every ball)."""
@@ -646,7 +646,7 @@ def set_event(ball, t, code, stamp, rec, ci):
     ci[ball, C_EVENT_STAMP] = stamp
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def is_stale(ball, rec, ci):
     """A pair event whose partner's trajectory changed after it was predicted."""
     other = ci[ball, C_EVENT_OTHER]

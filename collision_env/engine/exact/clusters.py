@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 
 from .._jit import njit
-from ..layout import CLUSTER_TESTS, PAIR_TESTS, WALL_TESTS
+from ..layout import CLUSTER_TESTS, KINEMATICS, PAIR_TESTS, WALL_TESTS
 from ..physics.impacts import record
 from ..physics.motion import advance_all, body_kinematics
 from ..physics.response import merge_bodies, stop_body
@@ -27,15 +27,15 @@ from . import calendar as cal
 from .trajectories import load
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def _copy_kinematics(i, b, out):
-    """Ball ``i``'s rigid kinematics (``motion.body_kinematics``) into ``out`` (7 floats)."""
+    """Ball ``i``'s rigid kinematics (``motion.body_kinematics``) into ``out`` (``layout.KINEMATICS``)."""
     k = body_kinematics(i, b.pos, b.vel, b.mass, b.body, b.omega)
-    for q in range(7):
+    for q in range(len(KINEMATICS)):
         out[q] = k[q]
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def _pair_time(i, k, now, horizon, b, wk):
     """When balls ``i`` and ``k`` (of different clusters) touch, from the ball state at ``now``."""
     pos, vel, body, omega = b.pos, b.vel, b.body, b.omega
@@ -54,7 +54,7 @@ def _pair_time(i, k, now, horizon, b, wk):
     )
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def _wall_time(i, now, horizon, b, ph, wk):
     """When ball ``i`` first touches a wall, from the ball state at ``now``: ``(time, wall)``."""
     if b.omega[b.body[i]] != 0.0:
@@ -102,7 +102,7 @@ def sync_all(t, b, rot, rec):
             load(k, t, rec, b.pos, b.vel, k)
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def _list_cluster(root, body, involved):
     """The balls of the cluster rooted at ``root``, into ``involved``; returns how many."""
     n_inv = 0

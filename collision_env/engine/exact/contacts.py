@@ -40,7 +40,7 @@ def contact_capacity(n):
     return 3 * n + 4 * n + 8
 
 
-@njit(refcount=False)
+@njit(refcount=False, python=False)
 def cascade(sc, t_abs, i0, j0, b, ph, wk):
     """Resolve, at one instant, every contact of the group of touching balls an impact started.
 
@@ -59,7 +59,7 @@ def cascade(sc, t_abs, i0, j0, b, ph, wk):
     return size
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def _gather_group(i0, j0, pos, radius, pairs, group, in_group):
     """Every ball connected to the impact's balls through contacts, into ``group``, breadth first;
     returns how many."""
@@ -84,7 +84,7 @@ def _gather_group(i0, j0, pos, radius, pairs, group, in_group):
     return size
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def _list_contacts(i0, j0, size, b, ph, wk):
     """The group's contacts, each once, in a fixed order (``wk.c_a``, ``wk.c_b``; ``wk.c_hit`` marks
     the impact's own); returns how many."""
@@ -110,7 +110,7 @@ def _list_contacts(i0, j0, size, b, ph, wk):
     return n_contacts
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def _sweep(sc, t_abs, n_contacts, u_min, b, ph, wk):
     """Sweep the contacts, applying each one's impulse, until a sweep changes nothing (True) or
     :data:`MAX_SWEEPS` sweeps have (False)."""
@@ -132,7 +132,7 @@ def _sweep(sc, t_abs, n_contacts, u_min, b, ph, wk):
     return False
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def _contact_normal(c, c_a, c_b, pos):
     """Unit normal of contact ``c``, pointing from ball ``c_a[c]`` to its partner (ball or wall)."""
     a = c_a[c]
@@ -145,7 +145,7 @@ def _contact_normal(c, c_a, c_b, pos):
     return wall_normal(-1 - other)
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def _record_contact(sc, t_abs, c, speed, b, ph, wk):
     """Report contact ``c`` of a group the first time it takes an impulse."""
     if wk.c_hit[c]:
@@ -162,7 +162,7 @@ def _record_contact(sc, t_abs, c, speed, b, ph, wk):
         record(wk.imp, wk.n_imp, sc, t_abs, a, -1, -1 - other, x, y, speed)
 
 
-@njit
+@njit(python=False)
 def settle(sc, t_abs, size, n_contacts, u_min, b, ph, wk):
     """End a contact cascade that sequential impulses would need unboundedly many sweeps for.
 
@@ -225,7 +225,7 @@ def settle(sc, t_abs, size, n_contacts, u_min, b, ph, wk):
             _record_contact(sc, t_abs, c, closing[c], b, ph, wk)
 
 
-@njit(refcount=False)
+@njit(inline="always")
 def _contacts_open(vel, pos, c_a, c_b, n_contacts, slack):
     """No contact of the group closes faster than ``slack`` (m/s)."""
     for c in range(n_contacts):
@@ -240,7 +240,7 @@ def _contacts_open(vel, pos, c_a, c_b, n_contacts, slack):
     return True
 
 
-@njit(refcount=False)
+@njit(inline="always")
 def _stop_group(vel, inv_mass, group, size, c_b, n_contacts):
     """The last resort of :func:`settle`: every contact at rest, at once."""
     on_wall = False

@@ -95,7 +95,7 @@ def move_to_cell(i, c, rec, ci, heads):
         link(i, c, rec, ci, heads)
 
 
-@njit(refcount=False)
+@njit(refcount=False, python=False)
 def fill_cells(n, rec, ci, heads, geo):
     """Empty every cell and put every ball in the cell of its calendar position."""
     for c in range(geo.nx * geo.ny):
@@ -133,7 +133,7 @@ def crossing(x, y, vx, vy, c, geo):
     return best, direction
 
 
-@njit(forceinline=True)
+@njit(inline="always")
 def neighbour_cell(c, direction, nx):
     """The cell a ball enters when it leaves cell ``c`` in ``direction``."""
     if direction == CROSS_LEFT:

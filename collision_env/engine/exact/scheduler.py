@@ -20,11 +20,10 @@ The scheduler of the event-driven loop (Alder & Wainwright 1959; Rapaport 1980; 
   (:mod:`~collision_env.engine.exact.bundles`).
 
 **Kinds of scene.** A stepping kernel is built for one :class:`Kind` of scene by
-:func:`step_kernel`: whether it forms stick clusters (:mod:`~.clusters`), resolves contact groups
-at e < 1 (:mod:`~.contacts`) and queues events in time buckets (large scenes). The kind's paths
-are chosen where the kernel is built (constants of a closure, which numba prunes), so a scene
-never compiles, nor runs, a path it cannot take: an elastic scene of a few balls compiles none of
-the three.
+:func:`step_kernel`: whether it forms stick clusters (:mod:`~.clusters`) or resolves contact
+groups at e < 1 (:mod:`~.contacts`). The kind's paths are chosen where the kernel is built
+(constants of a closure, which numba prunes), so a scene never compiles, nor runs, a path it cannot
+take: an elastic scene compiles neither.
 
 Balls move lazily: a ball's calendar record holds its position at its own ``ref_time``, brought
 up to date only when an event involves it (or when the step ends), so an event costs O(log N)
@@ -69,6 +68,7 @@ from ..layout import (
     CELL_CROSSINGS,
     EVENTS,
     HEAP,
+    KINEMATICS,
     PAIR_TESTS,
     S_MAX_EVENTS,
     STALE_EVENTS,
@@ -109,24 +109,28 @@ class Kind(NamedTuple):
 
     sticky: bool  #: form stick clusters (``inelastic="stick"`` at e = 0)
     cascades: bool  #: resolve contact groups at one instant (e < 1, slip)
-    buckets: bool  #: queue events in time buckets (``calendar.QUEUE_MIN_BALLS`` balls or more, no clusters)
 
     @property
     def label(self) -> str:
         """What the compile notice calls the kernel of this kind."""
-        what = "stick" if self.sticky else "inelastic" if self.cascades else "elastic"
-        return f"exact mode for {what} scenes" + (" with time buckets" if self.buckets else "")
+        return f"exact mode for {'stick' if self.sticky else 'inelastic' if self.cascades else 'elastic'} scenes"
 
 
-def scene_kind(sticky: bool, elasticity: float, n: int) -> Kind:
-    """The :class:`Kind` of a scene of ``n`` balls (``sticky``: ``Scene.sticky``). Stick scenes keep
-    every event in the heap whatever their size: a cluster's events cost O(N) each (its members
-    move together), far more than a heap's levels, and the queue orders events alike either way."""
-    return Kind(bool(sticky), not sticky and elasticity < 1.0, not sticky and cal.bucket_count(n) > 0)
+def scene_kind(sticky: bool, elasticity: float) -> Kind:
+    """The :class:`Kind` of a scene (``sticky``: ``Scene.sticky``)."""
+    return Kind(bool(sticky), not sticky and elasticity < 1.0)
 
 
-#: Every kind a scene can be (stick scenes have neither contact groups nor time buckets).
-KINDS = (*(Kind(False, c, q) for c in (False, True) for q in (False, True)), Kind(True, False, False))
+#: Every kind a scene can be (stick scenes have no contact groups).
+KINDS = (Kind(False, False), Kind(False, True), Kind(True, False))
+
+
+def queues_in_buckets(kind: Kind, n: int) -> bool:
+    """Scenes of ``kind`` and ``n`` balls queue events in time buckets (``calendar.QUEUE_MIN_BALLS``
+    balls or more). Stick scenes keep every event in the heap whatever their size: a cluster's
+    events cost O(N) each (its members move together), far more than a heap's levels, and the queue
+    orders events alike either way."""
+    return not kind.sticky and cal.bucket_count(n) > 0
 
 
 # ---------------------------------------------------------------------------- arrays
@@ -138,7 +142,7 @@ def calendar_arrays(kind: Kind, n_scenes: int, n: int) -> Calendar:
         np.zeros((n_scenes, n, len(CAL_I)), dtype=np.int32),
         np.zeros((n_scenes, EXACT_CELLS_PER_BALL * n), dtype=np.int32),
         aligned_zeros((n_scenes, cal.heap_rows(n), len(HEAP)), np.float64),
-        np.full((n_scenes, (cal.bucket_count(n) if kind.buckets else 0) + 1), -1, dtype=np.int32),
+        np.full((n_scenes, (cal.bucket_count(n) if queues_in_buckets(kind, n) else 0) + 1), -1, dtype=np.int32),
         np.zeros((n_scenes, n)),
     )
 
@@ -152,7 +156,7 @@ def exact_scratch(n: int) -> ExactScratch:
         np.empty(nc, dtype=np.int64),
         np.empty(nc, dtype=np.int64),
         np.zeros(nc, dtype=np.bool_),
-        np.empty((2, 7)),
+        np.empty((2, len(KINEMATICS))),
         np.empty((1, 2, len(BALL))),
         np.zeros(2, dtype=np.int64),
     )
@@ -164,7 +168,7 @@ def impacts_per_event(n: int, cascades: bool) -> int:
 
 
 # ---------------------------------------------------------------------------- begin
-@njit(refcount=False)
+@njit(refcount=False, python=False)
 def begin_whole_scene(now, b, cl, geo, pending):
     """Forget every prediction of a scene, take every ball's state (its radius and inverse mass
     too) into the calendar as of step time ``now`` and lay the balls into the grid; every ball is
@@ -202,7 +206,7 @@ def begin_changed_balls(b, cl, geo, pending):
 
 
 # ---------------------------------------------------------------------------- predict
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def _crossing_event(i, rec, ci, geo):
     """When ball ``i`` leaves its grid cell, and for which neighbour: ``(time, code)``."""
     r = rec[i]
@@ -210,7 +214,7 @@ def _crossing_event(i, rec, ci, geo):
     return (tau + r["ref_time"], cal.EV_CROSS - direction) if direction >= 0 else (INF, cal.EV_NONE)
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def _partner_event(i, rebuild, best_t, best_code, b, ph, cl, geo, wk):
     """Ball ``i``'s earliest collision with a partner in the 3 x 3 cells around it (every other
     ball when the grid has one cell), if it comes before ``(best_t, best_code)``: the new best
@@ -266,7 +270,7 @@ def next_event(i, rebuild, b, cl, ph, geo, wk):
 
 
 # ---------------------------------------------------------------------------- pop and screen
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def _verified_time(i, code, bounds, dim, rec):
     """The popped event's time, computed afresh from the records (a prediction from an earlier
     step carries the round-off of rebasing its time), or inf if it no longer happens."""
@@ -320,7 +324,7 @@ def screen(bi, t, now, ph, cl, geo, wk):
 # measurable at 10^2 (scale benchmark). Asking for the records too, once the heads are in, cost more
 # at 10^2 than it saved at 10^5, with a branch per cell or without. (The queue's own walk ahead is
 # ``calendar.walk_next_bucket``.)
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def _prefetch_heads(c, nx, heads):
     """Ask for the heads of the 3 x 3 cells around cell ``c`` (both ends of each row of three, which
     may straddle two cache lines; clamped to the array, since only the lines matter)."""
@@ -488,7 +492,8 @@ def _step(kind: Kind):
     """
     sticky, cascades = kind.sticky, kind.cascades
     whole_state = sticky or cascades  # (events may be resolved on the whole ball state)
-    build, schedule, first, rebase, walk_ahead = cal.BUCKET_QUEUE if kind.buckets else cal.HEAP_QUEUE
+    # (the two-level queue works as a heap of every ball when a scene has no buckets; stick scenes never do)
+    build, schedule, first, rebase, walk_ahead = cal.HEAP_QUEUE if kind.sticky else cal.BUCKET_QUEUE
 
     @njit(inline="always")
     def predict(i, now, horizon, rebuild, rot, b, cl, ph, geo, wk):

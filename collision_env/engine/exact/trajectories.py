@@ -22,7 +22,7 @@ from .._jit import njit
 from ..physics.toi import toi_pair, toi_wall
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def position_at(k, t, rec):
     """Where ball ``k`` is at step time ``t``."""
     r = rec[k]
@@ -30,7 +30,7 @@ def position_at(k, t, rec):
     return r["x"] + r["vx"] * dt, r["y"] + r["vy"] * dt
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def sync(k, t, rec):
     """Move ball ``k``'s record to step time ``t`` (straight-line motion)."""
     r = rec[k]
@@ -41,7 +41,7 @@ def sync(k, t, rec):
         r["ref_time"] = t
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def store(k, rec, pos, vel, row):
     """Ball ``k``'s record (position and velocity) into row ``row`` of a ball state."""
     r = rec[k]
@@ -51,7 +51,7 @@ def store(k, rec, pos, vel, row):
     vel[row, 1] = r["vy"]
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def load(k, t, rec, pos, vel, row):
     """Row ``row`` of a ball state into ball ``k``'s record, as of step time ``t``."""
     r = rec[k]
@@ -100,7 +100,7 @@ def pair_time(i, k, rec):
     return tc + toi_pair(dx, dy, dvx, dvy, sigma)
 
 
-@njit(forceinline=True)
+@njit(inline="always")
 def not_before(dx, dy, dvx, dvy, sigma, span):
     """Two balls apart by ``(dx, dy)``, closing at ``(dvx, dvy)``, cannot touch within ``span``
     seconds: their time of impact is at least ``c / (-2 b)`` (``b = dr . dv < 0``, ``c = |dr|^2 -

@@ -30,7 +30,7 @@ _RESCALE = 1e8
 _MAX_RESCALES = 40
 
 
-@njit
+@njit(inline="always")
 def _least_squares(e_mat, f, cols, n_cols, z, work):
     """Solve ``min |E[:, cols] z - f|`` by Householder QR; ``z[cols[k]]`` gets the solution."""
     rows = e_mat.shape[0]
@@ -199,7 +199,7 @@ def least_distance(g_mat, h):
     return x, False
 
 
-@njit
+@njit(inline="always")
 def _ldp_dual(g_mat, h, s, e_mat, f):
     """Lawson & Hanson's NNLS dual of the LDP ``G x >= h`` at scale ``s``: returns ``u >= 0``
     (``u > 0`` on the constraints that hold with equality at the solution)."""
@@ -221,7 +221,7 @@ def _ldp_dual(g_mat, h, s, e_mat, f):
     return nnls(e_mat, f)
 
 
-@njit
+@njit(inline="always")
 def _least_norm(g_mat, h, cols, n_cols, x, work, hh):
     """``x`` = the least-norm solution of ``G[cols] x = h[cols]``, by Householder QR of
     ``G[cols]^T = Q R``: ``x = Q R^-T h[cols]``. A row that depends on earlier ones (a pivot at
@@ -276,7 +276,7 @@ def _least_norm(g_mat, h, cols, n_cols, x, work, hh):
             x[k] -= t * work[k, q]
 
 
-@njit
+@njit(inline="always")
 def _meets(g_mat, h, x):
     """``G x >= h`` up to the round-off of a backward-stable solve (relative to the largest ``|h|``
     and the largest ``|G| |x|``: a solve is accurate norm-wise, not row by row)."""

@@ -34,7 +34,7 @@ def ball_views(balls):
     )
 
 
-@njit(refcount=False)
+@njit(refcount=False, python=False)
 def body_kinematics(i, pos, vel, mass, body, omega):
     """Centre of mass, its velocity, ball ``i``'s offset from it and the angular velocity.
 
@@ -63,7 +63,7 @@ def body_kinematics(i, pos, vel, mass, body, omega):
     return cx, cy, vx / m_tot, vy / m_tot, pos[i, 0] - cx, pos[i, 1] - cy, w
 
 
-@njit(refcount=False)
+@njit(refcount=False, python=False)
 def position_at(tau, cx, cy, vcx, vcy, dx, dy, w):
     """Position and velocity, ``tau`` seconds on, of a point of a body in rigid motion."""
     if w == 0.0:
@@ -75,7 +75,7 @@ def position_at(tau, cx, cy, vcx, vcy, dx, dy, w):
     return cx + vcx * tau + rx, cy + vcy * tau + ry, vcx - w * ry, vcy + w * rx
 
 
-@njit(refcount=False)
+@njit(refcount=False, python=False)
 def advance_body(root, dt, pos, vel, mass, body, omega):
     """Move the members of the rotating cluster rooted at ``root`` on by ``dt``."""
     cx, cy, vcx, vcy, _, _, w = body_kinematics(root, pos, vel, mass, body, omega)

@@ -106,7 +106,7 @@ def group_threshold(group, size, vel, inv_mass, collapse_ratio, collapse_floor):
     return max(collapse_ratio * math.sqrt(energy2 * heaviest_inv), _ROUNDOFF_SPEED * math.sqrt(fastest), collapse_floor)
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def separation_speed(closing_speed, e, u_min):
     """Normal speed at which a collision leaves the pair separating (see the regulariser)."""
     return e * closing_speed if closing_speed > u_min else u_min
@@ -148,7 +148,7 @@ def ball_wall(i, wall, vel, e, u_min):
     return abs(vn)
 
 
-@njit(refcount=False)
+@njit(refcount=False, python=False)
 def merge_bodies(i, j, pos, vel, mass, body, omega):
     """Stick balls ``i`` and ``j`` (and their clusters) into one rigid body. Returns the root."""
     bi = body[i]
@@ -196,7 +196,7 @@ def merge_bodies(i, j, pos, vel, mass, body, omega):
     return root
 
 
-@njit(refcount=False)
+@njit(refcount=False, python=False)
 def stop_body(i, vel, body, omega):
     """A stuck ball or cluster touching a wall stops dead and comes apart (PhET)."""
     root = body[i]

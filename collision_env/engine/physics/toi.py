@@ -24,6 +24,7 @@ from __future__ import annotations
 import math
 
 from .._jit import njit
+from ..layout import K_CX, K_CY, K_DX, K_DY, K_OMEGA, K_VX, K_VY
 from .motion import position_at
 from .tolerance import contact_tolerance
 from .walls import WALL_BOTTOM, WALL_LEFT, WALL_RIGHT, wall_axis, wall_count
@@ -57,7 +58,7 @@ def toi_pair(dx, dy, dvx, dvy, sigma):
     return c / (-b + math.sqrt(disc))
 
 
-@njit(forceinline=True)
+@njit(inline="always")
 def toi_wall_axis(x, v, r, lo, hi):
     """Time until a ball moving along one axis touches the wall it heads for, and that wall.
 
@@ -89,10 +90,16 @@ def toi_wall(x, y, vx, vy, r, bounds, dim):
     return t, wall
 
 
-@njit(refcount=False)
+@njit(inline="always")
+def _rigid(k):
+    """The kinematics ``k`` (``layout.KINEMATICS``) as ``motion.position_at`` takes them."""
+    return k[K_CX], k[K_CY], k[K_VX], k[K_VY], k[K_DX], k[K_DY], k[K_OMEGA]
+
+
+@njit(inline="always")
 def _pair_gap(tau, ki, kj, sigma):
-    xi, yi, vxi, vyi = position_at(tau, ki[0], ki[1], ki[2], ki[3], ki[4], ki[5], ki[6])
-    xj, yj, vxj, vyj = position_at(tau, kj[0], kj[1], kj[2], kj[3], kj[4], kj[5], kj[6])
+    xi, yi, vxi, vyi = position_at(tau, *_rigid(ki))
+    xj, yj, vxj, vyj = position_at(tau, *_rigid(kj))
     rx = xj - xi
     ry = yj - yi
     dist = math.sqrt(rx * rx + ry * ry)
@@ -100,9 +107,9 @@ def _pair_gap(tau, ki, kj, sigma):
     return dist - sigma, rate
 
 
-@njit(refcount=False)
+@njit(inline="always")
 def _wall_gap(tau, k, r, wall, bounds):
-    x, y, vx, vy = position_at(tau, k[0], k[1], k[2], k[3], k[4], k[5], k[6])
+    x, y, vx, vy = position_at(tau, *_rigid(k))
     if wall == WALL_LEFT:
         return (x - r) - bounds[0], vx
     if wall == WALL_RIGHT:
@@ -112,7 +119,7 @@ def _wall_gap(tau, k, r, wall, bounds):
     return (bounds[3] - r) - y, -vy
 
 
-@njit(refcount=False)
+@njit(refcount=False, python=False)
 def _ca_solve(is_pair, ki, kj, sigma, wall, bounds, bound_speed, horizon, tol):
     """Conservative advancement on a gap function ``g(tau)`` with ``|g'| <= bound_speed``.
 
@@ -163,29 +170,32 @@ def _ca_solve(is_pair, ki, kj, sigma, wall, bounds, bound_speed, horizon, tol):
     return tau
 
 
-@njit(refcount=False)
+@njit(refcount=False, python=False)
 def ca_pair(ki, kj, sigma, horizon):
     """Time until two balls, either of them in a rotating cluster, touch (or inf).
 
-    ``ki``/``kj`` are the 7-tuples of :func:`motion.body_kinematics` packed in arrays.
+    ``ki``/``kj`` are the balls' kinematics (``layout.KINEMATICS``, from :func:`motion.body_kinematics`).
     """
-    rel = math.hypot(ki[2] - kj[2], ki[3] - kj[3])
-    bound = rel + abs(ki[6]) * math.hypot(ki[4], ki[5]) + abs(kj[6]) * math.hypot(kj[4], kj[5])
-    coord = max(abs(ki[0]), abs(ki[1]), abs(kj[0]), abs(kj[1])) + math.hypot(ki[4], ki[5]) + math.hypot(kj[4], kj[5])
+    rel = math.hypot(ki[K_VX] - kj[K_VX], ki[K_VY] - kj[K_VY])
+    arm_i = math.hypot(ki[K_DX], ki[K_DY])
+    arm_j = math.hypot(kj[K_DX], kj[K_DY])
+    bound = rel + abs(ki[K_OMEGA]) * arm_i + abs(kj[K_OMEGA]) * arm_j
+    coord = max(abs(ki[K_CX]), abs(ki[K_CY]), abs(kj[K_CX]), abs(kj[K_CY])) + arm_i + arm_j
     tol = _CA_ROUNDOFF_SHARE * contact_tolerance(sigma, coord, CA_RTOL)
     return _ca_solve(True, ki, kj, sigma, -1, ki, bound, horizon, tol)
 
 
-@njit(refcount=False)
+@njit(refcount=False, python=False)
 def ca_wall(k, r, bounds, dim, horizon):
-    """First wall a ball of a rotating cluster touches: ``(t, wall)``."""
+    """First wall a ball of a rotating cluster touches (``k``: its kinematics): ``(t, wall)``."""
     best = INF
     best_wall = -1
-    spin = abs(k[6]) * math.hypot(k[4], k[5])
-    coord = max(abs(k[0]), abs(k[1]), abs(bounds[0]), abs(bounds[1]), abs(bounds[2]), abs(bounds[3]))
-    tol = _CA_ROUNDOFF_SHARE * contact_tolerance(r, coord + math.hypot(k[4], k[5]), CA_RTOL)
+    arm = math.hypot(k[K_DX], k[K_DY])
+    spin = abs(k[K_OMEGA]) * arm
+    coord = max(abs(k[K_CX]), abs(k[K_CY]), abs(bounds[0]), abs(bounds[1]), abs(bounds[2]), abs(bounds[3]))
+    tol = _CA_ROUNDOFF_SHARE * contact_tolerance(r, coord + arm, CA_RTOL)
     for wall in range(wall_count(dim)):
-        normal_speed = abs(k[2]) if wall_axis(wall) == 0 else abs(k[3])
+        normal_speed = abs(k[K_VX]) if wall_axis(wall) == 0 else abs(k[K_VY])
         t = _ca_solve(False, k, k, r, wall, bounds, normal_speed + spin, min(horizon, best), tol)
         if t < best:
             best = t

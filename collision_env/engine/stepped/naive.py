@@ -87,7 +87,7 @@ def contain(sc, t_abs, u_min, b, ph, state):
                 state.counters[EVENTS] += 1
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def _resolve_pair(sc, t_abs, i, j, u_min, b, ph, state):
     """Resolve an overlap of balls ``i`` and ``j``, if they overlap."""
     pos, vel, radius, body, sticky = b.pos, b.vel, b.radius, b.body, ph.sticky

@@ -50,7 +50,7 @@ def _move(i, dt, pos, vel, mass, body, omega, sticky):
                 pos[k, 1] += vel[k, 1] * dt
 
 
-@njit(forceinline=True)
+@njit(inline="always")
 def overlap_time_pair(dx, dy, dvx, dvy, sigma):
     """How long ago an overlapping pair touched: the non-negative root of PhET's quadratic."""
     a = dvx * dvx + dvy * dvy
@@ -64,7 +64,7 @@ def overlap_time_pair(dx, dy, dvx, dvy, sigma):
     return c / (b - sq)
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def overlap_time_border(x, y, vx, vy, r, bounds, dim):
     """PhET's ``|ds|^2 / (v . ds)``, with the overshoot vector ``ds`` it uses."""
     cx = min(max(x, bounds[0] + r), bounds[2] - r)
@@ -76,7 +76,7 @@ def overlap_time_border(x, y, vx, vy, r, bounds, dim):
     return t, dsx, dsy
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def _resolve_pair(sc, t_end, h, i, j, u_min, b, ph, state):
     """Reconstruct and resolve the collision of balls ``i`` and ``j``, if they overlap."""
     pos, vel, mass, radius, body, omega, sticky = b.pos, b.vel, b.mass, b.radius, b.body, b.omega, ph.sticky
@@ -109,7 +109,7 @@ def _resolve_pair(sc, t_end, h, i, j, u_min, b, ph, state):
         _move(j, t, pos, vel, mass, body, omega, sticky)
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def _resolve_border(sc, t_end, h, i, u_min, b, ph, state):
     """Reconstruct and resolve ball ``i``'s collision with the border, if it is past it."""
     pos, vel, body, sticky = b.pos, b.vel, b.body, ph.sticky

@@ -61,7 +61,7 @@ def advance_episodes(flags, engine, state, params):  # pragma: no cover - numba
         scene_i[b, SCENE_INTS.targets_hit] = n_hit
 
 
-@njit(forceinline=True)
+@njit(inline="always")
 def border_contact(x, y, vx, vy, r, xmin, ymin, xmax, ymax):  # pragma: no cover - numba
     """Where a ball at (x, y) of radius r would touch the border flying straight on at (vx, vy) != 0."""
     tx = math.inf
@@ -79,23 +79,23 @@ def border_contact(x, y, vx, vy, r, xmin, ymin, xmax, ymax):  # pragma: no cover
     return x + vx * max(ty, 0.0), ymax if vy > 0.0 else ymin
 
 
-@njit(forceinline=True)
+@njit(inline="always")
 def play_area_diagonal(p):  # pragma: no cover - numba
     """The length of the play area's diagonal (the aiming potential's unit), from the parameters."""
     return math.sqrt((p[PARAMS.xmax] - p[PARAMS.xmin]) ** 2 + (p[PARAMS.ymax] - p[PARAMS.ymin]) ** 2)
 
 
 @njit(refcount=False, forceinline=True)
-def _straight_aim(b, engine, state, params, seq, cluster):  # pragma: no cover - numba
-    """Scene ``b``'s aiming potential phi in straight flight: minus the distance, over the play-area
-    diagonal, from each scoring ball's straight-line border contact point to the nearest visible
-    pending target, at its smallest (-1 when nothing is aimed, or when the task does not shape): a
-    heuristic that ignores other balls."""
+def _straight_aim(b, views, diag, state, params, seq, cluster):  # pragma: no cover - numba
+    """Scene ``b``'s aiming potential phi in straight flight (``views``: the engine's ``ball_views``,
+    ``diag``: the play area's diagonal):
+    minus the distance, over the play-area diagonal, from each scoring ball's straight-line border
+    contact point to the nearest visible pending target, at its smallest (-1 when nothing is aimed,
+    or when the task does not shape): a heuristic that ignores other balls."""
     p = params.params
     if p[PARAMS.shaping] == 0.0:
         return -1.0
-    pos, vel, _, _, radii, _ = ball_views(engine.balls)
-    diag = play_area_diagonal(p)
+    pos, vel, _, _, radii, _ = views
     best = 1.0
     for i in range(pos.shape[1]):
         if not (params.scoring[i] and (not cluster or in_cluster(state.body, b, i))):
@@ -155,11 +155,13 @@ def settle(flags, engine, state, params):  # pragma: no cover - numba
     cluster = params.switches[SWITCHES.cluster] != 0
     straight = params.switches[SWITCHES.aim_predicted] == 0
     scene_f, scene_i = state.scene_f, state.scene_i
+    views = ball_views(engine.balls)
+    diag = play_area_diagonal(params.params)
     for b in range(flags.shape[0]):
         f = flags[b]
         if f == ROW_SKIP:
             continue
-        phi_new = _straight_aim(b, engine, state, params, seq, cluster) if straight else -1.0
+        phi_new = _straight_aim(b, views, diag, state, params, seq, cluster) if straight else -1.0
         if f == ROW_STEPPED:
             _reward(b, phi_new, state, params, straight)
         else:

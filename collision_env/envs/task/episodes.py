@@ -10,8 +10,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from collision_env.engine.compiled import njit
 
 from .layout import EPISODE_FLOATS, EPISODE_INTS, TARGET_GEOMETRY
@@ -26,7 +24,21 @@ def block_size(n_balls: int, n_targets: int, tries: int) -> int:
     return 3 * n_balls + 3 * n_targets + 2 * n_balls * tries
 
 
-@njit
+@njit(inline="always")
+def _sorted(values):  # pragma: no cover - numba
+    """``values`` (a new array) sorted in place, ascending: an insertion sort, for the few numbers of
+    one episode (numba's ``np.sort`` costs more to compile than a reset's whole work)."""
+    for k in range(1, values.shape[0]):
+        v = values[k]
+        j = k
+        while j > 0 and values[j - 1] > v:
+            values[j] = values[j - 1]
+            j -= 1
+        values[j] = v
+    return values
+
+
+@njit(inline="always")
 def _draw_velocities(uniforms, ctrl_mask, episode_f, dim, vel):  # pragma: no cover - numba
     """Speeds uniform in the ball's range, directions uniform (a random sign in 1D)."""
     N = vel.shape[1]
@@ -46,7 +58,7 @@ def _draw_velocities(uniforms, ctrl_mask, episode_f, dim, vel):  # pragma: no co
                 vel[r, i, 1] = speed * math.sin(2.0 * math.pi * u)
 
 
-@njit
+@njit(inline="always")
 def _place_on_line(uniforms, off, radii, episode_f, pos, ok):  # pragma: no cover - numba
     """Balls left to right by index, the free length split at sorted uniform points (always fits)."""
     N = pos.shape[1]
@@ -56,7 +68,7 @@ def _place_on_line(uniforms, off, radii, episode_f, pos, ok):  # pragma: no cove
         free = (xmax - xmin) - _GAP * (N + 1)
         for i in range(N):
             free -= 2.0 * radii[r, i]
-        us = np.sort(uniforms[r, off : off + N] * free)
+        us = _sorted(uniforms[r, off : off + N] * free)
         edge = xmin
         for i in range(N):
             edge += _GAP
@@ -66,7 +78,7 @@ def _place_on_line(uniforms, off, radii, episode_f, pos, ok):  # pragma: no cove
         ok[r] = True
 
 
-@njit
+@njit(inline="always")
 def _place_in_box(uniforms, off, tries, ctrl_mask, rack, radii, episode_f, pos, ok):  # pragma: no cover - numba
     """Each ball at the first of its tries that overlaps no ball placed before it; ``ok[r]`` False
     when some ball of row r found no such place."""
@@ -108,7 +120,7 @@ def _place_in_box(uniforms, off, tries, ctrl_mask, rack, radii, episode_f, pos, 
                 break
 
 
-@njit
+@njit(inline="always")
 def _draw_targets(uniforms, off, walls, dim, episode_f, t_wall, t_geo):  # pragma: no cover - numba
     """Target walls uniform among ``walls``, centres uniform along the wall (the whole end wall in 1D)."""
     K = t_wall.shape[1]
@@ -132,7 +144,7 @@ def _draw_targets(uniforms, off, walls, dim, episode_f, t_wall, t_geo):  # pragm
                 t_geo[r, k, TARGET_GEOMETRY.half_width] = hw
 
 
-@njit
+@njit(inline="always")
 def _draw_windows(uniforms, off, episode_f, t_geo):  # pragma: no cover - numba
     """Time windows opening at sorted uniform times, so that the targets come due in index order."""
     K = t_geo.shape[1]
@@ -145,7 +157,7 @@ def _draw_windows(uniforms, off, episode_f, t_geo):  # pragma: no cover - numba
                 t_geo[r, k, TARGET_GEOMETRY.opens] = -_NO_WINDOW
                 t_geo[r, k, TARGET_GEOMETRY.closes] = _NO_WINDOW
             continue
-        opens = np.sort(uniforms[r, off : off + K])
+        opens = _sorted(uniforms[r, off : off + K].copy())
         for k in range(K):
             t_geo[r, k, TARGET_GEOMETRY.opens] = earliest + (latest - earliest) * opens[k]
             t_geo[r, k, TARGET_GEOMETRY.closes] = t_geo[r, k, TARGET_GEOMETRY.opens] + win

@@ -16,7 +16,7 @@ from .arrays import unpack
 from .layout import PARAMS, SCENE_FLOATS, SWITCHES
 
 
-@njit(forceinline=True)
+@njit(refcount=False, forceinline=True)
 def clip1(v):  # pragma: no cover - numba
     """``v`` clipped to [-1, 1]."""
     return min(max(v, -1.0), 1.0)
@@ -33,7 +33,7 @@ def _first_nan_row(actions, active):  # pragma: no cover - numba
     return -1
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, python=True)  # (the scripted policies call it too)
 def capped_change(vx, vy, dx, dy, max_speed):  # pragma: no cover - numba
     """The velocity change that applies (dx, dy) to (vx, vy) without exceeding max(max_speed, |v|)."""
     nx = vx + dx

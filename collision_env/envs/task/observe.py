@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 from collision_env.engine.compiled import ball_views, njit
 from collision_env.engine.scene import WALL_BOTTOM, WALL_LEFT, WALL_NAMES, WALL_RIGHT
 
@@ -24,7 +26,7 @@ from .nudge import clip1
 from .scoring import in_cluster
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def centre_and_half_size(p):  # pragma: no cover - numba
     """The play area's centre and half size, ``(xc, yc, xh, yh)``, from the parameters ``p``."""
     xmin = p[PARAMS.xmin]
@@ -34,7 +36,27 @@ def centre_and_half_size(p):  # pragma: no cover - numba
     return 0.5 * (xmin + xmax), 0.5 * (ymin + ymax), 0.5 * (xmax - xmin), 0.5 * (ymax - ymin)
 
 
-@njit(forceinline=True)
+class Scales(NamedTuple):
+    """What the observation is normalised by: the play area's centre and half size (m), and the
+    velocity (m/s), mass (kg) and time (s) scales."""
+
+    xc: float
+    yc: float
+    xh: float
+    yh: float
+    vscale: float
+    mscale: float
+    tlimit: float
+
+
+@njit(refcount=False, forceinline=True)
+def scales(p):  # pragma: no cover - numba
+    """The observation's :class:`Scales`, from the parameters ``p`` (read once per call, not per scene)."""
+    xc, yc, xh, yh = centre_and_half_size(p)
+    return Scales(xc, yc, xh, yh, p[PARAMS.vscale], p[PARAMS.mscale], p[PARAMS.time_limit])
+
+
+@njit(inline="always")
 def _observed_point(wall, centre, xc, yc, xh, yh):  # pragma: no cover - numba
     """A target's centre point in observation coordinates, and the half length of its wall."""
     if wall == WALL_LEFT:
@@ -47,13 +69,11 @@ def _observed_point(wall, centre, xc, yc, xh, yh):  # pragma: no cover - numba
 
 
 @njit(refcount=False, forceinline=True)
-def _observe_balls(b, o, obs, engine, state, params, cluster):  # pragma: no cover - numba
-    """Scene ``b``'s ball blocks from entry ``o`` on; returns the entry after them and the scene's
-    kinetic energy."""
-    pos, vel, masses, _, _, _ = ball_views(engine.balls)
-    xc, yc, xh, yh = centre_and_half_size(params.params)
-    vscale = params.params[PARAMS.vscale]
-    mscale = params.params[PARAMS.mscale]
+def _observe_balls(b, o, obs, views, state, params, cluster, sc):  # pragma: no cover - numba
+    """Scene ``b``'s ball blocks from entry ``o`` on (``views``: the engine's ``ball_views``, ``sc``:
+    the :class:`Scales`); returns the entry after them and the scene's kinetic energy."""
+    pos, vel, masses, _, _, _ = views
+    xc, yc, xh, yh, vscale, mscale = sc.xc, sc.yc, sc.xh, sc.yh, sc.vscale, sc.mscale
     ke = 0.0
     for i in range(pos.shape[1]):
         vx = vel[b, i, 0]
@@ -73,12 +93,11 @@ def _observe_balls(b, o, obs, engine, state, params, cluster):  # pragma: no cov
 
 
 @njit(refcount=False, forceinline=True)
-def _observe_targets(b, o, obs, now, state, params, seq):  # pragma: no cover - numba
+def _observe_targets(b, o, obs, now, state, seq, sc):  # pragma: no cover - numba
     """Scene ``b``'s target slots from entry ``o`` on (the current target when sequential, else
     every target); returns the entry after them."""
     targets, geo = state.targets, state.target_geo
-    xc, yc, xh, yh = centre_and_half_size(params.params)
-    tlimit = params.params[PARAMS.time_limit]
+    xc, yc, xh, yh, tlimit = sc.xc, sc.yc, sc.xh, sc.yh, sc.tlimit
     n_targets = targets.shape[1]
     for slot in range(1 if seq else n_targets):
         k = min(state.scene_i[b, SCENE_INTS.current], n_targets - 1) if seq else slot
@@ -105,12 +124,16 @@ def observe(flags, obs, engine, state, params):  # pragma: no cover - numba
     cluster = params.switches[SWITCHES.cluster] != 0
     n_steps = params.switches[SWITCHES.n_steps]
     n_targets = state.targets.shape[1]
+    # (once per call, not per scene: a view of the batch's state, or a parameter read again after each
+    # write to the observation, costs as much as a scene's block)
+    views = ball_views(engine.balls)
+    sc = scales(params.params)
     for b in range(flags.shape[0]):
         if flags[b] == ROW_SKIP:
             continue
-        o, ke = _observe_balls(b, 0, obs, engine, state, params, cluster)
+        o, ke = _observe_balls(b, 0, obs, views, state, params, cluster, sc)
         state.scene_f[b, SCENE_FLOATS.energy] = ke
-        o = _observe_targets(b, o, obs, engine.time[b], state, params, seq)
+        o = _observe_targets(b, o, obs, engine.time[b], state, seq, sc)
         steps = state.scene_i[b, SCENE_INTS.steps]
         obs[b, o + GLOBAL_OBS.steps_left] = min(max(1.0 - steps / n_steps, 0.0), 1.0)
         obs[b, o + GLOBAL_OBS.targets_left] = (n_targets - state.scene_i[b, SCENE_INTS.targets_hit]) / n_targets

@@ -28,7 +28,7 @@ from .layout import (
 )
 
 
-@njit(forceinline=True)
+@njit(refcount=False, forceinline=True)
 def on_side_wall(wall):  # pragma: no cover - numba
     """Left and right walls run along y; bottom and top along x."""
     return wall == WALL_LEFT or wall == WALL_RIGHT
@@ -44,7 +44,7 @@ def in_cluster(body, b, i):  # pragma: no cover - numba
     return False
 
 
-@njit(forceinline=True)
+@njit(refcount=False, forceinline=True)
 def visible_targets(current, n_targets, seq):  # pragma: no cover - numba
     """The range of targets that can be hit now: the current one if sequential, else all."""
     if seq:
@@ -117,7 +117,7 @@ def target_hit(j, imp, state, seq):  # pragma: no cover - numba
     return -1
 
 
-@njit(forceinline=True)
+@njit(inline="always")
 def _distance_to_target(cx, cy, wall, centre, hw, xmin, ymin, xmax, ymax):  # pragma: no cover - numba
     """Distance from (cx, cy) to the target segment of half width hw centred at ``centre`` on ``wall``."""
     if wall == WALL_LEFT:
