@@ -45,9 +45,10 @@ def advance_episodes(flags, engine, state, params):  # pragma: no cover - numba
             continue
         if f == ROW_STEPPED:
             scene_i[b, SCENE_INTS.steps] += 1
+            now = engine.time[b]
             for k in range(targets.shape[1]):
-                closes = state.target_geo[b, k, TARGET_GEOMETRY.closes]
-                if targets[b, k, TARGET_INTS.status] == TARGET_PENDING and closes < engine.time[b]:
+                pending = targets[b, k, TARGET_INTS.status] == TARGET_PENDING
+                if pending and state.target_geo[b, k, TARGET_GEOMETRY.closes] < now:
                     targets[b, k, TARGET_INTS.status] = TARGET_FAILED
         elif f == ROW_RESET:
             scene_i[b, SCENE_INTS.steps] = 0

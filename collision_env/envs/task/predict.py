@@ -78,7 +78,8 @@ def predict_kernel(h, flags, imp, obs):  # pragma: no cover - numba
                 obs[b, o + PREDICTED_OBS.y] = 0.0
                 obs[b, o + PREDICTED_OBS.time] = 1.0
                 obs[b, o + PREDICTED_OBS.hits] = 0.0
-    j, scores = next_wall_impact(0, imp, flags, False, body, params)
+    cluster = switches[SWITCHES.cluster] != 0
+    j, scores = next_wall_impact(0, imp, flags, False, body, params.scoring, cluster)
     while j < imp.shape[0]:
         b = imp[j]["scene"]
         i = imp[j]["ball"]
@@ -98,7 +99,7 @@ def predict_kernel(h, flags, imp, obs):  # pragma: no cover - numba
                     obs[b, o + PREDICTED_OBS.y] = clip1((y - yc) / yh)
                     obs[b, o + PREDICTED_OBS.time] = clip1((imp[j]["time"] - engine.time[b]) / tlimit)
                     obs[b, o + PREDICTED_OBS.hits] = 1.0 if hits else 0.0
-        j, scores = next_wall_impact(j + 1, imp, flags, False, body, params)
+        j, scores = next_wall_impact(j + 1, imp, flags, False, body, params.scoring, cluster)
     if aim:
         for b in range(flags.shape[0]):
             f = flags[b]

@@ -72,19 +72,19 @@ def _split(body, b, i):  # pragma: no cover - numba
 
 
 @njit(refcount=False, forceinline=True)
-def next_wall_impact(j, imp, flags, stepped_only, body, params):  # pragma: no cover - numba
+def next_wall_impact(j, imp, flags, stepped_only, body, scoring, cluster):  # pragma: no cover - numba
     """The first wall impact at or after record ``j`` of a scene the walk looks at (its flag is
     ``ROW_STEPPED``, or with ``stepped_only`` False anything but ``ROW_SKIP``), and whether its
-    ball scores: ``(j, scores)``, ``j = len(imp)`` when there is none. On the way, ball-ball
-    impacts merge the clusters of the mirror ``body``; the wall impact's cluster comes apart."""
-    cluster = params.switches[SWITCHES.cluster] != 0
+    ball scores (``scoring[ball]``, and with ``cluster`` scoring only while stuck): ``(j, scores)``,
+    ``j = len(imp)`` when there is none. On the way, ball-ball impacts merge the clusters of the
+    mirror ``body``; the wall impact's cluster comes apart."""
     while j < imp.shape[0]:
         b = imp[j]["scene"]
         looked_at = flags[b] == ROW_STEPPED if stepped_only else flags[b] != ROW_SKIP
         if looked_at:
             i = imp[j]["ball"]
             if imp[j]["wall"] >= 0:
-                scores = params.scoring[i] and (not cluster or in_cluster(body, b, i))
+                scores = scoring[i] and (not cluster or in_cluster(body, b, i))
                 if cluster:
                     _split(body, b, i)
                 return j, scores
@@ -166,11 +166,12 @@ def score_impacts(flags, imp, state, params):  # pragma: no cover - numba
     (``scene_i[:, hits]`` and ``misses``), marking the targets hit (and, with sequential targets,
     moving on to the next)."""
     seq = params.switches[SWITCHES.sequential] != 0
+    cluster = params.switches[SWITCHES.cluster] != 0
     scene_i = state.scene_i
     for b in range(flags.shape[0]):
         scene_i[b, SCENE_INTS.hits] = 0
         scene_i[b, SCENE_INTS.misses] = 0
-    j, scores = next_wall_impact(0, imp, flags, True, state.body, params)
+    j, scores = next_wall_impact(0, imp, flags, True, state.body, params.scoring, cluster)
     while j < imp.shape[0]:
         if scores:
             b = imp[j]["scene"]
@@ -182,4 +183,4 @@ def score_impacts(flags, imp, state, params):  # pragma: no cover - numba
                 scene_i[b, SCENE_INTS.hits] += 1
             else:
                 scene_i[b, SCENE_INTS.misses] += 1
-        j, scores = next_wall_impact(j + 1, imp, flags, True, state.body, params)
+        j, scores = next_wall_impact(j + 1, imp, flags, True, state.body, params.scoring, cluster)
