@@ -52,4 +52,4 @@ def main(argv: list[str] | None = None) -> Path:
 
 
 if __name__ == "__main__":
-    run_cli(main, prog="agents.main")
+    run_cli(main, prog="agents.main", extras=("train", "render"))

@@ -458,4 +458,4 @@ def main(argv: list[str] | None = None) -> Path:
 
 
 if __name__ == "__main__":
-    run_cli(main, prog="train_ppo")
+    run_cli(main, prog="agents.train_ppo", extras=("train",))

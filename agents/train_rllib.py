@@ -46,6 +46,7 @@ from agents.config import (
     write_yaml,
 )
 from collision_env.engine import MODES
+from collision_env.extras import require
 
 DEFAULT_ENV = "CollisionEnv/OneBallTarget-v0"
 HYPERPARAMS = Path(__file__).with_name("hyperparams") / "rllib_ppo.yml"
@@ -281,11 +282,7 @@ def train(
     steps = episode_steps(env_id, kwargs)  # validates every env kwarg
     mode = kwargs.get("mode", "exact")
     kwargs_env = {**kwargs, "max_episode_steps": steps}
-    try:
-        import ray  # noqa: F401
-        from ray.rllib.algorithms.ppo import PPOConfig  # noqa: F401
-    except ImportError:
-        raise UsageError('RLlib is not installed: pip install -e ".[distributed]" (Ray with RLlib, torch)') from None
+    require("distributed", "agents.train_rllib", checkout=True)
     config = build_config(
         env_id, kwargs_env, hp, env_runners=env_runners, envs_per_runner=envs_per_runner, vectorize=vectorize, seed=seed
     )  # validates the PPO keywords
@@ -457,4 +454,4 @@ def main(argv: list[str] | None = None) -> Path:
 
 
 if __name__ == "__main__":
-    run_cli(main, prog="train_rllib")
+    run_cli(main, prog="agents.train_rllib", extras=("distributed",))

@@ -19,6 +19,7 @@ import numpy as np
 
 from collision_env.engine.scene import WALL_BOTTOM, WALL_LEFT, WALL_RIGHT
 from collision_env.envs._layout import TARGET_FAILED, TARGET_GEOMETRY, TARGET_HIT, TARGET_PENDING
+from collision_env.extras import require
 
 #: Above this many balls, balls that are neither controlled nor scoring are drawn plain (a gas).
 CROWD = 16
@@ -46,11 +47,10 @@ FLASH_LIFE = 0.4  # s of simulated time
 
 def _pygame():
     os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
-    try:
-        import pygame
-        import pygame.gfxdraw  # noqa: F401
-    except ImportError as e:  # pragma: no cover
-        raise ImportError("rendering needs pygame: pip install 'collision_env[render]'") from e
+    require("render", "rendering")
+    import pygame
+    import pygame.gfxdraw  # noqa: F401
+
     return pygame
 
 

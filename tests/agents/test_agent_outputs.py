@@ -14,6 +14,7 @@ pytest.importorskip("yaml")
 
 from agents import evaluate, train_ppo, train_rllib  # noqa: E402
 from agents.config import UsageError  # noqa: E402
+from collision_env.extras import MissingExtra  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 TINY = ["--timesteps", "2048", "--n-envs", "4", "--eval-freq", "0", "--save-freq", "0"]
@@ -55,7 +56,7 @@ def test_subproc_workers_fork_on_linux():
 
 @pytest.mark.skipif(importlib.util.find_spec("ray") is not None, reason="ray is installed here")
 def test_train_rllib_without_ray_says_how_to_install_it(tmp_path):
-    with pytest.raises(UsageError, match=r'pip install -e "\.\[distributed\]"'):
+    with pytest.raises(MissingExtra, match=r'pip install -e "\.\[distributed\]"'):
         train_rllib.train(output=tmp_path)
     assert not any(tmp_path.iterdir())  # nothing written
 
