@@ -7,13 +7,14 @@ a flash at the exact contact point of every impact (green on a target, red elsew
 white between balls) and, optionally, ball trails. In a crowd (more than ``CROWD`` balls) only the
 controlled and scoring balls get arrows, trails and flashes; the others are drawn as a plain gas.
 A bar on top shows the time used, the time windows and the targets. ``rgb_array`` frames are
-``(H, W, 3)`` uint8; ``human`` opens a window.
+``(H, W, 3)`` uint8; ``human`` opens a window (off-screen on a Linux machine without a display).
 """
 
 from __future__ import annotations
 
 import math
 import os
+import sys
 
 import numpy as np
 
@@ -52,6 +53,15 @@ def _pygame():
     import pygame.gfxdraw  # noqa: F401
 
     return pygame
+
+
+def headless_video_driver() -> None:
+    """Before a window opens: on Linux without a display (neither ``DISPLAY`` nor ``WAYLAND_DISPLAY``
+    set), tell SDL to draw it off-screen, which is where SDL ends up on such a machine anyway, but
+    only after probing Wayland, whose client library prints ``error: XDG_RUNTIME_DIR is invalid or
+    not set in the environment.`` A driver chosen in ``SDL_VIDEODRIVER`` is kept."""
+    if sys.platform.startswith("linux") and not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
+        os.environ.setdefault("SDL_VIDEODRIVER", "offscreen")
 
 
 def _fade(colour, f):
@@ -250,6 +260,7 @@ class Renderer:
     def show(self, frame: np.ndarray, fps: int) -> None:
         pg = self.pg
         if self.window is None:
+            headless_video_driver()
             pg.display.init()
             pg.display.set_caption("collision_env")
             self.window = pg.display.set_mode((self.width, self.height))
