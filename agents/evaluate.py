@@ -110,11 +110,11 @@ def trained_policy(run_dir: str | Path, which: str = "final") -> PolicyFactory:
 
 def rllib_policy(run_dir: str | Path) -> PolicyFactory:
     """The RLlib run's policy (the RLModule in ``<run>/checkpoint``), deterministic."""
-    from agents.train_rllib import CHECKPOINT_DIR
-
     require("distributed", "evaluating an RLlib run", checkout=True)
     from agents.rllib_policy import load_module, module_policy
+    from agents.train_rllib import CHECKPOINT_DIR, quiet_ray_logs
 
+    quiet_ray_logs()
     return module_policy(load_module(Path(run_dir) / CHECKPOINT_DIR))
 
 
