@@ -18,7 +18,7 @@ OLDEST_GYMNASIUM := gymnasium==1.1.1
 COMPAT_TESTS := tests/envs
 RAY_PORT ?= 6390
 
-.PHONY: main test lint test-compat test-rllib rllib-two-nodes rllib-report bench figures agents-study clean-cache
+.PHONY: main test lint wheel-check test-compat test-rllib rllib-two-nodes rllib-report bench figures agents-study clean-cache
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -56,6 +56,19 @@ test: $(STAMP)
 lint: $(STAMP)
 	$(PY) -m ruff check .
 	$(PY) -m ruff format --check .
+
+# The package as an index would get it: build the sdist and the wheel, check their metadata
+# (twine), then install the wheel with [fast] in a clean venv, outside the checkout, and make, reset
+# and step the default env there (the first step compiles the kernels, once).
+WHEEL_DIST ?= build/dist
+WHEEL_VENV ?= build/wheel-venv
+wheel-check: $(STAMP)
+	rm -rf $(WHEEL_DIST) $(WHEEL_VENV)
+	$(PY) -m build --quiet --outdir $(WHEEL_DIST) .
+	$(PY) -m twine check --strict $(WHEEL_DIST)/*
+	$(PYTHON) -m venv $(WHEEL_VENV)
+	$(WHEEL_VENV)/bin/python -m pip install --quiet "$$(ls $(WHEEL_DIST)/*.whl)[fast]"
+	cd $(WHEEL_VENV) && bin/python $(CURDIR)/scripts/wheel_smoke.py
 
 # The env API under the oldest allowed gymnasium and under Ray's (1.2.2), with the RLlib smoke test.
 test-compat: $(OLD_STAMP) $(RAY_STAMP)

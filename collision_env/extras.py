@@ -27,7 +27,7 @@ EXTRAS: dict[str, tuple[str, ...]] = {
     "plot": ("matplotlib",),
     "peers": ("billiards", "pymunk"),
     "test": ("pytest", "xdist", "hypothesis"),
-    "dev": ("ruff",),
+    "dev": ("ruff", "build", "twine"),
     "distributed": ("ray", "torch", "yaml"),
 }
 
