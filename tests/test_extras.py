@@ -93,6 +93,7 @@ def _run_without(module: str, command: list[str], cwd: Path) -> subprocess.Compl
         (["agents.rllib_report"], "ray", "distributed"),
         (["agents.study"], "matplotlib", "plot"),
         (["agents.study"], "stable_baselines3", "train"),
+        (["collision_env.play"], "pygame", "render"),
     ],
 )
 def test_an_entry_point_without_its_extra_says_which_in_one_line(tmp_path, command, module, extra):
@@ -103,5 +104,7 @@ def test_an_entry_point_without_its_extra_says_which_in_one_line(tmp_path, comma
     assert proc.returncode == 1, proc.stderr
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and "Traceback" not in proc.stderr, proc.stderr
-    assert f"needs the '{extra}' extra ({module} is missing): pip install -e \".[{extra}]\"" in lines[0]
-    assert lines[0].startswith(("agents.", "recording", "writing", "evaluating"))
+    # the agents run from a checkout (an editable install there), the package from an index or a wheel
+    target = f'-e ".[{extra}]"' if command[0].startswith("agents.") else f'"collision_env[{extra}]"'
+    assert f"needs the '{extra}' extra ({module} is missing): pip install {target}" in lines[0]
+    assert lines[0].startswith(("agents.", "collision_env.", "recording", "writing", "evaluating"))

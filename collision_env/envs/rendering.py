@@ -111,6 +111,11 @@ class Renderer:
         xmin, ymin, xmax, ymax = self.cfg.bounds
         return (self.margin + (x - xmin) * self.ppm, self.bar + self.margin + (ymax - y) * self.ppm)
 
+    def to_world(self, px: float, py: float) -> tuple[float, float]:
+        """The point (m) that the frame's pixel (``px``, ``py``) shows (the inverse of the drawing's mapping)."""
+        xmin, ymin, xmax, ymax = self.cfg.bounds
+        return (xmin + (px - self.margin) / self.ppm, ymax - (py - self.bar - self.margin) / self.ppm)
+
     def _segment_px(self, wall, c, hw, out=5):
         xmin, ymin, xmax, ymax = self.cfg.bounds
         if wall == WALL_LEFT:
