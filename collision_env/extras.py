@@ -27,7 +27,7 @@ EXTRAS: dict[str, tuple[str, ...]] = {
     "plot": ("matplotlib",),
     "peers": ("billiards", "pymunk"),
     "test": ("pytest", "xdist", "hypothesis"),
-    "dev": ("ruff", "build", "twine"),
+    "dev": ("ruff", "build", "twine", "cffconvert"),
     "distributed": ("ray", "torch", "yaml"),
 }
 
