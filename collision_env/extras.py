@@ -28,6 +28,7 @@ EXTRAS: dict[str, tuple[str, ...]] = {
     "peers": ("billiards", "pymunk"),
     "test": ("pytest", "xdist", "hypothesis"),
     "dev": ("ruff", "build", "twine", "cffconvert"),
+    "docs": ("mkdocs", "material", "mkdocstrings", "mkdocstrings_handlers"),
     "distributed": ("ray", "torch", "yaml"),
 }
 

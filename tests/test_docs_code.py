@@ -44,6 +44,7 @@ BLOCKS = [block for path in markdown_files() for block in code_blocks(path)]
 
 def test_the_readme_and_the_docs_have_code_blocks():
     assert len(BLOCKS) >= 3
+    assert any(block.values[1] == ("ray",) for block in BLOCKS)  # the marker is in use, as documented
 
 
 @pytest.mark.parametrize("code, modules", BLOCKS)
