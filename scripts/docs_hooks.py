@@ -4,6 +4,7 @@ what the code or the README already says:
 * one page per registered env id, ``envs/<name>.md``, from the env class's docstring, its task
   entry and its GIF in ``docs/img/`` (added to the nav under "Environments"), and the table of ids
   that ``<!-- env-table -->`` stands for;
+* ``<!-- extras-table -->`` stands for the table of the optional extras, from pyproject.toml;
 * ``<!-- readme-block NAME -->`` stands for the README's generated block ``NAME`` (between
   ``<!-- NAME:start -->`` and ``<!-- NAME:end -->``), its ``docs/`` links made relative to the page;
 * Sphinx roles in docstrings (``:class:`~a.b.C` ``) are shown as plain code (``C``).
@@ -15,6 +16,7 @@ import inspect
 import os
 import re
 import sys
+import tomllib
 from pathlib import Path
 
 from mkdocs.structure.files import File
@@ -27,6 +29,7 @@ from collision_env.envs import REGISTERED  # noqa: E402
 
 ENV_SECTION = "Environments"
 ENV_TABLE = "<!-- env-table -->"
+EXTRAS_TABLE = "<!-- extras-table -->"
 README_BLOCK = re.compile(r"^<!-- readme-block (?P<name>[\w:-]+) -->$", re.M)
 ROLE = re.compile(r":(?:py:)?(?:class|func|meth|mod|attr|data|obj|exc):<code>(?P<tilde>~?)(?P<target>[^<]*)</code>")
 
@@ -86,6 +89,13 @@ def env_table(page_path: str) -> str:
     return "\n".join(rows)
 
 
+def extras_table() -> str:
+    extras = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["optional-dependencies"]
+    rows = ["| extra | installs |", "|---|---|"]
+    rows += [f"| `{name}` | {', '.join(f'`{r}`' for r in requirements)} |" for name, requirements in extras.items()]
+    return "\n".join(rows)
+
+
 def readme_block(name: str, page_path: str) -> str:
     text = (ROOT / "README.md").read_text()
     match = re.search(rf"<!-- {re.escape(name)}:start -->\n(.*?)<!-- {re.escape(name)}:end -->", text, re.S)
@@ -111,7 +121,7 @@ def on_files(files, config):
 
 
 def on_page_markdown(markdown, page, config, files):
-    markdown = markdown.replace(ENV_TABLE, env_table(page.file.src_uri))
+    markdown = markdown.replace(ENV_TABLE, env_table(page.file.src_uri)).replace(EXTRAS_TABLE, extras_table())
     return README_BLOCK.sub(lambda m: readme_block(m["name"], page.file.src_uri), markdown)
 
 
