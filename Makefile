@@ -18,7 +18,7 @@ OLDEST_GYMNASIUM := gymnasium==1.1.1
 COMPAT_TESTS := tests/envs
 RAY_PORT ?= 6390
 
-.PHONY: main test lint test-compat test-rllib rllib-two-nodes rllib-report bench figures agents-study clean-cache
+.PHONY: main test lint docs wheel-check test-compat test-rllib rllib-two-nodes rllib-report bench figures agents-study clean-cache
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -57,10 +57,29 @@ lint: $(STAMP)
 	$(PY) -m ruff check .
 	$(PY) -m ruff format --check .
 
-# The env API under the oldest allowed gymnasium and under Ray's (1.2.2), with the RLlib smoke test.
+# The documentation site (mkdocs.yml) into site/: every warning fails the build (--strict). The env
+# pages and the API reference are generated from the docstrings (scripts/docs_hooks.py, docs_griffe.py).
+docs: $(STAMP)
+	NO_MKDOCS_2_WARNING=1 $(PY) -m mkdocs build --strict
+
+# The package as an index would get it: build the sdist and the wheel, check their metadata
+# (twine), then install the wheel with [fast] in a clean venv, outside the checkout, and make, reset
+# and step the default env there (the first step compiles the kernels, once).
+WHEEL_DIST ?= build/dist
+WHEEL_VENV ?= build/wheel-venv
+wheel-check: $(STAMP)
+	rm -rf $(WHEEL_DIST) $(WHEEL_VENV)
+	$(PY) -m build --quiet --outdir $(WHEEL_DIST) .
+	$(PY) -m twine check --strict $(WHEEL_DIST)/*
+	$(PYTHON) -m venv $(WHEEL_VENV)
+	$(WHEEL_VENV)/bin/python -m pip install --quiet "$$(ls $(WHEEL_DIST)/*.whl)[fast]"
+	cd $(WHEEL_VENV) && bin/python $(CURDIR)/scripts/wheel_smoke.py
+
+# The env API under the oldest allowed gymnasium and under Ray's (1.2.2), with the RLlib smoke test and
+# the code blocks of the README and docs/ (those that need Ray run there).
 test-compat: $(OLD_STAMP) $(RAY_STAMP)
 	$(OLD_PY) -m pytest -n 2 -q -p no:cacheprovider $(COMPAT_TESTS)
-	$(RAY_PY) -m pytest -n 2 -q -p no:cacheprovider $(COMPAT_TESTS) tests/agents/test_rllib.py
+	$(RAY_PY) -m pytest -n 2 -q -p no:cacheprovider $(COMPAT_TESTS) tests/agents/test_rllib.py tests/test_docs_code.py
 
 test-rllib: $(RAY_STAMP)
 	$(RAY_PY) -m pytest -q -p no:cacheprovider tests/agents/test_rllib.py

@@ -17,6 +17,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from collision_env.extras import run_entry_point
+
 HYPERPARAMS = Path(__file__).with_name("hyperparams") / "ppo.yml"
 CONFIG_FILE = "config.yml"
 MODEL_FILE = "model.zip"
@@ -30,13 +32,26 @@ class UsageError(Exception):
     """A mistake in what the user asked for: reported as one line, without a traceback."""
 
 
-def run_cli(main: Callable[[list[str] | None], Any], argv: list[str] | None = None, prog: str = "agents") -> Any:
-    """Run ``main(argv)``; a :class:`UsageError` becomes one line on stderr and exit status 2."""
-    try:
-        return main(argv)
-    except UsageError as err:
-        print(f"{prog}: error: {err}", file=sys.stderr)
-        raise SystemExit(2) from None
+def run_cli(
+    main: Callable[[list[str] | None], Any],
+    argv: list[str] | None = None,
+    prog: str = "agents",
+    extras: tuple[str, ...] = (),
+) -> Any:
+    """Run ``main(argv)``; a :class:`UsageError` becomes one line on stderr and exit status 2.
+
+    The optional ``extras`` the command needs are checked first; a missing one (then, or a module of
+    an extra that the run reaches for later) is one line naming the extra, and exit status 1.
+    """
+
+    def call():
+        try:
+            return main(argv)
+        except UsageError as err:
+            print(f"{prog}: error: {err}", file=sys.stderr)
+            raise SystemExit(2) from None
+
+    return run_entry_point(call, prog, extras, checkout=True)
 
 
 # --------------------------------------------------------------------------------------- env ids

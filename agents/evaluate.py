@@ -48,6 +48,7 @@ from agents.config import (
     run_cli,
 )
 from collision_env.engine import MODES
+from collision_env.extras import require
 
 EVAL_SEED = 1_000_000  # evaluation episodes start far from the training and EvalCallback seeds
 BASELINES = ("random", "scripted")
@@ -109,14 +110,12 @@ def trained_policy(run_dir: str | Path, which: str = "final") -> PolicyFactory:
 
 def rllib_policy(run_dir: str | Path) -> PolicyFactory:
     """The RLlib run's policy (the RLModule in ``<run>/checkpoint``), deterministic."""
-    from agents.train_rllib import CHECKPOINT_DIR
+    require("distributed", "evaluating an RLlib run", checkout=True)
+    from agents.rllib_policy import load_module, module_policy
+    from agents.train_rllib import CHECKPOINT_DIR, quiet_ray_logs
 
-    checkpoint = Path(run_dir) / CHECKPOINT_DIR
-    try:
-        from agents.rllib_policy import load_module, module_policy
-    except ImportError:
-        raise UsageError('evaluating an RLlib run needs ray: pip install -e ".[distributed]"') from None
-    return module_policy(load_module(checkpoint))
+    quiet_ray_logs()
+    return module_policy(load_module(Path(run_dir) / CHECKPOINT_DIR))
 
 
 def is_rllib_run(run: dict) -> bool:
@@ -146,6 +145,7 @@ def run_policy(run_dir: str | Path, run: dict, which: str = "final") -> PolicyFa
         if which != "final":
             raise UsageError("an RLlib run keeps only its final policy (--model final)")
         return rllib_policy(run_dir)
+    require("train", "evaluating a stable-baselines3 run", checkout=True)
     return trained_policy(run_dir, which)
 
 
@@ -275,11 +275,9 @@ def check_video_path(path: str | Path) -> Path:
     path = Path(path)
     if path.suffix.lower() not in (".gif", ".mp4"):
         raise UsageError(f"video: expected a .gif or .mp4 path, got {path}")
+    require("render", "recording a video", checkout=True)
     if path.suffix.lower() == ".mp4":
-        import importlib.util
-
-        if importlib.util.find_spec("imageio_ffmpeg") is None:
-            raise UsageError("writing MP4 needs imageio-ffmpeg (the 'video' extra); a .gif needs nothing more")
+        require("video", "writing MP4 (a .gif needs nothing more)", checkout=True)
     return path
 
 
@@ -430,4 +428,4 @@ def main(argv: list[str] | None = None) -> dict:
 
 
 if __name__ == "__main__":
-    run_cli(main, prog="evaluate")
+    run_cli(main, prog="agents.evaluate")

@@ -5,7 +5,8 @@
 
 Trains with ``agents.train_ppo`` (native batched env, exact engine mode), evaluates the policy over
 100 deterministic episodes in exact mode beside the random and scripted baselines
-(``agents.evaluate``), records one evaluation episode as a GIF, and prints where everything went.
+(``agents.evaluate``), records one evaluation episode as a GIF, plots the learning curve (success
+rate and return against env steps, ``agents.curve``) and prints where everything went.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import json
 from pathlib import Path
 
 from agents.config import CONFIG_FILE, MODEL_FILE, add_progress_flags, as_int, run_cli, wants_progress
+from agents.curve import CURVE_FILE
 from agents.evaluate import evaluate, markdown, record
 from agents.train_ppo import train
 
@@ -47,9 +49,11 @@ def main(argv: list[str] | None = None) -> Path:
     print(f"config:      {run_dir / CONFIG_FILE}")
     print(f"evaluation:  {run_dir / 'eval-exact.json'}")
     print(f"GIF:         {gif}")
+    if (run_dir / CURVE_FILE).is_file():
+        print(f"curve:       {run_dir / CURVE_FILE}")
     print(f"TensorBoard: tensorboard --logdir {run_dir / 'tb'}")
     return run_dir
 
 
 if __name__ == "__main__":
-    run_cli(main, prog="agents.main")
+    run_cli(main, prog="agents.main", extras=("train", "render"))

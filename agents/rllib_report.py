@@ -167,4 +167,4 @@ def main(argv: list[str] | None = None) -> str:
 
 
 if __name__ == "__main__":
-    run_cli(main, prog="rllib_report")
+    run_cli(main, prog="agents.rllib_report", extras=("distributed",))

@@ -667,4 +667,4 @@ def _added(path: Path, rows: list, base: list, minutes: float) -> tuple:
 
 
 if __name__ == "__main__":
-    run_cli(main, prog="agents.study")
+    run_cli(main, prog="agents.study", extras=("train", "plot"))

@@ -22,6 +22,7 @@ The run folder (``--output``/``--run-name``) holds:
 | ``tb/`` | TensorBoard logs (``tensorboard --logdir <run>/tb``) |
 | ``monitor.csv`` | per-episode return, length and success (``<i>.monitor.csv`` per sub-env with dummy/subproc) |
 | ``train.log`` | progress lines (every 10 % of the run) when no progress bar is shown |
+| ``learning_curve.png`` | success and return against env steps (``agents.curve``; needs matplotlib) |
 
 Evaluation and checkpoint frequencies count env steps (all sub-envs together), not callback calls.
 Every evaluation replays the same episodes (the evaluation env is reseeded first), so the best
@@ -58,8 +59,10 @@ from agents.config import (
     wants_progress,
     write_yaml,
 )
+from agents.curve import CURVE_FILE, plot_learning_curve
 from collision_env.bench.machine import versions
 from collision_env.engine import MODES
+from collision_env.extras import MissingExtra
 
 DEFAULT_ENV = "CollisionEnv/OneBallTarget-v0"
 VEC_ENVS = ("native", "dummy", "subproc")
@@ -379,6 +382,10 @@ def train(
     if eval_env is not None:
         eval_env.close()
     log(f"trained {model.num_timesteps:,} steps in {seconds:.0f} s ({model.num_timesteps / seconds:,.0f} steps/s)")
+    try:
+        plot_learning_curve(run_dir, title=f"PPO on {env_id} ({mode}, substeps {substeps}), seed {seed}")
+    except MissingExtra as err:  # the run is complete without its picture: say so and go on
+        log(str(err))
     return run_dir
 
 
@@ -452,10 +459,12 @@ def main(argv: list[str] | None = None) -> Path:
     )
     print(f"model:       {run_dir / MODEL_FILE}")
     print(f"config:      {run_dir / CONFIG_FILE}")
+    if (run_dir / CURVE_FILE).is_file():
+        print(f"curve:       {run_dir / CURVE_FILE}")
     print(f"tensorboard: tensorboard --logdir {run_dir / 'tb'}")
     print(f"evaluate:    python -m agents.evaluate {run_dir}")
     return run_dir
 
 
 if __name__ == "__main__":
-    run_cli(main, prog="train_ppo")
+    run_cli(main, prog="agents.train_ppo", extras=("train",))

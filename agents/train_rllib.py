@@ -25,6 +25,7 @@ evaluates it beside the random and scripted baselines.
 from __future__ import annotations
 
 import argparse
+import logging
 import os
 import platform
 import shutil
@@ -46,6 +47,7 @@ from agents.config import (
     write_yaml,
 )
 from collision_env.engine import MODES
+from collision_env.extras import require
 
 DEFAULT_ENV = "CollisionEnv/OneBallTarget-v0"
 HYPERPARAMS = Path(__file__).with_name("hyperparams") / "rllib_ppo.yml"
@@ -115,7 +117,8 @@ def build_config(
             )
         )
         .training(**training_kwargs(hp))
-        .debugging(seed=seed, log_level="ERROR")
+        # no CPU/GPU usage metrics (which no report here reads, and which want gputil installed)
+        .debugging(seed=seed, log_level="ERROR", log_sys_usage=False)
     )
 
 
@@ -219,16 +222,52 @@ def keep_ray_on_loopback() -> None:
     ray_constants.ENABLE_RAY_CLUSTER = False  # for this process, if ray was imported before
 
 
+#: Lines Ray logs on every run that say nothing about this one (Ray 2.60), by the logger that writes
+#: them: that a new local instance uses token authentication (Ray's default, which this trainer keeps),
+#: RLlib's note that PPO runs on its new API stack (which this trainer uses on purpose), and the
+#: deprecation warning that RLlib's own RLModule constructor sets off for every module it builds.
+RAY_NOISE = {
+    "ray._private.authentication.authentication_token_setup": "Token authentication is enabled for this Ray",
+    "ray.rllib.algorithms.algorithm_config": "on the new API stack! This is the new default",
+    "ray._common.deprecation": "RLModule(config=[RLModuleConfig",
+}
+
+
+class _DropLines(logging.Filter):
+    """Drops the log records whose message contains ``text``."""
+
+    def __init__(self, text: str):
+        super().__init__()
+        self.text = text
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return self.text not in record.getMessage()
+
+
+def quiet_ray_logs() -> None:
+    """Leave the lines of :data:`RAY_NOISE` out of this process's log; everything else Ray logs stays."""
+    for name, text in RAY_NOISE.items():
+        logger = logging.getLogger(name)
+        if not any(isinstance(f, _DropLines) and f.text == text for f in logger.filters):
+            logger.addFilter(_DropLines(text))
+
+
 def start_ray(address: str | None, num_cpus: int, node_ip_address: str | None = None) -> None:
     """Join the cluster at ``address`` (this machine's address in it: ``node_ip_address``, else
-    Ray's guess), or start a private local instance on 127.0.0.1."""
+    Ray's guess), or start a private local instance on 127.0.0.1.
+
+    The workers' output stays in Ray's log files (``log_to_driver=False``); the driver logs Ray's
+    warnings and errors only (not its progress notes), and none of :data:`RAY_NOISE`.
+    """
     import ray
 
+    quiet_ray_logs()
+    quiet = {"log_to_driver": False, "logging_level": logging.WARNING}
     if address:
-        ray.init(address=address, _node_ip_address=node_ip_address, log_to_driver=False)
+        ray.init(address=address, _node_ip_address=node_ip_address, **quiet)
     else:
         keep_ray_on_loopback()
-        ray.init(num_cpus=num_cpus, include_dashboard=False, _node_ip_address="127.0.0.1", log_to_driver=False)
+        ray.init(num_cpus=num_cpus, include_dashboard=False, _node_ip_address="127.0.0.1", **quiet)
 
 
 def train(
@@ -281,11 +320,7 @@ def train(
     steps = episode_steps(env_id, kwargs)  # validates every env kwarg
     mode = kwargs.get("mode", "exact")
     kwargs_env = {**kwargs, "max_episode_steps": steps}
-    try:
-        import ray  # noqa: F401
-        from ray.rllib.algorithms.ppo import PPOConfig  # noqa: F401
-    except ImportError:
-        raise UsageError('RLlib is not installed: pip install -e ".[distributed]" (Ray with RLlib, torch)') from None
+    require("distributed", "agents.train_rllib", checkout=True)
     config = build_config(
         env_id, kwargs_env, hp, env_runners=env_runners, envs_per_runner=envs_per_runner, vectorize=vectorize, seed=seed
     )  # validates the PPO keywords
@@ -457,4 +492,4 @@ def main(argv: list[str] | None = None) -> Path:
 
 
 if __name__ == "__main__":
-    run_cli(main, prog="train_rllib")
+    run_cli(main, prog="agents.train_rllib", extras=("distributed",))

@@ -11,7 +11,10 @@ fail at ``gym.make`` time.
 from __future__ import annotations
 
 import dataclasses
+import difflib
+import inspect
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -69,6 +72,26 @@ def _number(name, value, *, low=None, high=None, strict_low=False, integer=False
     if high is not None and value > high:
         raise ValueError(f"{name}: must be <= {high}, got {value!r}")
     return value
+
+
+class UnknownKeywordError(TypeError, ValueError):
+    """A keyword that no task field (nor the env) takes. A ``TypeError``, as for any call, and a
+    ``ValueError``, as every other bad ``gym.make`` argument is."""
+
+
+def check_keywords(given: Iterable[str], known: Iterable[str]) -> None:
+    """Raise :class:`UnknownKeywordError` for any name of ``given`` not in ``known``, suggesting the
+    closest known names (``difflib.get_close_matches``)."""
+    known = sorted(known)
+    unknown = sorted(set(given) - set(known))
+    if not unknown:
+        return
+    named = []
+    for name in unknown:
+        close = difflib.get_close_matches(str(name), known, n=2)
+        hint = f" (did you mean {' or '.join(repr(c) for c in close)}?)" if close else ""
+        named.append(f"{name!r}{hint}")
+    raise UnknownKeywordError(f"unexpected keyword argument(s) {', '.join(named)}; known: {known}")
 
 
 @dataclass(frozen=True)
@@ -165,6 +188,10 @@ class TaskConfig:
     max_events: int = 10_000
     # derived (not arguments)
     n_steps: int = field(init=False, default=0)
+
+    def __new__(cls, *args, **kwargs):
+        check_keywords(kwargs, field_names())  # before the generated __init__, which names no close match
+        return super().__new__(cls)
 
     def __post_init__(self):  # noqa: C901 - one check per field, in order
         s = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
@@ -348,17 +375,37 @@ class TaskConfig:
 PRESETS: dict[str, dict] = {}
 
 
-def make_config(preset: str | None = "one_ball", **overrides) -> TaskConfig:
-    """The preset's :class:`TaskConfig` with ``overrides`` applied (``preset=None``: the defaults)."""
+def field_names() -> tuple[str, ...]:
+    """The :class:`TaskConfig` fields a caller may set (every keyword ``gym.make`` passes on to the task)."""
+    return tuple(f.name for f in dataclasses.fields(TaskConfig) if f.init)
+
+
+def keywords_of(*functions) -> tuple[str, ...]:
+    """The named parameters of ``functions`` (an env's ``__init__``, ``gym.make``): what ``also`` offers."""
+    kinds = (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)
+    return tuple(
+        name
+        for f in functions
+        for name, p in inspect.signature(f).parameters.items()
+        if p.kind in kinds and name not in ("self", "id")
+    )
+
+
+def make_config(preset: str | None = "one_ball", *, also: Iterable[str] = (), **overrides) -> TaskConfig:
+    """The preset's :class:`TaskConfig` with ``overrides`` applied (``preset=None``: the defaults).
+
+    An unknown preset is a ``ValueError``; an unknown keyword an :class:`UnknownKeywordError` (a
+    ``TypeError`` and a ``ValueError``) that suggests the closest names among the fields and
+    ``also``, the keywords the caller takes itself (an env's ``render_mode``, say).
+    """
     if preset is None:
         base = {}
     elif preset in PRESETS:
         base = dict(PRESETS[preset])
     else:
-        raise ValueError(f"preset: expected one of {sorted(PRESETS)} or None, got {preset!r}")
-    names = {f.name for f in dataclasses.fields(TaskConfig) if f.init}
-    unknown = sorted(set(overrides) - names)
-    if unknown:
-        raise TypeError(f"unexpected keyword argument(s) {unknown}; known: {sorted(names)}")
+        close = difflib.get_close_matches(str(preset), sorted(PRESETS), n=1)
+        hint = f"; did you mean {close[0]!r}?" if close else ""
+        raise ValueError(f"preset: expected one of {sorted(PRESETS)} or None, got {preset!r}{hint}")
+    check_keywords(overrides, (*field_names(), *also))
     base.update(overrides)
     return TaskConfig(**base)

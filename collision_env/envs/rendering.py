@@ -7,18 +7,20 @@ a flash at the exact contact point of every impact (green on a target, red elsew
 white between balls) and, optionally, ball trails. In a crowd (more than ``CROWD`` balls) only the
 controlled and scoring balls get arrows, trails and flashes; the others are drawn as a plain gas.
 A bar on top shows the time used, the time windows and the targets. ``rgb_array`` frames are
-``(H, W, 3)`` uint8; ``human`` opens a window.
+``(H, W, 3)`` uint8; ``human`` opens a window (off-screen on a Linux machine without a display).
 """
 
 from __future__ import annotations
 
 import math
 import os
+import sys
 
 import numpy as np
 
 from collision_env.engine.scene import WALL_BOTTOM, WALL_LEFT, WALL_RIGHT
 from collision_env.envs.task.layout import TARGET_FAILED, TARGET_GEOMETRY, TARGET_HIT, TARGET_PENDING
+from collision_env.extras import require
 
 #: Above this many balls, balls that are neither controlled nor scoring are drawn plain (a gas).
 CROWD = 16
@@ -46,12 +48,20 @@ FLASH_LIFE = 0.4  # s of simulated time
 
 def _pygame():
     os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
-    try:
-        import pygame
-        import pygame.gfxdraw  # noqa: F401
-    except ImportError as e:  # pragma: no cover
-        raise ImportError("rendering needs pygame: pip install 'collision_env[render]'") from e
+    require("render", "rendering")
+    import pygame
+    import pygame.gfxdraw  # noqa: F401
+
     return pygame
+
+
+def headless_video_driver() -> None:
+    """Before a window opens: on Linux without a display (neither ``DISPLAY`` nor ``WAYLAND_DISPLAY``
+    set), tell SDL to draw it off-screen, which is where SDL ends up on such a machine anyway, but
+    only after probing Wayland, whose client library prints ``error: XDG_RUNTIME_DIR is invalid or
+    not set in the environment.`` A driver chosen in ``SDL_VIDEODRIVER`` is kept."""
+    if sys.platform.startswith("linux") and not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
+        os.environ.setdefault("SDL_VIDEODRIVER", "offscreen")
 
 
 def _fade(colour, f):
@@ -100,6 +110,11 @@ class Renderer:
     def _px(self, x, y):
         xmin, ymin, xmax, ymax = self.cfg.bounds
         return (self.margin + (x - xmin) * self.ppm, self.bar + self.margin + (ymax - y) * self.ppm)
+
+    def to_world(self, px: float, py: float) -> tuple[float, float]:
+        """The point (m) that the frame's pixel (``px``, ``py``) shows (the inverse of the drawing's mapping)."""
+        xmin, ymin, xmax, ymax = self.cfg.bounds
+        return (xmin + (px - self.margin) / self.ppm, ymax - (py - self.bar - self.margin) / self.ppm)
 
     def _segment_px(self, wall, c, hw, out=5):
         xmin, ymin, xmax, ymax = self.cfg.bounds
@@ -253,6 +268,7 @@ class Renderer:
     def show(self, frame: np.ndarray, fps: int) -> None:
         pg = self.pg
         if self.window is None:
+            headless_video_driver()
             pg.display.init()
             pg.display.set_caption("collision_env")
             self.window = pg.display.set_mode((self.width, self.height))

@@ -20,16 +20,13 @@ import gymnasium as gym
 import numpy as np
 from gymnasium.vector import AutoresetMode
 
-try:
-    from stable_baselines3.common.vec_env import VecEnv, VecMonitor
-except ModuleNotFoundError as err:  # an optional extra: say how to get it
-    raise ModuleNotFoundError(
-        f"collision_env.envs.sb3 needs stable-baselines3 ({err.name} is missing): "
-        'pip install "collision_env[train]" (on a CPU-only machine install torch\'s CPU build first)',
-        name=err.name,
-    ) from err
+from collision_env.extras import require
 
-from collision_env.envs.vector import CollisionTargetVectorEnv
+require("train", "collision_env.envs.sb3", modules=("stable_baselines3",))  # an optional extra: say how to get it
+
+from stable_baselines3.common.vec_env import VecEnv, VecMonitor  # noqa: E402
+
+from collision_env.envs.vector import CollisionTargetVectorEnv  # noqa: E402
 
 
 class CollisionSB3VecEnv(VecEnv):

@@ -11,7 +11,7 @@ from gymnasium import spaces
 from numpy.typing import ArrayLike
 
 from collision_env.engine import BatchSimulator
-from collision_env.envs._config import PRESETS, TaskConfig, make_config
+from collision_env.envs._config import PRESETS, TaskConfig, keywords_of, make_config
 from collision_env.envs._core import Impacts, TaskCore
 from collision_env.envs.task.layout import ROW_RESET, ROW_STEPPED, SCENE_FLOATS, SCENE_INTS
 
@@ -135,7 +135,7 @@ class CollisionTargetEnv(gym.Env):
     ):
         if preset is _CLASS_PRESET:
             preset = type(self).preset
-        self.config: TaskConfig = make_config(preset, **overrides)
+        self.config: TaskConfig = make_config(preset, also=keywords_of(type(self).__init__, gym.make), **overrides)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
                 f"render_mode: expected one of {self.metadata['render_modes']} or None, got {render_mode!r}"

@@ -14,6 +14,7 @@ from __future__ import annotations
 import copy
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 from gymnasium.error import ResetNeeded
@@ -22,7 +23,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 from numpy.typing import ArrayLike
 
-from collision_env.envs._config import TaskConfig, make_config
+from collision_env.envs._config import TaskConfig, keywords_of, make_config
 from collision_env.envs._core import Impacts, TaskCore
 from collision_env.envs.task.layout import ROW_OBSERVE, ROW_RESET, ROW_SKIP, ROW_STEPPED
 
@@ -74,7 +75,7 @@ class CollisionTargetVectorEnv(VectorEnv):
             raise ValueError(f"render_mode: expected 'rgb_array' or None, got {render_mode!r}")
         if preset is _CLASS_PRESET:
             preset = type(self).preset
-        self.config: TaskConfig = make_config(preset, **overrides)
+        self.config: TaskConfig = make_config(preset, also=keywords_of(type(self).__init__, gym.make_vec), **overrides)
         cfg = self.config
         self.num_envs = int(num_envs)
         self.max_episode_steps = None if max_episode_steps is None else int(max_episode_steps)

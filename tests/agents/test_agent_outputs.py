@@ -7,13 +7,15 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 pytest.importorskip("stable_baselines3")
 pytest.importorskip("yaml")
 
-from agents import evaluate, train_ppo, train_rllib  # noqa: E402
+from agents import curve, evaluate, train_ppo, train_rllib  # noqa: E402
 from agents.config import UsageError  # noqa: E402
+from collision_env.extras import MissingExtra  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 TINY = ["--timesteps", "2048", "--n-envs", "4", "--eval-freq", "0", "--save-freq", "0"]
@@ -48,6 +50,29 @@ def test_evaluate_never_replaces_an_earlier_evaluation(tmp_path):
     assert json.loads(mine.read_text())["episodes"] == 2
 
 
+def test_the_learning_curve_reads_every_monitor_file_in_the_order_episodes_ended(tmp_path):
+    (tmp_path / "0.monitor.csv").write_text(
+        '#{"t_start": 100.0}\nr,l,t,is_success\n1.0,10,5.0,True\n3.0,30,9.0,False\n'
+    )
+    (tmp_path / "1.monitor.csv").write_text('#{"t_start": 103.0}\nr,l,t,is_success\n2.0,20,4.0,True\n')
+    episodes = curve.training_episodes(tmp_path)  # ended at 105, 107, 109
+    assert episodes["steps"].tolist() == [10, 30, 60]
+    assert episodes["return"].tolist() == [1.0, 2.0, 3.0] and episodes["success"].tolist() == [1, 1, 0]
+    assert curve.running_mean(np.array([1.0, 2.0, 3.0, 4.0]), 2).tolist() == [1.0, 1.5, 2.5, 3.5]
+    assert curve.plot_learning_curve(tmp_path).is_file()
+    assert curve.plot_learning_curve(tmp_path / "empty") is None  # no episode ended: no picture
+
+
+def test_training_without_matplotlib_says_so_in_one_line_and_finishes(tmp_path, monkeypatch):
+    monkeypatch.setitem(sys.modules, "matplotlib", None)  # as if it were not installed
+    lines = []
+    run_dir = train_ppo.train(timesteps=2048, n_envs=4, eval_freq=0, save_freq=0, output=tmp_path, log=lines.append)
+    assert (run_dir / "model.zip").is_file() and not (run_dir / curve.CURVE_FILE).exists()
+    assert lines[-1] == (
+        "the learning curve needs the 'plot' extra (matplotlib is missing): pip install -e \".[plot]\""
+    )
+
+
 def test_subproc_workers_fork_on_linux():
     expected = "fork" if sys.platform.startswith("linux") else ("forkserver", "spawn")
     assert train_ppo.subproc_start_method() in expected
@@ -55,7 +80,7 @@ def test_subproc_workers_fork_on_linux():
 
 @pytest.mark.skipif(importlib.util.find_spec("ray") is not None, reason="ray is installed here")
 def test_train_rllib_without_ray_says_how_to_install_it(tmp_path):
-    with pytest.raises(UsageError, match=r'pip install -e "\.\[distributed\]"'):
+    with pytest.raises(MissingExtra, match=r'pip install -e "\.\[distributed\]"'):
         train_rllib.train(output=tmp_path)
     assert not any(tmp_path.iterdir())  # nothing written
 

@@ -114,6 +114,7 @@ def test_train_save_reload_evaluate_and_record(tmp_path):
         ]
     )
     files = ("config.yml", "model.zip", "vecnormalize.pkl", "best_model.zip", "monitor.csv", "eval/evaluations.npz")
+    files += ("learning_curve.png",)
     for name in files:
         assert (run / name).is_file(), name
     assert list((run / "checkpoints").glob("model_*_steps.zip")) and list((run / "tb").rglob("events.out.tfevents.*"))
@@ -271,7 +272,7 @@ def test_training_on_sb3_dummy_vec_env_and_other_mode(tmp_path):
 def test_main_job_trains_evaluates_and_records(tmp_path, capsys):
     run = main_job.main(["--timesteps", "2048", "--episodes", "2", "--output", str(tmp_path), "--no-progress"])
     out = capsys.readouterr().out
-    for path in (run / "model.zip", run / "episodes.gif", run / "eval-exact.json"):
+    for path in (run / "model.zip", run / "episodes.gif", run / "eval-exact.json", run / "learning_curve.png"):
         assert path.is_file() and str(path) in out
     assert "| random |" in out and f"| {evaluate.SCRIPTED_LABEL} |" in out and "tensorboard --logdir" in out
 

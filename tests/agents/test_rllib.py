@@ -72,3 +72,17 @@ def test_two_runners_on_a_local_cluster_write_a_checkpoint_that_evaluate_reloads
     assert results["policies"]["ppo"]["success_rate"] == pytest.approx(run["evaluations"][-1]["success"])
     assert results["policies"]["random"] is not None and results["policies"]["scripted"] is not None
     assert "RLlib PPO" in evaluate.markdown(results)
+
+
+def test_a_run_from_the_command_line_logs_none_of_rays_routine_notes(tmp_path):
+    hp = tmp_path / "small.yml"
+    hp.write_text(SMALL.replace("env_runners: 2", "env_runners: 1"))
+    command = ["--hyperparams", str(hp), "--output", str(tmp_path), "--run-name", "quiet"]
+    run = subprocess.run(
+        [sys.executable, "-m", "agents.train_rllib", *command], capture_output=True, text=True, cwd=ROOT, timeout=600
+    )
+    assert run.returncode == 0, run.stderr
+    assert "iteration 2:" in run.stdout
+    # Ray's Python log lines read "<time>\t<LEVEL> <file>:<line> -- <message>"; warnings and errors would stay
+    notes = [line for line in run.stderr.splitlines() if "\tINFO " in line or "\tWARNING " in line]
+    assert notes == []

@@ -11,7 +11,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env, data_equivalence
 
 import collision_env
-from collision_env.envs import GENERIC_ID, PRESET_IDS, PRESETS, Impacts
+from collision_env.envs import GENERIC_ID, PRESET_IDS, PRESETS, Impacts, TaskConfig
 
 
 def rollout(env, seed, n=60, action_seed=0):
@@ -168,6 +168,30 @@ def test_bad_kwargs_raise_for_vector_env_too():
         gym.make_vec("CollisionEnv/Billiards-v0", 4, mode="bogus")
     with pytest.raises(ValueError):
         gym.make_vec("CollisionEnv/Line1D-v0", 4, n_balls=-2)
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda **kw: gym.make("CollisionEnv/OneBallTarget-v0", **kw),
+        lambda **kw: gym.make_vec("CollisionEnv/OneBallTarget-v0", 2, **kw),
+        lambda **kw: TaskConfig(**kw),
+    ],
+    ids=["make", "make_vec", "TaskConfig"],
+)
+def test_a_misspelt_keyword_names_the_closest_ones(make):
+    with pytest.raises(ValueError, match=r"'substep' \(did you mean 'substeps'\?\)") as err:
+        make(substep=4)
+    assert isinstance(err.value, TypeError)  # as for any call with an unknown keyword
+    with pytest.raises(ValueError, match=r"'zzz';"):  # nothing close: no suggestion
+        make(zzz=1)
+
+
+def test_a_misspelt_env_argument_or_preset_is_suggested_too():
+    with pytest.raises(ValueError, match=r"did you mean 'trails'\?"):
+        gym.make("CollisionEnv/OneBallTarget-v0", trail=True)
+    with pytest.raises(ValueError, match=r"did you mean 'billiards'\?"):
+        gym.make("CollisionEnv/Target-v0", preset="billiard")
 
 
 def test_nan_action_raises_and_leaves_state_unchanged():

@@ -1,5 +1,9 @@
 """rgb_array frames without a display, human mode in a (dummy) window."""
 
+import os
+import subprocess
+import sys
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -51,6 +55,26 @@ def test_human_mode_opens_a_window_and_returns_none():
     assert env.render() is None
     env.step(env.action_space.sample())
     env.close()
+
+
+def test_a_window_without_a_display_prints_nothing():
+    """A headless machine: no display, no SDL driver chosen, no XDG_RUNTIME_DIR (which SDL's Wayland
+    probe complains about); the env checker opens the human window too."""
+    code = (
+        "import gymnasium as gym, collision_env\n"
+        "from gymnasium.utils.env_checker import check_env\n"
+        "env = gym.make('CollisionEnv/Line1D-v0', render_mode='human')\n"
+        "env.reset(seed=0)\n"
+        "env.step(env.action_space.sample())\n"
+        "env.close()\n"
+        "check_env(gym.make('CollisionEnv/OneBallTarget-v0', render_mode='rgb_array').unwrapped)\n"
+        "print('ok')\n"
+    )
+    hidden = ("DISPLAY", "WAYLAND_DISPLAY", "XDG_RUNTIME_DIR", "SDL_VIDEODRIVER", "PYGAME_HIDE_SUPPORT_PROMPT")
+    env = {k: v for k, v in os.environ.items() if k not in hidden}
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout == "ok\n" and run.stderr == ""
 
 
 def test_render_without_mode_warns_and_returns_none():

@@ -1,0 +1,129 @@
+"""MkDocs hooks of the documentation site (mkdocs.yml ``hooks:``), so that no page copies by hand
+what the code or the README already says:
+
+* one page per registered env id, ``envs/<name>.md``, from the env class's docstring, its task
+  entry and its GIF in ``docs/img/`` (added to the nav under "Environments"), and the table of ids
+  that ``<!-- env-table -->`` stands for;
+* ``<!-- extras-table -->`` stands for the table of the optional extras, from pyproject.toml;
+* ``<!-- readme-block NAME -->`` stands for the README's generated block ``NAME`` (between
+  ``<!-- NAME:start -->`` and ``<!-- NAME:end -->``), its ``docs/`` links made relative to the page;
+* Sphinx roles in docstrings (``:class:`~a.b.C` ``) are shown as plain code (``C``).
+"""
+
+from __future__ import annotations
+
+import inspect
+import os
+import re
+import sys
+import tomllib
+from pathlib import Path
+
+from mkdocs.structure.files import File
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))  # the checkout's collision_env, whatever is installed
+
+import collision_env  # noqa: E402
+from collision_env.envs import REGISTERED  # noqa: E402
+
+ENV_SECTION = "Environments"
+ENV_TABLE = "<!-- env-table -->"
+EXTRAS_TABLE = "<!-- extras-table -->"
+README_BLOCK = re.compile(r"^<!-- readme-block (?P<name>[\w:-]+) -->$", re.M)
+ROLE = re.compile(r":(?:py:)?(?:class|func|meth|mod|attr|data|obj|exc):<code>(?P<tilde>~?)(?P<target>[^<]*)</code>")
+
+
+def env_slug(env_id: str) -> str:
+    """``CollisionEnv/OneBallTarget-v0`` -> ``oneballtarget`` (also the name of its GIF)."""
+    return env_id.split("/")[-1].rsplit("-v", 1)[0].lower()
+
+
+def summary(env_id: str) -> str:
+    """The first line of the docstring of the module that defines the id's env class."""
+    module = sys.modules[REGISTERED[env_id].single.__module__]
+    return inspect.cleandoc(module.__doc__ or "").split("\n")[0]
+
+
+def gif(env_id: str) -> str | None:
+    path = Path("img") / f"{env_slug(env_id)}.gif"
+    return path.as_posix() if (ROOT / "docs" / path).is_file() else None
+
+
+def env_page(env_id: str) -> str:
+    reg = REGISTERED[env_id]
+    single, vector = reg.single.__name__, reg.vector.__name__
+    lines = [f"# `{env_id}`", "", summary(env_id), ""]
+    if gif(env_id):
+        lines += [f'![{env_id}]({relative(gif(env_id), "envs/page.md")}){{ width="480" }}', ""]
+    lines += [
+        f'`gym.make("{env_id}")` makes the single env (`collision_env.envs.{single}`), '
+        f'`gym.make_vec("{env_id}", n)` the native vector env on the batched engine (`{vector}`); '
+        "both take any `TaskConfig` field as a keyword, the engine's `mode` and `substeps` among them.",
+        "",
+    ]
+    if reg.task is not None:
+        lines += [
+            f'The preset `{reg.task.preset}` (`gym.make("CollisionEnv/Target-v0", preset="{reg.task.preset}")`) '
+            "sets these `TaskConfig` fields; the others keep their defaults:",
+            "",
+            "| field | value |",
+            "|---|---|",
+            *(f"| `{k}` | `{v!r}` |" for k, v in reg.task.config.items()),
+            "",
+        ]
+    return "\n".join(lines) + "\n" + inspect.cleandoc(reg.single.__doc__) + "\n"
+
+
+def relative(path: str, page_path: str) -> str:
+    """``path`` (relative to docs/) as a link from the page ``page_path`` (also relative to docs/)."""
+    return Path(os.path.relpath(Path("docs", path), Path("docs", page_path).parent)).as_posix()
+
+
+def env_table(page_path: str) -> str:
+    rows = ["| id | the task | |", "|---|---|---|"]
+    for env_id in collision_env.ENV_IDS:
+        picture = f'![]({relative(gif(env_id), page_path)}){{ width="200" }}' if gif(env_id) else ""
+        link = relative(f"envs/{env_slug(env_id)}.md", page_path)
+        rows.append(f"| [`{env_id}`]({link}) | {summary(env_id)} | {picture} |")
+    return "\n".join(rows)
+
+
+def extras_table() -> str:
+    extras = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["optional-dependencies"]
+    rows = ["| extra | installs |", "|---|---|"]
+    rows += [f"| `{name}` | {', '.join(f'`{r}`' for r in requirements)} |" for name, requirements in extras.items()]
+    return "\n".join(rows)
+
+
+def readme_block(name: str, page_path: str) -> str:
+    text = (ROOT / "README.md").read_text()
+    match = re.search(rf"<!-- {re.escape(name)}:start -->\n(.*?)<!-- {re.escape(name)}:end -->", text, re.S)
+    if match is None:
+        raise ValueError(f"README.md has no block {name!r}")
+    return re.sub(r"\]\(docs/([^)]*)\)", lambda m: f"]({relative(m[1], page_path)})", match.group(1))
+
+
+# ------------------------------------------------------------------------------------------ hooks
+def on_config(config):
+    pages = [{env_id: f"envs/{env_slug(env_id)}.md"} for env_id in collision_env.ENV_IDS]
+    for item in config["nav"]:
+        if isinstance(item, dict) and ENV_SECTION in item:
+            item[ENV_SECTION] = [*item[ENV_SECTION], *pages]
+            return config
+    raise ValueError(f"mkdocs.yml: the nav has no {ENV_SECTION!r} section for the env pages")
+
+
+def on_files(files, config):
+    for env_id in collision_env.ENV_IDS:
+        files.append(File.generated(config, f"envs/{env_slug(env_id)}.md", content=env_page(env_id)))
+    return files
+
+
+def on_page_markdown(markdown, page, config, files):
+    markdown = markdown.replace(ENV_TABLE, env_table(page.file.src_uri)).replace(EXTRAS_TABLE, extras_table())
+    return README_BLOCK.sub(lambda m: readme_block(m["name"], page.file.src_uri), markdown)
+
+
+def on_page_content(html, page, config, files):
+    return ROLE.sub(lambda m: f"<code>{m['target'].rsplit('.', 1)[-1] if m['tilde'] else m['target']}</code>", html)
