@@ -113,6 +113,7 @@ figures: $(STAMP)
 	$(PY) -m collision_env.bench.engine --markdown docs/bench/engine.md --readme README.md
 	$(PY) -m collision_env.bench.scale --markdown docs/bench/scale.md --readme README.md
 	$(PY) -m collision_env.bench.envs --markdown docs/bench/envs_bench.md --readme README.md
+	$(PY) -m collision_env.bench.compile --markdown docs/bench/compile.md --readme README.md
 	$(PY) scripts/render_presets.py
 
 # Train cheap, evaluate exact: PPO under every engine mode and seed, then every preset (long).

@@ -12,23 +12,25 @@ it is the number of columns. The meanings stay attached to the layout's class
 from __future__ import annotations
 
 from collections import namedtuple
+from typing import Any
 
 from collision_env.engine.scene import WALL_NAMES
 
 
-def layout(name: str, rows: tuple) -> tuple:
+def layout(name: str, rows: tuple) -> Any:
     """A namedtuple instance: field name -> column index, columns numbered in the order of ``rows``.
 
     ``rows`` is a tuple of ``(names, meaning)``: ``names`` is one field name or several separated by
     spaces (fields documented together, such as ``"x y"``), ``meaning`` what the columns hold.
+    (Typed ``Any``: its fields are made from the table.)
     """
     fields = [field for names, _ in rows for field in names.split()]
-    cls = namedtuple(name, fields)
+    cls: Any = namedtuple(name, fields)  # type: ignore[misc]
     cls.layout_rows = tuple((tuple(names.split()), meaning) for names, meaning in rows)
     return cls(*range(len(fields)))
 
 
-def rows_of(columns: tuple) -> tuple:
+def rows_of(columns: Any) -> tuple:
     """``((first column, last column, meaning), ...)`` of a layout, one entry per row of its table."""
     out = []
     for names, meaning in type(columns).layout_rows:
