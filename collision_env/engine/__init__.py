@@ -9,6 +9,7 @@ See :class:`Simulator` (one scene) and :class:`BatchSimulator` (many scenes at o
 """
 
 from ._jit import BACKEND
+from .keywords import UnknownKeywordError
 from .scene import (
     BALL_DENSITY,
     CONSTANT_RADIUS,
@@ -43,6 +44,7 @@ __all__ = [
     "Impact",
     "Scene",
     "Simulator",
+    "UnknownKeywordError",
     "radius_from_mass",
     "warm_up",
 ]

@@ -8,11 +8,13 @@ from __future__ import annotations
 
 import math
 import numbers
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .keywords import check_keywords
 from .physics.walls import WALL_BOTTOM, WALL_LEFT, WALL_NAMES, WALL_RIGHT, WALL_TOP
 
 #: PhET Collision Lab's 2D play area, (xmin, ymin, xmax, ymax) in metres.
@@ -87,6 +89,11 @@ class Scene:
     dimension: int = 2
     inelastic: str = "slip"
     ball_collisions: bool = True
+
+    def __new__(cls, *args: Any, **kwargs: Any) -> Scene:
+        # before the generated __init__, whose TypeError names no close match
+        check_keywords(kwargs, (f.name for f in fields(cls)))
+        return super().__new__(cls)
 
     def __post_init__(self) -> None:
         if (

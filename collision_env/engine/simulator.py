@@ -10,6 +10,8 @@ changes.
 from __future__ import annotations
 
 import copy
+import functools
+import inspect
 import numbers
 import warnings
 from collections.abc import Mapping
@@ -22,6 +24,7 @@ from ._jit import BACKEND, compile_for
 from .argpack import pack_arrays
 from .broadphase import GRID_MIN_BALLS, grid_geometry
 from .frames import copy_impacts, record_frame
+from .keywords import check_keywords
 from .layout import (
     B_INV_MASS,
     B_MASS,
@@ -178,6 +181,13 @@ class BatchSimulator:
     naming the field and the ball, and changes nothing.
     """
 
+    #: Whether shapes in error messages leave out the batch axis (a :class:`Simulator`'s batch of one).
+    _single = False
+
+    def __new__(cls, *args: Any, **kwargs: Any) -> BatchSimulator:
+        check_keywords(kwargs, _keywords(cls))  # before __init__, whose TypeError names no close match
+        return super().__new__(cls)
+
     def __init__(
         self,
         scene: Scene,
@@ -225,7 +235,7 @@ class BatchSimulator:
             raise ValueError(f"positions: need at least one scene and one ball, got shape {shape}")
         self._n_scenes = n_scenes
         self._n = n
-        self._label = Labels(n_scenes)
+        self._label = Labels(n_scenes, self._single)
         pos, vel, mass, radius = checked_balls(
             scene, self._label, np.arange(n_scenes), n, positions, velocities, masses, radii
         )
@@ -522,35 +532,42 @@ class BatchSimulator:
     def num_balls(self) -> int:
         return self._n
 
+    # The state properties are read-only snapshots: a write to one raises ("assignment destination
+    # is read-only") rather than being dropped; set_scenes, nudge and set_state change the state.
     @property
     def positions(self) -> np.ndarray:
-        return self._pos.copy()
+        """``(B, N, 2)`` centres, m (a read-only snapshot)."""
+        return _snapshot(self._pos)
 
     @property
     def velocities(self) -> np.ndarray:
-        return self._vel.copy()
+        """``(B, N, 2)`` velocities, m/s (a read-only snapshot)."""
+        return _snapshot(self._vel)
 
     @property
     def masses(self) -> np.ndarray:
-        return self._mass.copy()
+        """``(B, N)`` masses, kg (a read-only snapshot)."""
+        return _snapshot(self._mass)
 
     @property
     def radii(self) -> np.ndarray:
-        return self._radius.copy()
+        """``(B, N)`` radii, m (a read-only snapshot)."""
+        return _snapshot(self._radius)
 
     @property
     def time(self) -> np.ndarray:
-        return self._time.copy()
+        """``(B,)`` each scene's clock, s (a read-only snapshot)."""
+        return _snapshot(self._time)
 
     @property
     def clusters(self) -> np.ndarray:
         """``(B, N)``: the index of the ball rooting each ball's rigid cluster (itself if free)."""
-        return self._body.copy()
+        return _snapshot(self._body)
 
     @property
     def cap_reached(self) -> np.ndarray:
         """``(B,)`` bool: the event cap stopped that scene's last step early."""
-        return self._capped.copy()
+        return _snapshot(self._capped)
 
     # the settings are fixed at construction: the kernels are bound to them (make a new simulator
     # to change one; get_state/set_state carry a state across)
@@ -674,7 +691,9 @@ class BatchSimulator:
                 raise ValueError(f"state: missing {key!r}")
             a = np.asarray(state[key])
             if a.shape != shape:
-                raise ValueError(f"state {key}: expected shape {shape}, got {a.shape}")
+                raise ValueError(
+                    f"state {key}: expected shape {self._label.shape(shape)}, got {self._label.shape(a.shape)}"
+                )
             kinds = "iu" if key == "clusters" else "iuf"
             if a.dtype.kind not in kinds:
                 raise ValueError(
@@ -746,7 +765,7 @@ class BatchSimulator:
         kept = tuple(type(b)(*(aligned_copy(a) for a in b)) for b in self._mode_arrays)
         self._mode_arrays = kept + fresh[len(kept) :]
         self._kernel = self._spec.kernel(self.scene, self._n)
-        self._label = Labels(self._n_scenes)
+        self._label = Labels(self._n_scenes, self._single)
         self._bind_views()
         self._alloc_work()
 
@@ -785,9 +804,11 @@ class Simulator:
         if shape is None or len(shape) != 2:
             got = "a ragged sequence" if shape is None else shape
             raise ValueError(f"positions: expected shape (N, 2), got {got}")
-        self._batch = BatchSimulator(
-            scene, [positions], [velocities], masses, radii, mode=mode, substeps=substeps, **options
-        )
+        check_keywords(options, _keywords(BatchSimulator))
+        # a batch of one whose errors give shapes as this simulator takes them
+        self._batch = BatchSimulator.__new__(BatchSimulator)
+        self._batch._single = True
+        self._batch.__init__(scene, [positions], [velocities], masses, radii, mode=mode, substeps=substeps, **options)
 
     @property
     def batch(self) -> BatchSimulator:
@@ -819,12 +840,13 @@ class Simulator:
         rec = self._batch._frames(dt, n, out, _single_shapes)
         return Frames(rec.time[:, 0], rec.positions[:, 0], rec.velocities[:, 0], _impact_list(rec.impacts))
 
-    positions = property(lambda self: self._batch._pos[0].copy(), doc="(N, 2) centres, m (a copy).")
-    velocities = property(lambda self: self._batch._vel[0].copy(), doc="(N, 2) velocities, m/s (a copy).")
-    masses = property(lambda self: self._batch._mass[0].copy(), doc="(N,) masses, kg.")
-    radii = property(lambda self: self._batch._radius[0].copy(), doc="(N,) radii, m.")
+    # read-only snapshots, as BatchSimulator's: set_balls, nudge and set_state change the state
+    positions = property(lambda self: _snapshot(self._batch._pos[0]), doc="(N, 2) centres, m (read-only).")
+    velocities = property(lambda self: _snapshot(self._batch._vel[0]), doc="(N, 2) velocities, m/s (read-only).")
+    masses = property(lambda self: _snapshot(self._batch._mass[0]), doc="(N,) masses, kg (read-only).")
+    radii = property(lambda self: _snapshot(self._batch._radius[0]), doc="(N,) radii, m (read-only).")
     time = property(lambda self: float(self._batch._time[0]), doc="Simulation time, s.")
-    clusters = property(lambda self: self._batch._body[0].copy(), doc="(N,) root ball of each ball's cluster.")
+    clusters = property(lambda self: _snapshot(self._batch._body[0]), doc="(N,) root ball of each ball's cluster.")
     cap_reached = property(lambda self: bool(self._batch._capped[0]), doc="The last step stopped at the event cap.")
     models = property(lambda self: self._batch.models)
     stats = property(lambda self: self._batch.stats)
@@ -865,6 +887,19 @@ class Simulator:
         return new
 
     __copy__ = copy
+
+
+@functools.cache
+def _keywords(cls: type) -> tuple[str, ...]:
+    """The keyword arguments ``cls.__init__`` takes."""
+    return tuple(inspect.signature(cls.__init__).parameters)[1:]
+
+
+def _snapshot(array: np.ndarray) -> np.ndarray:
+    """A read-only copy of ``array``: a write to it raises instead of silently changing nothing."""
+    out = array.copy()
+    out.flags.writeable = False
+    return out
 
 
 def _single_shapes(sim, n):

@@ -61,18 +61,23 @@ def check_seconds(value: float, field: str) -> None:
         raise ValueError(f"{field}: must be finite and at most {MAX_MAGNITUDE:g} s, got {value}")
 
 
-def real_array(value, shapes: list, field: str, where: Callable) -> np.ndarray:
+def real_array(value, shapes: list, field: str, where: Callable, label: Labels | None = None) -> np.ndarray:
     """A float64 copy of ``value``: real numbers (no booleans, strings or complex numbers) in one of
-    ``shapes``. ``where(index)`` names the ball of an element (for the error message)."""
+    ``shapes``, the last of them the batched one. ``where(index)`` names the ball of an element, and
+    ``label`` shows shapes (for the error message)."""
+    rank = len(shapes[-1])
+
+    def expected():
+        shown = (label.shape(s, len(s) == rank) if label else str(s) for s in shapes)
+        return " or ".join(dict.fromkeys(shown))
+
     if isinstance(value, np.ndarray) and value.dtype.kind in "iuf":
         arr = value.astype(np.float64)
     else:
         try:
             obj = np.array(value, dtype=object)
         except ValueError:
-            raise ValueError(
-                f"{field}: expected real numbers of shape {' or '.join(map(str, shapes))}, got a ragged sequence"
-            ) from None
+            raise ValueError(f"{field}: expected real numbers of shape {expected()}, got a ragged sequence") from None
         if obj.shape in shapes:
             for index, x in np.ndenumerate(obj):
                 if not is_real(x):
@@ -82,15 +87,22 @@ def real_array(value, shapes: list, field: str, where: Callable) -> np.ndarray:
                     )
         arr = obj.astype(np.float64) if obj.shape in shapes else obj
     if arr.shape not in shapes:
-        raise ValueError(f"{field}: expected shape {' or '.join(map(str, shapes))}, got {arr.shape}")
+        got = label.shape(arr.shape, arr.ndim == rank) if label else str(arr.shape)
+        raise ValueError(f"{field}: expected shape {expected()}, got {got}")
     return arr
 
 
 class Labels:
-    """How errors name a ball: ``"scene s, ball i: "`` in a batch, ``"ball i: "`` in a batch of one."""
+    """How errors name a ball (``"scene s, ball i: "`` in a batch, ``"ball i: "`` in a batch of one)
+    and shapes (without the batch axis for a ``single`` simulator, which has none)."""
 
-    def __init__(self, n_scenes: int):
+    def __init__(self, n_scenes: int, single: bool = False):
         self.n_scenes = n_scenes
+        self.single = single
+
+    def shape(self, shape: tuple[int, ...], batched: bool = True) -> str:
+        """``shape`` as the caller passed it: a batched shape loses its leading axis if single."""
+        return str(shape[1:] if self.single and batched and len(shape) > 0 else shape)
 
     def __call__(self, sc, ball=None) -> str:
         where = f"scene {sc}, " if self.n_scenes > 1 else ""
@@ -105,11 +117,11 @@ def checked_balls(scene: Scene, label: Labels, scenes, n: int, positions, veloci
     def where(index):
         return label(scenes[index[0]], index[1]) if len(index) > 1 else label(scenes[0], index[0])
 
-    pos = real_array(positions, [(k, n, 2)], "positions", where)
-    vel = real_array(velocities, [(k, n, 2)], "velocities", where)
+    pos = real_array(positions, [(k, n, 2)], "positions", where, label)
+    vel = real_array(velocities, [(k, n, 2)], "velocities", where, label)
     if masses is None:
         raise ValueError(f"masses: expected shape ({n},) or ({k}, {n}), got None")
-    m = np.broadcast_to(real_array(masses, [(n,), (k, n)], "masses", where), (k, n)).copy()
+    m = np.broadcast_to(real_array(masses, [(n,), (k, n)], "masses", where, label), (k, n)).copy()
     if radii is None:
         r = radius_from_mass(m)
     elif isinstance(radii, str):
@@ -117,7 +129,7 @@ def checked_balls(scene: Scene, label: Labels, scenes, n: int, positions, veloci
             raise ValueError(f"radii: expected None, 'constant' or an array, got {radii!r}")
         r = np.full((k, n), CONSTANT_RADIUS)
     else:
-        r = np.broadcast_to(real_array(radii, [(n,), (k, n)], "radii", where), (k, n)).copy()
+        r = np.broadcast_to(real_array(radii, [(n,), (k, n)], "radii", where, label), (k, n)).copy()
 
     def fail(mask, message):
         bad = np.argwhere(mask)
@@ -212,7 +224,7 @@ def checked_nudge(dv, scene: Scene, vel, mass, label: Labels) -> np.ndarray:
     that stay representable (bounded through the clusters' spin by the largest change of any of
     their members: a rigid impulse moves no point faster than that)."""
     n_scenes, n = mass.shape
-    dv = real_array(dv, [(n_scenes, n, 2)], "nudge", lambda index: label(*index[:2]))
+    dv = real_array(dv, [(n_scenes, n, 2)], "nudge", lambda index: label(*index[:2]), label)
     # one cheap test on the common path; find the culprit only when there is one
     if not (np.abs(dv) <= MAX_MAGNITUDE).all():
         s, i = np.argwhere(~(np.abs(dv) <= MAX_MAGNITUDE).all(-1))[0]

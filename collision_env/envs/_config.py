@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from collision_env.engine import MODES
+from collision_env.engine.keywords import check_keywords
 from collision_env.engine.scene import PLAY_AREA_1D, PLAY_AREA_2D, WALL_NAMES, radius_from_mass
 from collision_env.envs.task.layout import BALL_OBS, GLOBAL_OBS, PREDICTED_OBS, TARGET_OBS
 
@@ -72,26 +73,6 @@ def _number(name, value, *, low=None, high=None, strict_low=False, integer=False
     if high is not None and value > high:
         raise ValueError(f"{name}: must be <= {high}, got {value!r}")
     return value
-
-
-class UnknownKeywordError(TypeError, ValueError):
-    """A keyword that no task field (nor the env) takes. A ``TypeError``, as for any call, and a
-    ``ValueError``, as every other bad ``gym.make`` argument is."""
-
-
-def check_keywords(given: Iterable[str], known: Iterable[str]) -> None:
-    """Raise :class:`UnknownKeywordError` for any name of ``given`` not in ``known``, suggesting the
-    closest known names (``difflib.get_close_matches``)."""
-    known = sorted(known)
-    unknown = sorted(set(given) - set(known))
-    if not unknown:
-        return
-    named = []
-    for name in unknown:
-        close = difflib.get_close_matches(str(name), known, n=2)
-        hint = f" (did you mean {' or '.join(repr(c) for c in close)}?)" if close else ""
-        named.append(f"{name!r}{hint}")
-    raise UnknownKeywordError(f"unexpected keyword argument(s) {', '.join(named)}; known: {known}")
 
 
 @dataclass(frozen=True)
@@ -394,9 +375,10 @@ def keywords_of(*functions) -> tuple[str, ...]:
 def make_config(preset: str | None = "one_ball", *, also: Iterable[str] = (), **overrides) -> TaskConfig:
     """The preset's :class:`TaskConfig` with ``overrides`` applied (``preset=None``: the defaults).
 
-    An unknown preset is a ``ValueError``; an unknown keyword an :class:`UnknownKeywordError` (a
-    ``TypeError`` and a ``ValueError``) that suggests the closest names among the fields and
-    ``also``, the keywords the caller takes itself (an env's ``render_mode``, say).
+    An unknown preset is a ``ValueError``; an unknown keyword an
+    :class:`~collision_env.engine.keywords.UnknownKeywordError` (a ``TypeError`` and a
+    ``ValueError``) that suggests the closest names among the fields and ``also``, the keywords the
+    caller takes itself (an env's ``render_mode``, say).
     """
     if preset is None:
         base = {}

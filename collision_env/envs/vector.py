@@ -190,7 +190,7 @@ class CollisionTargetVectorEnv(VectorEnv):
                 core.reset_scenes(idx, [self._rngs[i] for i in idx])
                 flags = np.where(active, ROW_STEPPED, ROW_RESET).astype(np.int8)
                 imp = imp[active[imp["scene"]]]
-                event_cap &= active
+                event_cap = event_cap & active
             else:
                 flags = np.full(B, ROW_STEPPED, dtype=np.int8)
             obs = core.finish(flags, imp, self._fresh_obs())

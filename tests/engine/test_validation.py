@@ -134,3 +134,71 @@ def test_batch_errors_name_the_scene():
         batch.set_scenes([0, 1], [[[-1.0, 0.0], [1.0, 0.0]], [[-5.0, 0.0], [1.0, 0.0]]], np.zeros((2, 2, 2)))
     for key, value in batch.get_state().items():
         np.testing.assert_array_equal(value, before[key])
+
+
+@pytest.mark.parametrize(
+    "call, message",
+    [
+        (
+            lambda: make(velocities=[[1.0, 0.0, 0.0], [0.0, 0.0, 0.0]]),
+            r"velocities: expected shape \(2, 2\), got \(2, 3\)",
+        ),
+        (lambda: make(masses=[1.0, 2.0, 3.0]), r"masses: expected shape \(2,\), got \(3,\)"),
+        (lambda: make().nudge([[1.0, 0.0]]), r"nudge: expected shape \(2, 2\), got \(1, 2\)"),
+        (lambda: make().set_balls(velocities=[[1.0, 0.0]]), r"velocities: expected shape \(2, 2\), got \(1, 2\)"),
+        (lambda: make().set_state({**make().get_state(), "radii": np.ones(3)}), r"expected shape \(2,\), got \(3,\)"),
+    ],
+)
+def test_a_single_simulator_gives_shapes_without_a_batch_axis(call, message):
+    with pytest.raises(ValueError, match=message):
+        call()
+
+
+def test_a_batch_gives_shapes_with_its_batch_axis():
+    batch = BatchSimulator(Scene(), [GOOD["positions"]], [GOOD["velocities"]], GOOD["masses"])
+    with pytest.raises(ValueError, match=r"nudge: expected shape \(1, 2, 2\), got \(2, 2\)"):
+        batch.nudge(GOOD["velocities"])
+
+
+@pytest.mark.parametrize(
+    "call, typo, meant",
+    [
+        (lambda: make(substep=4), "substep", "substeps"),
+        (lambda: make(max_event=10), "max_event", "max_events"),
+        (
+            lambda: BatchSimulator(Scene(), [GOOD["positions"]], [GOOD["velocities"]], GOOD["masses"], mode_="naive"),
+            "mode_",
+            "mode",
+        ),
+        (lambda: Scene(bound=None), "bound", "bounds"),
+        (lambda: Scene(elasticty=0.5), "elasticty", "elasticity"),
+    ],
+)
+def test_a_misspelled_engine_keyword_names_the_closest(call, typo, meant):
+    # a TypeError, as for any call, and a ValueError, as other bad arguments are
+    for kind in (TypeError, ValueError):
+        with pytest.raises(kind, match=rf"'{typo}' \(did you mean '{meant}'"):
+            call()
+
+
+@pytest.mark.parametrize("name", ["positions", "velocities", "masses", "radii", "clusters"])
+def test_state_properties_are_read_only_snapshots(name):
+    sim = make()
+    before = getattr(sim, name)
+    with pytest.raises(ValueError, match="read-only"):
+        before[0] = 0  # a write raises rather than being dropped
+    assert np.array_equal(before, getattr(sim, name))
+    batch_view = getattr(sim.batch, name)
+    with pytest.raises(ValueError, match="read-only"):
+        batch_view[0] = 0
+
+
+def test_property_snapshots_do_not_follow_the_state():
+    sim = make()
+    before = sim.positions
+    sim.step(0.5)
+    assert not np.array_equal(before, sim.positions)
+    moved = sim.positions.copy()  # a writable copy, handed back through a setter
+    moved[0, 0] -= 0.1
+    sim.set_balls(positions=moved)
+    assert sim.positions[0, 0] == moved[0, 0]
