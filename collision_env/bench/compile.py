@@ -144,7 +144,7 @@ def main(argv=None) -> int:
             json.dump(results, f, indent=1)
     if args.markdown:
         with open(args.markdown, "w") as f:
-            f.write(table)
+            f.write("# Compile time\n\n" + table)
     if args.readme:
         write_block(args.readme, "bench:compile", table)
     return 0
