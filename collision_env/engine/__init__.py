@@ -9,6 +9,7 @@ See :class:`Simulator` (one scene) and :class:`BatchSimulator` (many scenes at o
 """
 
 from ._jit import BACKEND
+from .gas import Gas, disk_gas
 from .keywords import UnknownKeywordError
 from .scene import (
     BALL_DENSITY,
@@ -41,10 +42,12 @@ __all__ = [
     "BatchSimulator",
     "EventCapWarning",
     "Frames",
+    "Gas",
     "Impact",
     "Scene",
     "Simulator",
     "UnknownKeywordError",
+    "disk_gas",
     "radius_from_mass",
     "warm_up",
 ]

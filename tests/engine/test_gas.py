@@ -1,0 +1,91 @@
+"""Starting states for hard-disk studies: the asked area fraction, no overlap, the asked temperature."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from collision_env.engine.gas import CLOSE_PACKED, RANDOM_MAX, disk_gas
+
+
+def smallest_gap(gas):
+    """The smallest surface-to-surface distance between two disks (all pairs)."""
+    p, r = gas.positions, gas.radii
+    d = np.sqrt(((p[:, None] - p[None]) ** 2).sum(-1))
+    np.fill_diagonal(d, np.inf)
+    return float((d - (r[:, None] + r[None])).min())
+
+
+def inside(gas):
+    x0, y0, x1, y1 = gas.scene.bounds
+    p, r = gas.positions, gas.radii[:, None]
+    return bool(((p - r >= (x0, y0)) & (p + r <= (x1, y1))).all())
+
+
+@given(
+    n=st.integers(2, 300),
+    fraction=st.floats(0.01, 1.0),
+    arrangement=st.sampled_from(["lattice", "random"]),
+    diameters=st.sampled_from([(1.0,), (1.0, 1.4), (0.3, 2.0, 1.0)]),
+    seed=st.integers(0, 2**32 - 1),
+)
+@settings(max_examples=60, deadline=None)
+def test_a_gas_has_the_asked_area_fraction_and_no_overlap(n, fraction, arrangement, diameters, seed):
+    limit = RANDOM_MAX if arrangement == "random" else CLOSE_PACKED
+    try:
+        gas = disk_gas(n, fraction * limit, arrangement=arrangement, diameters=diameters, seed=seed)
+    except ValueError as error:  # a box too tight for this arrangement: refused, and said so
+        assert "packing_fraction" in str(error)
+        return
+    assert gas.packing_fraction == pytest.approx(fraction * limit, rel=1e-12)
+    assert smallest_gap(gas) >= 0.0
+    assert inside(gas)
+    assert np.array_equal(gas.radii, 0.5 * np.array(diameters)[np.arange(n) % len(diameters)])
+    # Maxwell-Boltzmann velocities at kT = 1, the centre of mass at rest
+    assert gas.kinetic_energy() == pytest.approx(n, rel=1e-12)
+    assert np.abs(gas.velocities.sum(0)).max() <= 1e-12 * n
+
+
+def test_the_dense_lattice_reaches_high_area_fractions_and_runs():
+    gas = disk_gas(400, 0.68, seed=2)
+    assert gas.packing_fraction == pytest.approx(0.68) and smallest_gap(gas) > 0.0
+    sim = gas.simulator()
+    sim.step(0.5)
+    assert sim.time == pytest.approx(0.5)
+    assert sim.kinetic_energy() == pytest.approx(gas.kinetic_energy(), rel=1e-12)
+
+
+def test_velocities_follow_maxwell_boltzmann():
+    gas = disk_gas(20_000, 0.2, mass=2.0, temperature=3.0, seed=5)
+    vx = gas.velocities[:, 0]
+    assert vx.std() == pytest.approx(math.sqrt(3.0 / 2.0), rel=0.02)
+    # a Gaussian's fourth moment is three squared variances
+    assert np.mean(vx**4) / np.mean(vx**2) ** 2 == pytest.approx(3.0, rel=0.05)
+
+
+def test_the_same_seed_gives_the_same_gas():
+    a, b = disk_gas(200, 0.4, arrangement="random", seed=7), disk_gas(200, 0.4, arrangement="random", seed=7)
+    assert np.array_equal(a.positions, b.positions) and np.array_equal(a.velocities, b.velocities)
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        (dict(n=1, packing_fraction=0.3), "n: must be an integer of at least 2"),
+        (dict(n=2.5, packing_fraction=0.3), "n: must be an integer"),
+        (dict(n=10, packing_fraction=0.0), "packing_fraction: must be in"),
+        (dict(n=10, packing_fraction=0.95), "packing_fraction: must be in"),
+        (dict(n=10, packing_fraction=0.6, arrangement="random"), "packing_fraction: must be in"),
+        (dict(n=10, packing_fraction=True), "packing_fraction: must be in"),
+        (dict(n=4096, packing_fraction=0.9), "do not fit a triangular lattice"),
+        (dict(n=10, packing_fraction=0.3, arrangement="hexagonal"), "arrangement: must be"),
+        (dict(n=10, packing_fraction=0.3, diameters=(1.0, -1.0)), "diameters: expected positive"),
+        (dict(n=10, packing_fraction=0.3, mass=0.0), "mass: must be positive"),
+        (dict(n=10, packing_fraction=0.3, temperature=math.inf), "temperature: must be positive"),
+    ],
+)
+def test_bad_input_is_refused(kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        disk_gas(**kwargs)
