@@ -192,7 +192,7 @@ def _policy_kwargs(value: Any) -> dict:
     if isinstance(value, str):
         try:
             value = eval(value, {"__builtins__": {}}, {"dict": dict, "nn": nn})  # RL Zoo's format
-        except Exception as err:  # noqa: BLE001 - any failure is the user's string
+        except Exception as err:  # any failure is the user's string
             raise UsageError(f"policy_kwargs: cannot read {value!r}: {err}") from None
     if not isinstance(value, dict):
         raise UsageError(f"policy_kwargs: expected a mapping, got {value!r}")

@@ -16,14 +16,14 @@ from pathlib import Path
 
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 
-import gymnasium as gym  # noqa: E402
-import imageio.v3 as iio  # noqa: E402
-import numpy as np  # noqa: E402
+import gymnasium as gym
+import imageio.v3 as iio
+import numpy as np
 
-import collision_env  # noqa: E402, F401
-from collision_env.envs import PRESET_IDS  # noqa: E402
-from collision_env.envs.rendering import Renderer  # noqa: E402
-from collision_env.envs.scripted import scripted_policy  # noqa: E402
+import collision_env  # noqa: F401
+from collision_env.envs import PRESET_IDS
+from collision_env.envs.rendering import Renderer
+from collision_env.envs.scripted import scripted_policy
 
 
 def render_episode(env_id: str, seed: int, ppm: float, every: int):

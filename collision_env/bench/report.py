@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .sweep import FIELDS  # noqa: F401 (re-exported for the CSV writer and tests)
+from .sweep import FIELDS
 
 #: Final-state errors (in radii) at or below this are round-off: such runs "match exact".
 ROUND_OFF = 1e-9

@@ -193,7 +193,7 @@ class TaskConfig:
         check_keywords(kwargs, field_names())  # before the generated __init__, which names no close match
         return super().__new__(cls)
 
-    def __post_init__(self):  # noqa: C901 - one check per field, in order
+    def __post_init__(self):  # one check per field, in order
         s = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
         if self.dimension not in (1, 2) or isinstance(self.dimension, bool):
             raise ValueError(f"dimension: must be 1 or 2, got {self.dimension!r}")

@@ -50,7 +50,7 @@ def _pygame():
     os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
     require("render", "rendering")
     import pygame
-    import pygame.gfxdraw  # noqa: F401
+    import pygame.gfxdraw
 
     return pygame
 
