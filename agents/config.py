@@ -23,6 +23,7 @@ HYPERPARAMS = Path(__file__).with_name("hyperparams") / "ppo.yml"
 CONFIG_FILE = "config.yml"
 MODEL_FILE = "model.zip"
 VECNORMALIZE_FILE = "vecnormalize.pkl"
+EVAL_SEED = 1_000_000  # evaluation episodes start far from the training and EvalCallback seeds
 
 #: Keys of a hyperparameter entry that are not PPO keywords.
 RUN_KEYS = ("n_envs", "n_timesteps", "policy", "normalize", "env_kwargs")

@@ -35,6 +35,7 @@ import numpy as np
 
 from agents.config import (
     CONFIG_FILE,
+    EVAL_SEED,
     MODEL_FILE,
     VECNORMALIZE_FILE,
     UsageError,
@@ -47,10 +48,10 @@ from agents.config import (
     read_run,
     run_cli,
 )
+from agents.train_rllib import ALGORITHM, CHECKPOINT_DIR, quiet_ray_logs
 from collision_env.engine import MODES
 from collision_env.extras import require
 
-EVAL_SEED = 1_000_000  # evaluation episodes start far from the training and EvalCallback seeds
 BASELINES = ("random", "scripted")
 SCRIPTED_LABEL = "scripted (aims with the engine's prediction)"
 
@@ -112,22 +113,17 @@ def rllib_policy(run_dir: str | Path) -> PolicyFactory:
     """The RLlib run's policy (the RLModule in ``<run>/checkpoint``), deterministic."""
     require("distributed", "evaluating an RLlib run", checkout=True)
     from agents.rllib_policy import load_module, module_policy
-    from agents.train_rllib import CHECKPOINT_DIR, quiet_ray_logs
 
     quiet_ray_logs()
     return module_policy(load_module(Path(run_dir) / CHECKPOINT_DIR))
 
 
 def is_rllib_run(run: dict) -> bool:
-    from agents.train_rllib import ALGORITHM
-
     return run.get("algorithm") == ALGORITHM
 
 
 def read_any_run(run_dir: str | Path) -> dict:
     """The resolved config of a train_ppo or train_rllib run folder (UsageError if it is neither)."""
-    from agents.train_rllib import CHECKPOINT_DIR
-
     run_dir = Path(run_dir)
     config = run_dir / CONFIG_FILE
     if config.is_file():

@@ -36,6 +36,7 @@ import numpy as np
 
 from agents.config import (
     CONFIG_FILE,
+    EVAL_SEED,
     UsageError,
     as_int,
     check_env_id,
@@ -296,8 +297,6 @@ def train(
     Arguments left as None come from the hyperparameter entry. Everything is validated before Ray
     starts or the run folder is made.
     """
-    from agents.evaluate import EVAL_SEED
-
     log = log or (lambda line: print(line, flush=True))
     check_env_id(env_id)
     hp = hyperparams_for(env_id, hyperparams)
