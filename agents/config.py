@@ -15,7 +15,7 @@ import math
 import sys
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 from collision_env.extras import run_entry_point
 
@@ -100,7 +100,7 @@ def episode_steps(env_id: str, env_kwargs: dict) -> int:
     """Control steps per episode of ``env_id`` under ``env_kwargs`` (validates the kwargs)."""
     import gymnasium as gym
 
-    import collision_env  # noqa: F401  (registers the ids)
+    from collision_env.envs import CollisionTargetEnv  # (importing the envs registers the ids)
 
     check_env_kwargs(env_kwargs)
     try:
@@ -108,7 +108,7 @@ def episode_steps(env_id: str, env_kwargs: dict) -> int:
     except (TypeError, ValueError) as err:
         raise UsageError(f"{env_id}: {err}") from None
     try:
-        return int(env.unwrapped.config.n_steps)
+        return int(cast(CollisionTargetEnv, env.unwrapped).config.n_steps)
     finally:
         env.close()
 

@@ -86,7 +86,7 @@ def trained_policy(run_dir: str | Path, which: str = "final") -> PolicyFactory:
     if not model_path.is_file():
         raise UsageError(f"{model_path} not found")
     model = PPO.load(model_path, device="cpu")
-    obs_rms, clip, eps = None, None, None
+    obs_rms, clip, eps = None, 0.0, 0.0  # (clip and eps are read only with obs_rms)
     norm = normalize_settings(run["hyperparams"].get("normalize"))
     if norm is not None and norm.get("norm_obs", True):
         stats = run_dir / (VECNORMALIZE_FILE if which == "final" else BEST_VECNORMALIZE_FILE)
@@ -159,11 +159,17 @@ def random_policy(seed: int = 0) -> PolicyFactory:
 def scripted_baseline(env) -> PolicyFactory | None:
     """The task's scripted aiming policy (``collision_env.envs.scripted.scripted_policy``), or None
     if the task of ``env`` has none."""
-    from collision_env.envs.scripted import scripted_policy
+    from collision_env.envs.scripted import ScriptedPolicy, scripted_policy
 
     if scripted_policy(env.unwrapped) is None:
         return None
-    return lambda env, episode: scripted_policy(env)
+
+    def factory(env: object, episode: int) -> ScriptedPolicy:
+        policy = scripted_policy(env)
+        assert policy is not None  # (the task has one)
+        return policy
+
+    return factory
 
 
 # ---------------------------------------------------------------------------------------- play
@@ -242,7 +248,7 @@ def evaluate(
     seed = as_int("seed", seed, low=0)
     kwargs = eval_kwargs(run, mode, substeps)
     env = make_env(env_id, kwargs)
-    policies = {"ppo": run_policy(run_dir, run, model)}
+    policies: dict[str, PolicyFactory | None] = {"ppo": run_policy(run_dir, run, model)}
     if "random" in baselines:
         policies["random"] = random_policy(seed)
     if "scripted" in baselines:

@@ -51,8 +51,9 @@ def time_split(venv):
         def __init__(self):
             super().__init__()
             self.raw: dict = defaultdict(float)
-            self._mark = None
+            self._mark: float | None = None
             self.engine_timed = False
+            self._wrapped: list[tuple[object, str]] = []  # (object, attribute) of the timers added
 
         def _on_training_start(self) -> None:
             self._timed(self.model.policy, "forward", "act")
@@ -93,7 +94,7 @@ def time_split(venv):
 
         def _timed(self, obj, name: str, key: str) -> None:
             add_timer(obj, name, self.raw, key)
-            self._wrapped = getattr(self, "_wrapped", []) + [(obj, name)]
+            self._wrapped.append((obj, name))
 
         def split(self, total: float) -> dict:
             """Seconds per part (``PARTS``) of a ``learn`` call that took ``total`` seconds."""

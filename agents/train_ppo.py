@@ -37,6 +37,7 @@ import argparse
 import shutil
 import time
 from pathlib import Path
+from typing import Any
 
 from agents.config import (
     CONFIG_FILE,
@@ -174,10 +175,12 @@ def _callbacks(
         """Keep the VecNormalize statistics that the best model was evaluated with."""
 
         def _on_step(self) -> bool:
-            self.model.get_vec_normalize_env().save(str(run_dir / BEST_VECNORMALIZE_FILE))
+            vec_normalize = self.model.get_vec_normalize_env()
+            assert vec_normalize is not None  # (given to normalised runs only)
+            vec_normalize.save(str(run_dir / BEST_VECNORMALIZE_FILE))
             return True
 
-    out = []
+    out: list[BaseCallback] = []
     if eval_freq:
         out.append(
             SeededEvalCallback(
@@ -221,7 +224,7 @@ def _progress_log(total: int, log, every: float = 0.1):
             done = self.model.num_timesteps
             if done >= self.next:
                 self.next += every * total
-                episodes = list(self.model.ep_info_buffer)
+                episodes = list(self.model.ep_info_buffer or ())
                 success = list(getattr(self.model, "ep_success_buffer", []))
                 line = f"{done:,} / {total:,} steps ({100 * done / total:.0f} %)"
                 if success:
@@ -435,7 +438,10 @@ def main(argv: list[str] | None = None) -> Path:
     # a run's config.yml supplies the defaults of the run it describes
     data = load_yaml(args.hyperparams)
     run = data if is_run_config(data) else {}
-    pick = lambda given, key, default: given if given is not None else run.get(key, default)  # noqa: E731
+
+    def pick(given: Any, key: str, default: Any) -> Any:
+        return given if given is not None else run.get(key, default)
+
     callbacks = {**CALLBACK_DEFAULTS, **run.get("callbacks", {})}
     run_dir = train(
         pick(args.env, "env_id", DEFAULT_ENV),

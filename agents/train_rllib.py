@@ -31,6 +31,7 @@ import platform
 import shutil
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -300,7 +301,10 @@ def train(
     log = log or (lambda line: print(line, flush=True))
     check_env_id(env_id)
     hp = hyperparams_for(env_id, hyperparams)
-    pick = lambda value, key, default: hp.get(key, default) if value is None else value  # noqa: E731
+
+    def pick(value: Any, key: str, default: Any) -> Any:
+        return hp.get(key, default) if value is None else value
+
     iterations = as_int("iterations", pick(iterations, "iterations", 100))
     env_runners = as_int("env_runners", pick(env_runners, "env_runners", 2), low=0)
     envs_per_runner = as_int("envs_per_runner", pick(envs_per_runner, "envs_per_runner", 16))

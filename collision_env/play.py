@@ -55,7 +55,7 @@ class Player:
         self.held: set[str] = set()  # arrow keys held down
         self.ball = 0  # index into cfg.controlled of the steered ball
         self.aim: np.ndarray | None = None  # the velocity the steered ball is being nudged to
-        self._press = None  # world point of a mouse press, until it is released
+        self._press: np.ndarray | None = None  # world point of a mouse press, until it is released
         self.paused = False
         self.pending = 0  # single steps asked for while paused
         self.quit = False

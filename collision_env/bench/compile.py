@@ -59,7 +59,7 @@ def rows() -> list[tuple[str, str, float | None]]:
     """``(what, code, goal in CPU seconds or None)`` of every row, in order."""
     from collision_env.engine.modes import MODES
 
-    out = [
+    out: list[tuple[str, str, float | None]] = [
         ("first exact-mode `Simulator.step` (2 elastic balls)", _STEP, 20.0),
         ('first `gym.make("CollisionEnv/OneBallTarget-v0")` + `reset` + `step`', _ENV, 30.0),
         ("`python -m collision_env.precompile` (every kernel)", _PRECOMPILE, 60.0),

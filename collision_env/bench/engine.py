@@ -40,6 +40,7 @@ import json
 import math
 import sys
 import time
+from typing import Any
 
 import numpy as np
 
@@ -120,7 +121,7 @@ def bench_gas(quick, n=50, horizon=20.0):
         for _ in range(n_frames):
             peer.step(FRAME, record=False)
 
-    ours = {}
+    ours: dict[str, Any] = {}
 
     def new_sim(max_events=10_000):
         ours["sim"] = Simulator(scene, pos, vel, masses, radii=radii, mode="exact", max_events=max_events)
@@ -148,6 +149,7 @@ def bench_gas(quick, n=50, horizon=20.0):
     # the peer's impacts over the full horizon, recorded (untimed)
     peer.start(case)
     events = peer.step(horizon)
+    assert events is not None  # (recorded)
     long_peer = _pairs(events)
     long_peer_positions = peer.state()[0]
 
@@ -157,6 +159,7 @@ def bench_gas(quick, n=50, horizon=20.0):
     t_check = 0.5 * (events["time"][k] + events["time"][k + 1])
     peer.start(case)
     peer_short = peer.step(t_check)
+    assert peer_short is not None  # (recorded)
     sim = Simulator(scene, pos, vel, masses, radii=radii, mode="exact")
     our_short = sim.step(t_check)
     same_sequence = _pairs(our_short) == _pairs(peer_short)
@@ -225,7 +228,7 @@ def bench_per_step(quick):
         pos, vel = random_balls(rng, n, PLAY_AREA_2D, STEP_RADIUS)
         masses = rng.uniform(0.5, 2.0, n)
         radii = np.full(n, STEP_RADIUS)
-        row = {"balls": n, "steps": steps, "modes": {}}
+        row: dict[str, Any] = {"balls": n, "steps": steps, "modes": {}}
         for mode, k in MODE_CONFIGS:
             sim = Simulator(Scene(), pos, vel, masses, radii=radii, mode=mode, substeps=k)
             start = sim.get_state()
@@ -430,7 +433,7 @@ def run(quick=False, parts=("gas", "per_step", "batch"), log=print):
     t0 = time.perf_counter()
     log("warming up the kernels (numba compile or cache load) ...")
     warm_up()
-    results = {}
+    results: dict[str, Any] = {}
     if "gas" in parts:
         results["gas"] = []
         for n, horizon in GAS_CASES + (() if quick else GAS_CASES_FULL):

@@ -22,13 +22,14 @@ class EngineRunner(Runner):
     """This engine, one mode."""
 
     engine = "collision_env"
+    mode: str
+    _sim: BatchSimulator  # (made by start)
 
     def __init__(self, mode: str, substeps: int = 1, max_events: int = 10_000):
         self.mode = mode
         self.substeps = substeps
         self.max_events = max_events
         self.iterations = None
-        self._sim = None
         self._capped = False
 
     @property
@@ -70,11 +71,11 @@ class EngineRunner(Runner):
 def engine_runners(full: bool) -> list[Runner]:
     """This engine's configurations: naive, posteriori with 1/2/4/8 substeps (quick: 1 and 8), exact."""
     ks = (1, 2, 4, 8) if full else (1, 8)
-    return [EngineRunner("naive")] + [EngineRunner("posteriori", k) for k in ks] + [EngineRunner("exact")]
+    return [EngineRunner("naive"), *(EngineRunner("posteriori", k) for k in ks), EngineRunner("exact")]
 
 
 #: the knobs each peer is measured at, ``(full run, quick run)``
-PEER_KNOBS = {
+PEER_KNOBS: dict[str, tuple[list[dict[str, int]], list[dict[str, int]]]] = {
     "pymunk": (
         [{"iterations": 10}, {"iterations": 10, "substeps": 8}, {"iterations": 30}],
         [{"iterations": 10}, {"iterations": 10, "substeps": 8}],
@@ -85,12 +86,13 @@ PEER_KNOBS = {
 
 def peer_runners(full: bool) -> tuple[list[Runner], dict[str, str]]:
     """Installed peers at their knobs, and the reasons for the ones missing."""
-    runners, missing = [], {}
+    runners: list[Runner] = []
+    missing: dict[str, str] = {}
     for name in PEERS:
         first = make_peer(name)
         if isinstance(first, str):
             missing[name] = first
             continue
         full_knobs, quick_knobs = PEER_KNOBS[name]
-        runners += [make_peer(name, **knobs) for knobs in (full_knobs if full else quick_knobs)]
+        runners += [PEERS[name](**knobs) for knobs in (full_knobs if full else quick_knobs)]  # (installed)
     return runners, missing

@@ -317,14 +317,14 @@ def cells(quick: bool = False) -> list[Cell]:
         n = 3 if r >= 0.5 else 4
         for dt in (1e-3, 0.1):
 
-            def build(r=r, n=n):
+            def build_sized(r=r, n=n):
                 c = gas(n, radius=r, packing=n * math.pi * r * r / 8.0, speed=1.0, seed=6)
                 return c
 
             add(
                 f"gas{n} r={r:g} dt={dt:g}",
                 "radius",
-                build,
+                build_sized,
                 dt,
                 5.0,
                 _box_rate(n, 1.0, PLAY_AREA_2D, r),
@@ -567,7 +567,7 @@ def _three_balls(e):
     )
 
 
-def _run_exact(case, dt, duration):
+def _run_exact(case: Case, dt: float, duration: float) -> tuple[np.ndarray, Simulator]:
     """The impacts of ``case`` in exact mode over ``duration`` (steps of ``dt``) and the final simulator."""
     sim = Simulator(*case, mode="exact")
     rows = [sim.batch.step(dt) for _ in range(max(1, int(round(duration / dt))))]
@@ -825,7 +825,7 @@ def run_cell(cell: Cell, mode: str, substeps: int, budget: float) -> dict:
     ke0 = sim.kinetic_energy()
     ke_prev = ke0
     count = 0
-    keep = []
+    keep: list[np.ndarray] | None = []
     kept = 0
     worst_step = 0.0
     engine_time = 0.0

@@ -45,7 +45,7 @@ def as_impacts(impacts) -> np.ndarray:
     """
     if isinstance(impacts, np.ndarray) and impacts.dtype.names is not None:
         out = np.empty(len(impacts), dtype=IMPACTS)
-        for name in IMPACTS.names:
+        for name in IMPACTS.names or ():
             out[name] = impacts[name]
         return out
     rows = []
@@ -159,7 +159,8 @@ def match_impacts(run, ref, window: float, neighbours: int = 4) -> Match:
         d_all.append(d[keep])
         j_all.append(ref_idx[q[keep]])
         i_all.append(run_idx[which[keep]])
-    pr, pf = [], []
+    matched_run: list[int] = []
+    matched_ref: list[int] = []
     if d_all:
         d = np.concatenate(d_all)
         j = np.concatenate(j_all)
@@ -172,15 +173,15 @@ def match_impacts(run, ref, window: float, neighbours: int = 4) -> Match:
             if run_used[ii] or ref_used[jj]:
                 continue
             run_used[ii] = ref_used[jj] = True
-            pr.append(ii)
-            pf.append(jj)
-            if len(pr) == most:
+            matched_run.append(ii)
+            matched_ref.append(jj)
+            if len(matched_run) == most:
                 break
     else:
         run_used = np.zeros(len(run), dtype=bool)
         ref_used = np.zeros(len(ref), dtype=bool)
-    pr = np.array(pr, dtype=np.int64)
-    pf = np.array(pf, dtype=np.int64)
+    pr = np.array(matched_run, dtype=np.int64)
+    pf = np.array(matched_ref, dtype=np.int64)
     time_error = np.abs(run["time"][pr] - ref["time"][pf])
     point_error = np.hypot(run["x"][pr] - ref["x"][pf], run["y"][pr] - ref["y"][pf])
     run_pairs = {k for k in run_keys if k[2] < 0}

@@ -156,7 +156,7 @@ def results_markdown(rows, missing, env_rows, quick, meta) -> str:
         "| scene | n | engine / mode | " + " | ".join(f"dt={d:g}" for d in dts) + " |",
         "|---|---:|---|" + "---:|" * len(dts),
     ]
-    largest = {}
+    largest: dict[str, int] = {}
     for r in ok:
         largest[r["scene"]] = max(largest.get(r["scene"], 0), r["n"])
     for scene, n in largest.items():
@@ -231,7 +231,7 @@ def plot_all(rows, out: Path) -> list[str]:
     names = []
 
     # 1. Pareto front: error vs cost, one panel per scene at its largest ball count
-    largest = {}
+    largest: dict[str, int] = {}
     for r in ok:
         largest[r["scene"]] = max(largest.get(r["scene"], 0), r["n"])
     scenes = list(largest)
@@ -596,7 +596,7 @@ def summary_markdown(rows, extreme_rows, stat_rows, quick, meta) -> str:
         for mode in dict.fromkeys(r["mode"] for r in extreme_rows):
             rs = [r for r in extreme_rows if r["mode"] == mode]
             fails = [r for r in rs if r["status"] != "pass"]
-            reasons = defaultdict(int)
+            reasons: defaultdict[str, int] = defaultdict(int)
             for r in fails:
                 for reason in str(r["status"]).split(", "):
                     reasons[reason] += 1

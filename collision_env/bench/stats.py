@@ -65,6 +65,7 @@ def gas_statistics(quick: bool, log=print) -> list[dict]:
         n = 64
         case = spec.case(n)
         b = case.scene.bounds
+        assert b is not None  # (a bounded scene)
         area = (b[2] - b[0]) * (b[3] - b[1])
         r = float(case.radii[0])
         m = float(case.masses[0])

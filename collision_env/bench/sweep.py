@@ -157,7 +157,8 @@ def reference(spec: SceneSpec, n: int) -> Reference:
     horizon = spec.horizon
     if spec.chaotic:
         first = record_run(exact, case, [horizon / REFERENCE_STEPS] * REFERENCE_STEPS)
-        horizon = M.short_horizon(first.impacts, n, COLLISIONS_PER_BALL, default=horizon)
+        short = M.short_horizon(first.impacts, n, COLLISIONS_PER_BALL, default=horizon)
+        horizon = horizon if short is None else short
     rec = record_run(exact, case, [horizon / REFERENCE_STEPS] * REFERENCE_STEPS)
     v_peak = float(np.sqrt((rec.velocities**2).sum(-1)).max())
     per_ball = M.collisions_per_ball(rec.impacts, n).mean() if len(rec.impacts) else 0.0
@@ -334,7 +335,7 @@ def run_sweep(quick: bool, scenes=None, peers=True, log=print) -> tuple[list[dic
     """The whole sweep; returns the rows and what was left out (missing peers)."""
     warm_up()
     runners = engine_runners(full=not quick)
-    missing = {}
+    missing: dict[str, str] = {}
     if peers:
         extra, missing = peer_runners(full=not quick)
         runners = runners + extra

@@ -165,6 +165,8 @@ if HAVE_NUMBA:
     from numba.core import types as _types
     from numba.core.caching import CompileResultCacheImpl, FunctionCache, _CacheLocator
     from numba.core.registry import CPUDispatcher
+    from numba.core.types.containers import BaseTuple as _BaseTuple  # (not in numba's stubs of types)
+    from numba.core.types.misc import unliteral as _unliteral
 
     class _SourceHashLocator(_CacheLocator):
         """Numba cache locator: one folder for the whole package, named by its source hash."""
@@ -207,14 +209,14 @@ if HAVE_NUMBA:
         """The type a kernel called from another is compiled for: literals as their plain type, and
         every integer as int64 (an index read from an int32 array and one counted in a loop then
         share one compiled version)."""
-        t = _types.unliteral(t)
+        t = _unliteral(t)
         return _types.int64 if isinstance(t, _types.Integer) else t
 
     def _closure_key(func) -> bytes:
         """What identifies a closure's constants across processes: each cell's pickled value, or for
         a cell holding a kernel, that kernel's name and the key of its own cells (its code is
         covered by :data:`SOURCE_HASH`)."""
-        parts = []
+        parts: list[object] = []
         for cell in func.__closure__ or ():
             value = cell.cell_contents
             if isinstance(value, CPUDispatcher):
@@ -331,7 +333,7 @@ if HAVE_NUMBA:
     def prefetch(typingctx, array, index):
         """Ask for the cache line of ``array[index]`` (``index``: an integer, or a tuple of one per
         axis) to be brought in for reading. A hint: it changes no value and cannot fault."""
-        indices = tuple(index) if isinstance(index, _types.BaseTuple) else (index,)
+        indices = tuple(index) if isinstance(index, _BaseTuple) else (index,)
         if not (isinstance(array, _types.Array) and len(indices) == array.ndim):
             return None
         if not all(isinstance(i, _types.Integer) for i in indices):
@@ -340,7 +342,7 @@ if HAVE_NUMBA:
         def codegen(context, builder, signature, args):
             array_type, index_type = signature.args
             view = context.make_array(array_type)(context, builder, args[0])
-            if isinstance(index_type, _types.BaseTuple):
+            if isinstance(index_type, _BaseTuple):
                 values, types = _cgutils.unpack_tuple(builder, args[1]), tuple(index_type)
             else:
                 values, types = [args[1]], (index_type,)

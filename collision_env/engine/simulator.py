@@ -12,8 +12,8 @@ from __future__ import annotations
 import copy
 import numbers
 import warnings
-from collections.abc import Mapping
-from typing import Any, NamedTuple
+from collections.abc import Mapping, Sequence
+from typing import Any, NamedTuple, cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -181,8 +181,8 @@ class BatchSimulator:
     def __init__(
         self,
         scene: Scene,
-        positions: ArrayLike,
-        velocities: ArrayLike,
+        positions: ArrayLike | Sequence[ArrayLike],
+        velocities: ArrayLike | Sequence[ArrayLike],
         masses: ArrayLike,
         radii: ArrayLike | str | None = None,
         *,
@@ -214,7 +214,7 @@ class BatchSimulator:
         self._collapse_floor = float(collapse_floor)
 
         try:
-            shape = np.shape(positions)
+            shape = np.shape(cast(ArrayLike, positions))  # (numpy's ArrayLike leaves out lists of arrays)
         except ValueError:  # numpy refuses ragged nesting
             shape = None
         if shape is None or len(shape) != 3 or shape[-1] != 2:
@@ -299,7 +299,7 @@ class BatchSimulator:
         if rows is None:
             rows = self._spec.impact_rows(self.scene, self._n, self._uses_grid())
         self._imp = np.empty(rows, dtype=IMPACT_DTYPE)
-        self._imp_bytes = memoryview(self._imp.view(np.uint8))
+        self._imp_bytes = self._imp.view(np.uint8).data
         counts = getattr(self, "_n_imp", None)  # (kept when the buffer grows in the middle of a step)
         self._n_imp = np.zeros(3, dtype=np.int64)  # rows filled, scenes that reached the cap, stalled
         if counts is not None:
@@ -446,7 +446,7 @@ class BatchSimulator:
         return Frames(times, positions, velocities, impacts)
 
     @staticmethod
-    def _frame_rows(positions, velocities):
+    def _frame_rows(positions: np.ndarray, velocities: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(F, B, N, 2) frames as the kernels record them: (F, B * N, 2) views."""
         f, b, n, _ = positions.shape
         return positions.reshape(f, b * n, 2), velocities.reshape(f, b * n, 2)
@@ -594,7 +594,7 @@ class BatchSimulator:
         return (self._mass[..., None] * self._vel).sum(1)
 
     # ------------------------------------------------------------------ changing the state
-    def nudge(self, dv: ArrayLike, check: bool = True) -> None:
+    def nudge(self, dv: ArrayLike | Sequence[ArrayLike], check: bool = True) -> None:
         """Change every ball's velocity by ``dv`` (``(B, N, 2)``), as an impulse ``m dv``.
 
         A member of a stuck cluster passes the impulse to the whole cluster (linear and angular).
@@ -610,8 +610,8 @@ class BatchSimulator:
     def set_scenes(
         self,
         index: ArrayLike,
-        positions: ArrayLike,
-        velocities: ArrayLike,
+        positions: ArrayLike | Sequence[ArrayLike],
+        velocities: ArrayLike | Sequence[ArrayLike],
         masses: ArrayLike | None = None,
         radii: ArrayLike | str | None = None,
         time: ArrayLike = 0.0,
@@ -624,7 +624,7 @@ class BatchSimulator:
         """
         time = real_number(time, "time")
         check_seconds(time, "time")
-        idx = np.arange(self._n_scenes)[index]
+        idx = np.arange(self._n_scenes)[cast(Any, index)]  # (indices or a mask: numpy's indexing decides)
         idx = np.atleast_1d(idx)
         if masses is None:
             masses = self._mass[idx]

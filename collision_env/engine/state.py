@@ -189,7 +189,7 @@ def pack(*bundles: NamedTuple, frames: bool = False) -> np.ndarray | tuple:
 def with_frames(h: np.ndarray | tuple, slot: int, frames: FramesOut) -> np.ndarray | tuple:
     """Pack ``h`` (made with room for frames) with ``frames`` at ``slot``; without numba, the
     tuple of bundles with ``frames`` last."""
-    if not HAVE_NUMBA:
+    if isinstance(h, tuple):  # (without numba)
         return (*h, frames)
     set_slots(h, slot, frames)
     return h

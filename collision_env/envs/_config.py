@@ -157,7 +157,7 @@ class TaskConfig:
     n_balls: int = 1
     mass_range: tuple = (1.0, 1.0)
     others_mass_range: tuple | None = None
-    radius: object = "mass"
+    radius: str | float = "mass"
     layout: str = "random"
     speed_range: tuple = (0.3, 0.8)
     others_speed_range: tuple = (0.0, 0.0)
@@ -198,10 +198,12 @@ class TaskConfig:
         if self.dimension not in (1, 2) or isinstance(self.dimension, bool):
             raise ValueError(f"dimension: must be 1 or 2, got {self.dimension!r}")
         s("dimension", int(self.dimension))
-        if self.bounds is None:
-            s("bounds", PLAY_AREA_1D if self.dimension == 1 else PLAY_AREA_2D)
+        bounds = self.bounds
+        if bounds is None:
+            bounds = PLAY_AREA_1D if self.dimension == 1 else PLAY_AREA_2D
+            s("bounds", bounds)
         try:
-            b = tuple(float(v) for v in self.bounds)
+            b = tuple(float(v) for v in bounds)
         except (TypeError, ValueError):
             raise ValueError(f"bounds: expected (xmin, ymin, xmax, ymax), got {self.bounds!r}") from None
         if len(b) != 4 or not all(math.isfinite(v) for v in b) or not (b[0] < b[2] and b[1] < b[3]):
@@ -219,10 +221,11 @@ class TaskConfig:
         s("mass_range", _pair("mass_range", self.mass_range))
         if self.mass_range[0] <= 0:
             raise ValueError(f"mass_range: masses must be > 0, got {self.mass_range!r}")
-        if self.others_mass_range is None:
-            s("others_mass_range", self.mass_range)
-        s("others_mass_range", _pair("others_mass_range", self.others_mass_range))
-        if self.others_mass_range[0] <= 0:
+        others = _pair(
+            "others_mass_range", self.mass_range if self.others_mass_range is None else self.others_mass_range
+        )
+        s("others_mass_range", others)
+        if others[0] <= 0:
             raise ValueError(f"others_mass_range: masses must be > 0, got {self.others_mass_range!r}")
         if isinstance(self.radius, str):
             if self.radius not in RADIUS_RULES:
@@ -296,7 +299,7 @@ class TaskConfig:
         s("max_events", _number("max_events", self.max_events, low=1, integer=True))
         s("n_steps", max(1, int(round(self.time_limit / self.dt))))
         # geometric feasibility: every ball must fit, and the balls must be placeable
-        extremes = np.array([*self.mass_range, *self.others_mass_range])
+        extremes = np.array([*self.mass_range, *others])
         r_big = float(self.radius_of(extremes).max())
         if 2 * r_big >= min(b[2] - b[0], b[3] - b[1]):
             raise ValueError(f"radius: a ball of radius {r_big:.4g} m does not fit in bounds {b}")

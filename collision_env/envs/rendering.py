@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 import os
 import sys
+from typing import Any
 
 import numpy as np
 
@@ -85,8 +86,8 @@ class Renderer:
         self.width = int(round((xmax - xmin) * ppm)) + 2 * margin
         self.height = int(round((ymax - ymin) * ppm)) + 2 * margin + bar
         self.surf = self.pg.Surface((self.width, self.height))
-        self.window = None
-        self.clock = None
+        self.window: Any = None  # pygame's display surface and clock, once shown (pygame is imported lazily)
+        self.clock: Any = None
         self.start()
 
     # ------------------------------------------------------------------------------------- #

@@ -14,7 +14,7 @@ per sub-env holding ``is_success``, ``TimeLimit.truncated`` and, when the episod
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, cast
 
 import gymnasium as gym
 import numpy as np
@@ -42,7 +42,7 @@ class CollisionSB3VecEnv(VecEnv):
         self,
         env_id: str | None = None,
         n_envs: int = 1,
-        venv: CollisionTargetVectorEnv | None = None,
+        venv: gym.vector.VectorEnv | None = None,
         **env_kwargs: Any,
     ):
         if venv is None:
@@ -65,7 +65,7 @@ class CollisionSB3VecEnv(VecEnv):
             )
         self.venv = venv
         super().__init__(venv.num_envs, venv.single_observation_space, venv.single_action_space)
-        self._actions = None
+        self._actions: np.ndarray | None = None
 
     # ------------------------------------------------------------------------------------- #
     def reset(self) -> np.ndarray:
@@ -75,7 +75,8 @@ class CollisionSB3VecEnv(VecEnv):
             if any(o != self._options[0] for o in self._options):
                 raise ValueError("per-sub-env reset options differ; the batched env takes one options dict")
             options = dict(self._options[0])
-        obs, info = self.venv.reset(seed=seeds, options=options)
+        # (one seed per sub-env, as CollisionTargetVectorEnv.reset takes; VectorEnv declares int | None)
+        obs, info = self.venv.reset(seed=cast(Any, seeds), options=options)
         self.reset_infos = self._split(info, np.ones(self.num_envs, dtype=bool))
         self._reset_seeds()
         self._reset_options()
@@ -120,7 +121,7 @@ class CollisionSB3VecEnv(VecEnv):
     # ------------------------------------------------------------------------------------- #
     def get_images(self) -> list[np.ndarray | None]:
         frames = self.venv.render()
-        return list(frames) if frames is not None else [None] * self.num_envs
+        return cast("list[np.ndarray | None]", list(frames)) if frames is not None else [None] * self.num_envs
 
     def get_attr(self, attr_name: str, indices=None) -> list:
         value = getattr(self.venv, attr_name)

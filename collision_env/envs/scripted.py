@@ -88,7 +88,7 @@ class AimingPolicy(ScriptedPolicy):
         self.speed = speed
         self.lookahead = lookahead
         self.angles = np.linspace(-math.pi, math.pi, directions, endpoint=False)
-        self.want = {}
+        self.want: dict[int, np.ndarray | None] = {}
 
     def _pending(self) -> list:
         core, cfg = self.env.core, self.env.config

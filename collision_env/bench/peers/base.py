@@ -20,10 +20,14 @@ class Runner:
     """Common interface: ``start(case)``, ``step(dt, record)`` -> impacts or None, ``state()``."""
 
     engine = "?"
-    family = "?"  # what a curve in the plots is: "naive", "posteriori k=4", "exact", "pymunk", "billiards"
     mode: str | None = None
     substeps = 1
     iterations: int | None = None
+
+    @property
+    def family(self) -> str:
+        """What a curve in the plots is: "naive", "posteriori k=4", "exact", "pymunk", "billiards"."""
+        return "?"
 
     @property
     def label(self) -> str:

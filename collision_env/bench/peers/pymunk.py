@@ -88,7 +88,7 @@ class PymunkRunner(Runner):
         self._space = space
         self._time = 0.0
         self._now = 0.0
-        self._log = []
+        self._log: list[tuple] = []
         self._count = 0
         self._recording = False
         space.on_collision(begin=self._begin)

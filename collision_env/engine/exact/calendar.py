@@ -33,7 +33,8 @@ scene never compiles it.
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from collections.abc import Callable
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -658,11 +659,11 @@ class QueueOps(NamedTuple):
     afresh, move an event after its time changed, the ball whose event comes first, rebase its
     times at a step's end, and a step of the walk ahead of the next bucket."""
 
-    build: object
-    schedule: object
-    first: object
-    rebase: object
-    walk: object
+    build: Callable[..., Any]
+    schedule: Callable[..., Any]
+    first: Callable[..., Any]
+    rebase: Callable[..., Any]
+    walk: Callable[..., Any]
 
 
 #: A heap of every ball (scenes of fewer than :data:`QUEUE_MIN_BALLS` balls), and Paul's two-level
