@@ -9,6 +9,7 @@ envs and to retrain it (``train_ppo --hyperparams runs/<run>/config.yml`` reads 
 
 from __future__ import annotations
 
+import argparse
 import ast
 import difflib
 import math
@@ -299,7 +300,7 @@ def as_int(name: str, value: Any, low: int = 1) -> int:
     return int(number)
 
 
-def add_progress_flags(parser) -> None:
+def add_progress_flags(parser: argparse.ArgumentParser) -> None:
     """``--progress`` / ``--no-progress`` (default: a progress bar when stdout is a terminal)."""
     bar = parser.add_mutually_exclusive_group()
     bar.add_argument(

@@ -30,7 +30,9 @@ import math
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING, cast
 
+import gymnasium as gym
 import numpy as np
 
 from agents.config import (
@@ -52,11 +54,14 @@ from agents.train_rllib import ALGORITHM, CHECKPOINT_DIR, quiet_ray_logs
 from collision_env.engine import MODES
 from collision_env.extras import require
 
+if TYPE_CHECKING:
+    from collision_env.envs import CollisionTargetEnv
+
 BASELINES = ("random", "scripted")
 SCRIPTED_LABEL = "scripted (aims with the engine's prediction)"
 
 #: A policy factory: called after each reset with (unwrapped env, episode index); returns obs -> action.
-PolicyFactory = Callable[[object, int], Callable[[np.ndarray], np.ndarray]]
+PolicyFactory = Callable[[gym.Env, int], Callable[[np.ndarray], np.ndarray]]
 
 
 def wilson_interval(successes: int, n: int, z: float = 1.96) -> tuple[float, float]:
@@ -156,7 +161,7 @@ def random_policy(seed: int = 0) -> PolicyFactory:
     return factory
 
 
-def scripted_baseline(env) -> PolicyFactory | None:
+def scripted_baseline(env: gym.Env) -> PolicyFactory | None:
     """The task's scripted aiming policy (``collision_env.envs.scripted.scripted_policy``), or None
     if the task of ``env`` has none."""
     from collision_env.envs.scripted import ScriptedPolicy, scripted_policy
@@ -164,7 +169,7 @@ def scripted_baseline(env) -> PolicyFactory | None:
     if scripted_policy(env.unwrapped) is None:
         return None
 
-    def factory(env: object, episode: int) -> ScriptedPolicy:
+    def factory(env: gym.Env, episode: int) -> ScriptedPolicy:
         policy = scripted_policy(env)
         assert policy is not None  # (the task has one)
         return policy
@@ -173,12 +178,12 @@ def scripted_baseline(env) -> PolicyFactory | None:
 
 
 # ---------------------------------------------------------------------------------------- play
-def play(env, factory: PolicyFactory, episodes: int, seed: int, frames: list | None = None) -> dict:
+def play(env: gym.Env, factory: PolicyFactory, episodes: int, seed: int, frames: list | None = None) -> dict:
     """Play ``episodes`` episodes (episode i from ``reset(seed=seed + i)``); return the summary.
 
     With ``frames`` (a list) the env must render ``rgb_array``; every frame is appended to it.
     """
-    cost_per = env.unwrapped.config.action_cost
+    cost_per = cast("CollisionTargetEnv", env.unwrapped).config.action_cost
     rows = []
     start = time.perf_counter()
     for i in range(episodes):
@@ -189,7 +194,7 @@ def play(env, factory: PolicyFactory, episodes: int, seed: int, frames: list | N
         ret, nudge, steps, done = 0.0, 0.0, 0, False
         while not done:
             obs, reward, term, trunc, info = env.step(act(obs))
-            ret += reward
+            ret += float(reward)
             nudge += info["nudge"]
             steps += 1
             done = term or trunc
@@ -212,9 +217,7 @@ def play(env, factory: PolicyFactory, episodes: int, seed: int, frames: list | N
     }
 
 
-def make_env(env_id: str, env_kwargs: dict, render_mode: str | None = None):
-    import gymnasium as gym
-
+def make_env(env_id: str, env_kwargs: dict, render_mode: str | None = None) -> gym.Env:
     import collision_env  # noqa: F401
 
     return gym.make(env_id, max_episode_steps=episode_steps(env_id, env_kwargs), render_mode=render_mode, **env_kwargs)

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import time
 from collections import defaultdict
+from typing import Any
 
 from collision_env.bench.timing import add_timer
 
@@ -37,7 +38,7 @@ PARTS = (
 )
 
 
-def time_split(venv):
+def time_split(venv: Any) -> Any:
     """A stable-baselines3 callback that times the parts of ``learn`` (see the module docstring).
 
     Give it to ``learn`` with the model's vector env ``venv``; after training, ``split(total)``

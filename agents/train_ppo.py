@@ -36,8 +36,9 @@ from __future__ import annotations
 import argparse
 import shutil
 import time
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from agents.config import (
     CONFIG_FILE,
@@ -65,6 +66,9 @@ from collision_env.bench.machine import versions
 from collision_env.engine import MODES
 from collision_env.extras import MissingExtra
 
+if TYPE_CHECKING:
+    from stable_baselines3.common.vec_env import VecEnv
+
 DEFAULT_ENV = "CollisionEnv/OneBallTarget-v0"
 VEC_ENVS = ("native", "dummy", "subproc")
 EVAL_SEED_OFFSET = 100_000  # evaluation episodes never share seeds with training episodes
@@ -76,7 +80,7 @@ CALLBACK_DEFAULTS = {"eval_freq": 50_000, "eval_episodes": 20, "save_freq": 250_
 
 def make_vec_env(
     env_id: str, n_envs: int, seed: int, env_kwargs: dict, vec_env: str = "native", monitor_dir: Path | None = None
-):
+) -> VecEnv:
     """An SB3 ``VecEnv`` of ``n_envs`` sub-envs (sub-env i seeded ``seed + i``), monitored.
 
     ``native``: the batched env through :func:`collision_env.envs.sb3.make_sb3_vec_env` (one
@@ -269,7 +273,7 @@ def train(
     threads: int = 1,
     overwrite: bool = False,
     verbose: int = 0,
-    log=None,
+    log: Callable[[str], None] | None = None,
 ) -> Path:
     """Train PPO on ``env_id`` and write the run folder; returns its path.
 

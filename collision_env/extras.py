@@ -39,7 +39,7 @@ TORCH_EXTRAS = ("train", "distributed")
 class MissingExtra(ModuleNotFoundError):
     """A module of an optional extra is not installed; the message says which extra installs it."""
 
-    def __init__(self, extra: str, module: str, who: str, checkout: bool = False):
+    def __init__(self, extra: str, module: str, who: str, checkout: bool = False) -> None:
         target = f'-e ".[{extra}]"' if checkout else f'"collision_env[{extra}]"'
         torch = " (torch's CPU build first on a machine without a GPU: see the README)" if extra in TORCH_EXTRAS else ""
         super().__init__(f"{who} needs the '{extra}' extra ({module} is missing): pip install {target}{torch}")

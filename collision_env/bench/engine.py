@@ -40,6 +40,7 @@ import json
 import math
 import sys
 import time
+from collections.abc import Callable, Iterable
 from typing import Any
 
 import numpy as np
@@ -67,7 +68,14 @@ BATCH_BALLS = 4
 
 
 # ---------------------------------------------------------------------------------------- helpers
-def random_balls(rng, n, bounds, radius, speed=1.0, gap=1.05):
+def random_balls(
+    rng: np.random.Generator,
+    n: int,
+    bounds: tuple[float, float, float, float],
+    radius: float,
+    speed: float = 1.0,
+    gap: float = 1.05,
+) -> tuple[np.ndarray, np.ndarray]:
     """``n`` non-overlapping balls of ``radius`` inside ``bounds``, random directions at ``speed``.
 
     Returns ``(positions (n, 2), velocities (n, 2))``; centres are at least ``gap * 2 radius`` apart.
@@ -97,7 +105,7 @@ def _pairs(impacts) -> list[tuple[int, int]]:
     ]
 
 
-def bench_gas(quick, n=50, horizon=20.0):
+def bench_gas(quick: bool, n: int = 50, horizon: float = 20.0) -> dict:
     """Exact mode against billiards on an ``n``-disk gas over ``horizon`` s; see the module doc."""
     peer = make_peer("billiards")
     if isinstance(peer, str):
@@ -218,7 +226,7 @@ def bench_gas(quick, n=50, horizon=20.0):
 
 
 # ---------------------------------------------------------------------------------------- 2. per step
-def bench_per_step(quick):
+def bench_per_step(quick: bool) -> dict:
     """Microseconds per ``step(1/60)`` of each mode at each ball count (and pymunk's)."""
     pymunk = make_peer("pymunk")
     steps, repeats = (200, 5) if quick else (1000, 25)
@@ -264,7 +272,7 @@ def bench_per_step(quick):
 
 
 # ---------------------------------------------------------------------------------------- 3. batch
-def bench_batch(quick):
+def bench_batch(quick: bool) -> dict:
     """Scene-steps per second: one BatchSimulator of 1024 scenes against a loop of Simulators."""
     steps, repeats = (10, 3) if quick else (30, 15)
     rng = np.random.default_rng(11)
@@ -335,7 +343,7 @@ def _fmt(x, digits=3):
     return f"{x:,.{digits}g}" if abs(x) < 1000 else f"{x:,.0f}"
 
 
-def render_markdown(results):
+def render_markdown(results: dict) -> str:
     """The benchmark's figures as Markdown (a string), from :func:`run`'s dict or its JSON."""
     meta = results["meta"]
     v = meta["versions"]
@@ -428,7 +436,9 @@ def render_markdown(results):
 
 
 # ---------------------------------------------------------------------------------------- main
-def run(quick=False, parts=("gas", "per_step", "batch"), log=print):
+def run(
+    quick: bool = False, parts: Iterable[str] = ("gas", "per_step", "batch"), log: Callable[[str], None] = print
+) -> dict:
     """Run the benchmark; returns the raw figures as a JSON-ready dict."""
     t0 = time.perf_counter()
     log("warming up the kernels (numba compile or cache load) ...")
@@ -472,7 +482,7 @@ def _jsonable(obj):
     return obj
 
 
-def main(argv=None):
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m collision_env.bench.engine", description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="fewer repeats: about 30 s instead of a few minutes")
     parser.add_argument("--json", metavar="PATH", help="write the raw figures to PATH")

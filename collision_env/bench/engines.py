@@ -13,9 +13,12 @@ optional imports: :func:`peer_runners` returns only those installed, with the re
 
 from __future__ import annotations
 
+import numpy as np
+
 from collision_env.engine import BatchSimulator
 
 from .peers import PEERS, Runner, make_peer
+from .scenes import Case
 
 
 class EngineRunner(Runner):
@@ -25,7 +28,7 @@ class EngineRunner(Runner):
     mode: str
     _sim: BatchSimulator  # (made by start)
 
-    def __init__(self, mode: str, substeps: int = 1, max_events: int = 10_000):
+    def __init__(self, mode: str, substeps: int = 1, max_events: int = 10_000) -> None:
         self.mode = mode
         self.substeps = substeps
         self.max_events = max_events
@@ -33,12 +36,12 @@ class EngineRunner(Runner):
         self._capped = False
 
     @property
-    def family(self):
+    def family(self) -> str:
         if self.mode == "posteriori" or (self.mode == "naive" and self.substeps > 1):
             return f"{self.mode} k={self.substeps}"
         return self.mode
 
-    def start(self, case):
+    def start(self, case: Case) -> None:
         self._sim = BatchSimulator(
             case.scene,
             case.positions[None],
@@ -51,20 +54,20 @@ class EngineRunner(Runner):
         )
         self._capped = False
 
-    def step(self, dt, record=True):
+    def step(self, dt: float, record: bool = True) -> np.ndarray:
         rows = self._sim.step(dt)
         if self._sim._capped[0]:
             self._capped = True
         return rows
 
-    def state(self):
+    def state(self) -> tuple[np.ndarray, np.ndarray]:
         return self._sim._pos[0].copy(), self._sim._vel[0].copy()
 
     @property
-    def impact_count(self):
+    def impact_count(self) -> int:
         return self._sim.stats["events"]
 
-    def flags(self):
+    def flags(self) -> dict:
         return {"cap_reached": self._capped}
 
 

@@ -38,7 +38,7 @@ import math
 import sys
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -923,7 +923,12 @@ def repro(cell: Cell) -> str:
     )
 
 
-def run_extremes(quick: bool, budget: float | None = None, modes=MODES, log=print) -> list[dict]:
+def run_extremes(
+    quick: bool,
+    budget: float | None = None,
+    modes: Sequence[tuple[str, int]] = MODES,
+    log: Callable[[str], None] = print,
+) -> list[dict]:
     budget = budget if budget is not None else (5.0 if quick else 30.0)
     rows = []
     grid = cells(quick)
@@ -1011,7 +1016,7 @@ def extremes_markdown(rows: list[dict], quick: bool, budget: float) -> str:
     return "\n".join(lines)
 
 
-def write_csv(path, rows, fields):
+def write_csv(path: str | Path, rows: list[dict], fields: Sequence[str]) -> None:
     with open(path, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=fields, extrasaction="ignore")
         w.writeheader()
@@ -1019,7 +1024,7 @@ def write_csv(path, rows, fields):
             w.writerow({k: r.get(k, "") for k in fields})
 
 
-def main(argv=None):
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m collision_env.bench.extremes", description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="a subset of the grid (about 15 s)")
     parser.add_argument("--out", default="docs/bench", help="output folder (default docs/bench)")

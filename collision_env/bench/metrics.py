@@ -19,8 +19,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any, cast
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from collision_env.engine import WALL_NAMES
 
@@ -36,7 +38,7 @@ IMPACTS = np.dtype(
 )
 
 
-def as_impacts(impacts) -> np.ndarray:
+def as_impacts(impacts: Any) -> np.ndarray:
     """Impacts as an :data:`IMPACTS` array.
 
     Accepts an :data:`IMPACTS` or engine ``IMPACT_DTYPE`` array, a list of engine ``Impact``
@@ -105,7 +107,7 @@ class Match:
         }
 
 
-def match_impacts(run, ref, window: float, neighbours: int = 4) -> Match:
+def match_impacts(run: np.ndarray, ref: np.ndarray, window: float, neighbours: int = 4) -> Match:
     """Pair ``run`` impacts with ``ref`` impacts one to one.
 
     Two impacts can pair only if they have the same key (:func:`impact_keys`) and their times
@@ -198,7 +200,7 @@ def match_impacts(run, ref, window: float, neighbours: int = 4) -> Match:
 
 
 # --------------------------------------------------------------------------- conservation, validity
-def drift(series, reference=None, scale=None) -> float:
+def drift(series: ArrayLike, reference: float | None = None, scale: float | None = None) -> float:
     """Largest relative deviation of ``series`` from ``reference``.
 
     ``series`` is ``(T,)`` or ``(T, d)`` (a vector per time: its deviation is the Euclidean norm).
@@ -218,24 +220,31 @@ def drift(series, reference=None, scale=None) -> float:
     return worst / scale if scale > 0 else worst
 
 
-def kinetic_energy(vel, masses) -> np.ndarray:
+def kinetic_energy(vel: ArrayLike, masses: ArrayLike) -> np.ndarray:
     """Total kinetic energy of ``vel`` ``(..., N, 2)``, J."""
     return 0.5 * (np.asarray(masses) * (np.asarray(vel) ** 2).sum(-1)).sum(-1)
 
 
-def momentum(vel, masses) -> np.ndarray:
+def momentum(vel: ArrayLike, masses: ArrayLike) -> np.ndarray:
     """Total momentum of ``vel`` ``(..., N, 2)``, kg m/s."""
     return (np.asarray(masses)[:, None] * np.asarray(vel)).sum(-2)
 
 
-def final_state_error(pos, vel, ref_pos, ref_vel, radii, speed_scale) -> tuple[float, float]:
+def final_state_error(
+    pos: np.ndarray,
+    vel: np.ndarray,
+    ref_pos: np.ndarray,
+    ref_vel: np.ndarray,
+    radii: np.ndarray,
+    speed_scale: float,
+) -> tuple[float, float]:
     """``(max_i |x_i - x_ref,i| / r_i, max_i |v_i - v_ref,i| / speed_scale)``."""
     dx = np.hypot(*(np.asarray(pos) - np.asarray(ref_pos)).T) / np.asarray(radii)
     dv = np.hypot(*(np.asarray(vel) - np.asarray(ref_vel)).T) / speed_scale
     return float(dx.max()), float(dv.max())
 
 
-def escapes(positions, bounds, dimension=2) -> np.ndarray:
+def escapes(positions: ArrayLike, bounds: tuple[float, float, float, float] | None, dimension: int = 2) -> np.ndarray:
     """``(N,)`` bool: balls whose centre is outside the border in any of ``positions`` ``([T,] N, 2)``.
 
     A ball that merely overlaps a wall has not escaped (see :func:`wall_penetration`); one whose
@@ -251,10 +260,12 @@ def escapes(positions, bounds, dimension=2) -> np.ndarray:
     if dimension == 2:
         out |= (p[..., 1] < ymin) | (p[..., 1] > ymax)
     out |= ~np.isfinite(p).all(-1)
-    return out.any(0)
+    return cast(np.ndarray, out.any(0))  # (p has three axes)
 
 
-def wall_penetration(positions, radii, bounds, dimension=2) -> float:
+def wall_penetration(
+    positions: ArrayLike, radii: ArrayLike, bounds: tuple[float, float, float, float] | None, dimension: int = 2
+) -> float:
     """Deepest overlap of a ball with a wall over ``positions`` ``([T,] N, 2)``, in radii (0: none)."""
     if bounds is None:
         return 0.0
@@ -269,7 +280,7 @@ def wall_penetration(positions, radii, bounds, dimension=2) -> float:
     return float(max(0.0, np.nanmax(depth / r)))
 
 
-def max_overlap(positions, radii, chunk=256) -> float:
+def max_overlap(positions: ArrayLike, radii: ArrayLike, chunk: int = 256) -> float:
     """Deepest ball-ball overlap over ``positions`` ``([T,] N, 2)``, relative to the radii sum (0: none)."""
     p = np.asarray(positions, dtype=np.float64)
     if p.ndim == 2:
@@ -289,7 +300,7 @@ def max_overlap(positions, radii, chunk=256) -> float:
     return max(0.0, worst)
 
 
-def collisions_per_ball(impacts, n) -> np.ndarray:
+def collisions_per_ball(impacts: np.ndarray, n: int) -> np.ndarray:
     """``(n,)`` number of impacts each ball took part in (a ball-ball impact counts for both)."""
     imp = as_impacts(impacts)
     count = np.bincount(imp["ball"], minlength=n).astype(np.float64)
@@ -298,7 +309,7 @@ def collisions_per_ball(impacts, n) -> np.ndarray:
     return count
 
 
-def short_horizon(impacts, n, per_ball=5.0, default=None) -> float | None:
+def short_horizon(impacts: np.ndarray, n: int, per_ball: float = 5.0, default: float | None = None) -> float | None:
     """A time between two impacts at which the balls have had ``per_ball`` impacts on average.
 
     ``impacts`` must be in time order (a reference run). Returns ``default`` if the run never
@@ -314,7 +325,7 @@ def short_horizon(impacts, n, per_ball=5.0, default=None) -> float | None:
 
 
 # --------------------------------------------------------------------------- statistics
-def ks_rayleigh(speeds, masses=None, kT=None) -> float:
+def ks_rayleigh(speeds: ArrayLike, masses: ArrayLike | None = None, kT: float | None = None) -> float:
     """Kolmogorov-Smirnov distance between sampled speeds and the 2D Maxwell-Boltzmann (Rayleigh) law.
 
     ``F(v) = 1 - exp(-m v^2 / (2 kT))``. With several masses, each speed is scaled by

@@ -124,7 +124,7 @@ def inelastic(n: int = 2, flavour: str = "stick") -> Case:
 
 
 # --------------------------------------------------------------------------- gases
-def gas_box(n: int, radius: float, packing: float, aspect: float = 2.0):
+def gas_box(n: int, radius: float, packing: float, aspect: float = 2.0) -> tuple[float, float, float, float]:
     """Bounds of a box of aspect ``aspect`` (width/height) holding ``n`` disks at packing fraction ``packing``."""
     area = n * math.pi * radius**2 / packing
     h = math.sqrt(area / aspect)

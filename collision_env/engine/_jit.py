@@ -59,7 +59,12 @@ import pickle
 import shutil
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    import numpy as np
 
 try:  # numba is an optional accelerator, not a requirement of the core install
     import numba as _numba
@@ -249,7 +254,7 @@ if HAVE_NUMBA:
     class _KernelDispatcher(CPUDispatcher):
         """A CPU dispatcher compiled for plain (non-literal) argument types, cached by source hash."""
 
-        label = None  #: what :class:`_CompileNotice` calls it (None: named only inside a labelled one)
+        label: str | None = None  #: what :class:`_CompileNotice` calls it (None: named only inside a labelled one)
 
         def get_call_template(self, args, kws):
             args = tuple(_plain(a) for a in args)
@@ -278,21 +283,28 @@ if HAVE_NUMBA:
             )
 
 
-def _in_package(func) -> bool:
+def _in_package(func: Callable[..., Any]) -> bool:
     try:
         return Path(func.__code__.co_filename).resolve().is_relative_to(PACKAGE_DIR)
     except (OSError, ValueError):
         return False
 
 
-def compile_for(kernel, *example_args) -> None:
+def compile_for(kernel: Any, *example_args: Any) -> None:
     """Compile ``kernel`` now for the types of ``example_args`` (or load it from the cache), rather
     than at its first call; without numba, nothing to do."""
     if HAVE_NUMBA:
         kernel.compile(tuple(_numba.typeof(a) for a in example_args))
 
 
-def njit(func=None, *, refcount=True, label=None, python=None, **options):
+def njit(
+    func: Callable[..., Any] | None = None,
+    *,
+    refcount: bool = True,
+    label: str | None = None,
+    python: bool | None = None,
+    **options: Any,
+) -> Any:
     """Compile ``func`` with numba in nopython mode (cached), or return it unchanged.
 
     Use bare (``@njit``) or with extra numba options (``@njit(inline="always")``);
@@ -363,5 +375,5 @@ if HAVE_NUMBA:
 
 else:
 
-    def prefetch(array, index):
+    def prefetch(array: np.ndarray, index: int | tuple[int, ...]) -> None:
         """Ask for the cache line of ``array[index]`` ahead of its use: nothing to do in Python."""

@@ -14,8 +14,9 @@ import dataclasses
 import difflib
 import inspect
 import math
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -368,7 +369,7 @@ class TaskConfig:
             mask[:] = True
         return mask
 
-    def replace(self, **changes) -> TaskConfig:
+    def replace(self, **changes: Any) -> TaskConfig:
         return dataclasses.replace(self, **changes)
 
 
@@ -383,7 +384,7 @@ def field_names() -> tuple[str, ...]:
     return tuple(f.name for f in dataclasses.fields(TaskConfig) if f.init)
 
 
-def keywords_of(*functions) -> tuple[str, ...]:
+def keywords_of(*functions: Callable[..., Any]) -> tuple[str, ...]:
     """The named parameters of ``functions`` (an env's ``__init__``, ``gym.make``): what ``also`` offers."""
     kinds = (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)
     return tuple(
@@ -394,7 +395,7 @@ def keywords_of(*functions) -> tuple[str, ...]:
     )
 
 
-def make_config(preset: str | None = "one_ball", *, also: Iterable[str] = (), **overrides) -> TaskConfig:
+def make_config(preset: str | None = "one_ball", *, also: Iterable[str] = (), **overrides: Any) -> TaskConfig:
     """The preset's :class:`TaskConfig` with ``overrides`` applied (``preset=None``: the defaults).
 
     An unknown preset is a ``ValueError``; an unknown keyword an :class:`UnknownKeywordError` (a

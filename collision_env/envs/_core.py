@@ -54,7 +54,7 @@ class Impacts:
 
     __slots__ = ("records",)
 
-    def __init__(self, records: np.ndarray):
+    def __init__(self, records: np.ndarray) -> None:
         self.records = records
 
     def __len__(self) -> int:
@@ -122,7 +122,15 @@ class Episodes:
 
     __slots__ = ("positions", "velocities", "masses", "radii", "t_wall", "t_geo")
 
-    def __init__(self, positions, velocities, masses, radii, t_wall, t_geo):
+    def __init__(
+        self,
+        positions: np.ndarray,
+        velocities: np.ndarray,
+        masses: np.ndarray,
+        radii: np.ndarray,
+        t_wall: np.ndarray,
+        t_geo: np.ndarray,
+    ) -> None:
         self.positions = positions
         self.velocities = velocities
         self.masses = masses
@@ -159,7 +167,7 @@ class EpisodeSampler:
     the vector env and a single env seeded alike therefore draw the same episodes.
     """
 
-    def __init__(self, cfg: TaskConfig):
+    def __init__(self, cfg: TaskConfig) -> None:
         self.cfg = cfg
         n, k = cfg.n_balls, cfg.n_targets
         self.block = block_size(n, k, PLACEMENT_TRIES)
@@ -262,7 +270,7 @@ class TaskCore:
     engine's own. The named properties below are views.
     """
 
-    def __init__(self, cfg: TaskConfig, num_scenes: int):
+    def __init__(self, cfg: TaskConfig, num_scenes: int) -> None:
         from collision_env.engine import IMPACT_DTYPE, BatchSimulator, Scene
 
         self.cfg = cfg
@@ -410,7 +418,7 @@ class TaskCore:
         self._write_episode(idx, eps)
 
     @staticmethod
-    def check_actions(actions, field: str = "action") -> None:
+    def check_actions(actions: Any, field: str = "action") -> None:
         """Raise ValueError unless ``actions`` holds real numbers: a complex, string or boolean action
         would otherwise be cast to float64 silently (its imaginary part dropped, ``"0.5"`` parsed,
         ``True`` read as 1). The envs call this on the action as given, before they convert it."""

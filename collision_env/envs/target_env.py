@@ -135,7 +135,7 @@ class CollisionTargetEnv(gym.Env):
 
     def __init__(
         self, preset: str | None = _CLASS_PRESET, render_mode: str | None = None, trails: bool = False, **overrides: Any
-    ):
+    ) -> None:
         if preset is _CLASS_PRESET:
             preset = type(self).preset
         self.config: TaskConfig = make_config(preset, also=keywords_of(type(self).__init__, gym.make), **overrides)

@@ -61,7 +61,7 @@ class CollisionTargetVectorEnv(VectorEnv):
         preset: str | None = _CLASS_PRESET,
         trails: bool = False,
         **overrides: Any,
-    ):
+    ) -> None:
         if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
             raise ValueError(f"num_envs: must be a positive integer, got {num_envs!r}")
         if max_episode_steps is not None and (

@@ -8,6 +8,8 @@ chunks, which :func:`collect` converts).
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 import numpy as np
 
 from ..metrics import IMPACTS, as_impacts
@@ -59,7 +61,7 @@ class Runner:
         return {}
 
 
-def collect(chunks) -> np.ndarray:
+def collect(chunks: Iterable[np.ndarray | None]) -> np.ndarray:
     """Impacts returned by a runner's steps, as one :data:`~collision_env.bench.metrics.IMPACTS` array."""
-    chunks = [c for c in chunks if c is not None and len(c)]
-    return as_impacts(np.concatenate(chunks)) if chunks else _EMPTY.copy()
+    kept = [c for c in chunks if c is not None and len(c)]
+    return as_impacts(np.concatenate(kept)) if kept else _EMPTY.copy()

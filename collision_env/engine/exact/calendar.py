@@ -151,7 +151,7 @@ BUCKETS_PER_BALL = 0.5
 EVENTS_PER_BUCKET = 16
 
 
-def bucket_count(n):
+def bucket_count(n: int) -> int:
     """Buckets in the ring of a scene of ``n`` balls (0: every event in the heap)."""
     return int(BUCKETS_PER_BALL * n) if n >= QUEUE_MIN_BALLS else 0
 
@@ -174,7 +174,7 @@ ARITY = 8
 HEAP_OFFSET = ARITY - 1
 
 
-def heap_rows(n):
+def heap_rows(n: int) -> int:
     """Rows of a scene's heap array for ``n`` balls: the offset, then whole cache lines."""
     return -(-(n + HEAP_OFFSET) // ARITY) * ARITY
 
