@@ -52,10 +52,12 @@ test: $(STAMP)
 	$(PY) -m collision_env.precompile
 	$(PY) -m pytest -n 2
 
-# ruff's lint rules and its formatter, as configured in pyproject.toml (the pre-commit hooks run the same).
+# ruff's lint rules and its formatter (the pre-commit hooks run the same), then mypy's type check of
+# collision_env, agents and scripts; all as configured in pyproject.toml.
 lint: $(STAMP)
 	$(PY) -m ruff check .
 	$(PY) -m ruff format --check .
+	$(PY) -m mypy
 
 # The documentation site (mkdocs.yml) into site/: every warning fails the build (--strict). The env
 # pages and the API reference are generated from the docstrings (scripts/docs_hooks.py, docs_griffe.py).

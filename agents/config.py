@@ -9,13 +9,14 @@ envs and to retrain it (``train_ppo --hyperparams runs/<run>/config.yml`` reads 
 
 from __future__ import annotations
 
+import argparse
 import ast
 import difflib
 import math
 import sys
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 from collision_env.extras import run_entry_point
 
@@ -23,6 +24,7 @@ HYPERPARAMS = Path(__file__).with_name("hyperparams") / "ppo.yml"
 CONFIG_FILE = "config.yml"
 MODEL_FILE = "model.zip"
 VECNORMALIZE_FILE = "vecnormalize.pkl"
+EVAL_SEED = 1_000_000  # evaluation episodes start far from the training and EvalCallback seeds
 
 #: Keys of a hyperparameter entry that are not PPO keywords.
 RUN_KEYS = ("n_envs", "n_timesteps", "policy", "normalize", "env_kwargs")
@@ -99,7 +101,7 @@ def episode_steps(env_id: str, env_kwargs: dict) -> int:
     """Control steps per episode of ``env_id`` under ``env_kwargs`` (validates the kwargs)."""
     import gymnasium as gym
 
-    import collision_env  # noqa: F401  (registers the ids)
+    from collision_env.envs import CollisionTargetEnv  # (importing the envs registers the ids)
 
     check_env_kwargs(env_kwargs)
     try:
@@ -107,7 +109,7 @@ def episode_steps(env_id: str, env_kwargs: dict) -> int:
     except (TypeError, ValueError) as err:
         raise UsageError(f"{env_id}: {err}") from None
     try:
-        return int(env.unwrapped.config.n_steps)
+        return int(cast(CollisionTargetEnv, env.unwrapped).config.n_steps)
     finally:
         env.close()
 
@@ -192,7 +194,7 @@ def _policy_kwargs(value: Any) -> dict:
     if isinstance(value, str):
         try:
             value = eval(value, {"__builtins__": {}}, {"dict": dict, "nn": nn})  # RL Zoo's format
-        except Exception as err:  # noqa: BLE001 - any failure is the user's string
+        except Exception as err:  # any failure is the user's string
             raise UsageError(f"policy_kwargs: cannot read {value!r}: {err}") from None
     if not isinstance(value, dict):
         raise UsageError(f"policy_kwargs: expected a mapping, got {value!r}")
@@ -298,7 +300,7 @@ def as_int(name: str, value: Any, low: int = 1) -> int:
     return int(number)
 
 
-def add_progress_flags(parser) -> None:
+def add_progress_flags(parser: argparse.ArgumentParser) -> None:
     """``--progress`` / ``--no-progress`` (default: a progress bar when stdout is a terminal)."""
     bar = parser.add_mutually_exclusive_group()
     bar.add_argument(

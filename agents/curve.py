@@ -34,7 +34,7 @@ def training_episodes(run_dir: str | Path) -> dict:
         with path.open() as fh:
             start = json.loads(fh.readline().removeprefix("#"))["t_start"]
             for row in csv.DictReader(fh):
-                success = {"True": 1.0, "False": 0.0}.get(row.get("is_success"), np.nan)
+                success = {"True": 1.0, "False": 0.0}.get(row.get("is_success") or "", np.nan)
                 rows.append((start + float(row["t"]), int(row["l"]), success, float(row["r"])))
     rows.sort()
     table = np.array(rows, dtype=float).reshape(-1, 4)

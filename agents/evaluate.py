@@ -30,11 +30,14 @@ import math
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING, cast
 
+import gymnasium as gym
 import numpy as np
 
 from agents.config import (
     CONFIG_FILE,
+    EVAL_SEED,
     MODEL_FILE,
     VECNORMALIZE_FILE,
     UsageError,
@@ -47,15 +50,18 @@ from agents.config import (
     read_run,
     run_cli,
 )
+from agents.train_rllib import ALGORITHM, CHECKPOINT_DIR, quiet_ray_logs
 from collision_env.engine import MODES
 from collision_env.extras import require
 
-EVAL_SEED = 1_000_000  # evaluation episodes start far from the training and EvalCallback seeds
+if TYPE_CHECKING:
+    from collision_env.envs import CollisionTargetEnv
+
 BASELINES = ("random", "scripted")
 SCRIPTED_LABEL = "scripted (aims with the engine's prediction)"
 
 #: A policy factory: called after each reset with (unwrapped env, episode index); returns obs -> action.
-PolicyFactory = Callable[[object, int], Callable[[np.ndarray], np.ndarray]]
+PolicyFactory = Callable[[gym.Env, int], Callable[[np.ndarray], np.ndarray]]
 
 
 def wilson_interval(successes: int, n: int, z: float = 1.96) -> tuple[float, float]:
@@ -85,7 +91,7 @@ def trained_policy(run_dir: str | Path, which: str = "final") -> PolicyFactory:
     if not model_path.is_file():
         raise UsageError(f"{model_path} not found")
     model = PPO.load(model_path, device="cpu")
-    obs_rms, clip, eps = None, None, None
+    obs_rms, clip, eps = None, 0.0, 0.0  # (clip and eps are read only with obs_rms)
     norm = normalize_settings(run["hyperparams"].get("normalize"))
     if norm is not None and norm.get("norm_obs", True):
         stats = run_dir / (VECNORMALIZE_FILE if which == "final" else BEST_VECNORMALIZE_FILE)
@@ -112,22 +118,17 @@ def rllib_policy(run_dir: str | Path) -> PolicyFactory:
     """The RLlib run's policy (the RLModule in ``<run>/checkpoint``), deterministic."""
     require("distributed", "evaluating an RLlib run", checkout=True)
     from agents.rllib_policy import load_module, module_policy
-    from agents.train_rllib import CHECKPOINT_DIR, quiet_ray_logs
 
     quiet_ray_logs()
     return module_policy(load_module(Path(run_dir) / CHECKPOINT_DIR))
 
 
 def is_rllib_run(run: dict) -> bool:
-    from agents.train_rllib import ALGORITHM
-
     return run.get("algorithm") == ALGORITHM
 
 
 def read_any_run(run_dir: str | Path) -> dict:
     """The resolved config of a train_ppo or train_rllib run folder (UsageError if it is neither)."""
-    from agents.train_rllib import CHECKPOINT_DIR
-
     run_dir = Path(run_dir)
     config = run_dir / CONFIG_FILE
     if config.is_file():
@@ -160,23 +161,29 @@ def random_policy(seed: int = 0) -> PolicyFactory:
     return factory
 
 
-def scripted_baseline(env) -> PolicyFactory | None:
+def scripted_baseline(env: gym.Env) -> PolicyFactory | None:
     """The task's scripted aiming policy (``collision_env.envs.scripted.scripted_policy``), or None
     if the task of ``env`` has none."""
-    from collision_env.envs.scripted import scripted_policy
+    from collision_env.envs.scripted import ScriptedPolicy, scripted_policy
 
     if scripted_policy(env.unwrapped) is None:
         return None
-    return lambda env, episode: scripted_policy(env)
+
+    def factory(env: gym.Env, episode: int) -> ScriptedPolicy:
+        policy = scripted_policy(env)
+        assert policy is not None  # (the task has one)
+        return policy
+
+    return factory
 
 
 # ---------------------------------------------------------------------------------------- play
-def play(env, factory: PolicyFactory, episodes: int, seed: int, frames: list | None = None) -> dict:
+def play(env: gym.Env, factory: PolicyFactory, episodes: int, seed: int, frames: list | None = None) -> dict:
     """Play ``episodes`` episodes (episode i from ``reset(seed=seed + i)``); return the summary.
 
     With ``frames`` (a list) the env must render ``rgb_array``; every frame is appended to it.
     """
-    cost_per = env.unwrapped.config.action_cost
+    cost_per = cast("CollisionTargetEnv", env.unwrapped).config.action_cost
     rows = []
     start = time.perf_counter()
     for i in range(episodes):
@@ -187,7 +194,7 @@ def play(env, factory: PolicyFactory, episodes: int, seed: int, frames: list | N
         ret, nudge, steps, done = 0.0, 0.0, 0, False
         while not done:
             obs, reward, term, trunc, info = env.step(act(obs))
-            ret += reward
+            ret += float(reward)
             nudge += info["nudge"]
             steps += 1
             done = term or trunc
@@ -210,9 +217,7 @@ def play(env, factory: PolicyFactory, episodes: int, seed: int, frames: list | N
     }
 
 
-def make_env(env_id: str, env_kwargs: dict, render_mode: str | None = None):
-    import gymnasium as gym
-
+def make_env(env_id: str, env_kwargs: dict, render_mode: str | None = None) -> gym.Env:
     import collision_env  # noqa: F401
 
     return gym.make(env_id, max_episode_steps=episode_steps(env_id, env_kwargs), render_mode=render_mode, **env_kwargs)
@@ -246,7 +251,7 @@ def evaluate(
     seed = as_int("seed", seed, low=0)
     kwargs = eval_kwargs(run, mode, substeps)
     env = make_env(env_id, kwargs)
-    policies = {"ppo": run_policy(run_dir, run, model)}
+    policies: dict[str, PolicyFactory | None] = {"ppo": run_policy(run_dir, run, model)}
     if "random" in baselines:
         policies["random"] = random_policy(seed)
     if "scripted" in baselines:

@@ -36,16 +36,16 @@ class ListFriendlyInfos(VectorWrapper):
     def _strip(info: dict) -> dict:
         return {k: v for k, v in info.items() if k not in ("impacts", "_impacts")}
 
-    def reset(self, **kwargs):
+    def reset(self, **kwargs: Any) -> tuple[Any, dict]:
         obs, info = self.env.reset(**kwargs)
         return obs, self._strip(info)
 
-    def step(self, actions):
+    def step(self, actions: Any) -> tuple[Any, Any, Any, Any, dict]:
         obs, reward, term, trunc, info = self.env.step(actions)
         return obs, reward, term, trunc, self._strip(info)
 
 
-def make_env(config: dict[str, Any]):
+def make_env(config: dict[str, Any]) -> gym.Env | gym.vector.VectorEnv:
     """RLlib env creator: ``config`` holds ``env_id``, the env keywords and, for the native vector
     env, ``num_envs``. Imports ``collision_env`` itself, so it works in a fresh worker process."""
     import collision_env  # noqa: F401  (registers the ids in this process)

@@ -6,7 +6,9 @@ RLModule saved under ``checkpoint/learner_group/learner/rl_module/default_policy
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -14,14 +16,14 @@ import numpy as np
 MODULE_SUBPATH = Path("learner_group") / "learner" / "rl_module" / "default_policy"
 
 
-def load_module(checkpoint: str | Path):
+def load_module(checkpoint: str | Path) -> Any:
     """The RLModule of an RLlib PPO checkpoint folder."""
     from ray.rllib.core.rl_module.rl_module import RLModule
 
     return RLModule.from_checkpoint(str(Path(checkpoint).resolve() / MODULE_SUBPATH))
 
 
-def deterministic_actions(module, obs: np.ndarray) -> np.ndarray:
+def deterministic_actions(module: Any, obs: np.ndarray) -> np.ndarray:
     """The module's most likely action for each row of ``obs``, clipped into the [-1, 1] box."""
     import torch
 
@@ -32,10 +34,10 @@ def deterministic_actions(module, obs: np.ndarray) -> np.ndarray:
     return np.clip(actions, -1.0, 1.0).astype(np.float32)
 
 
-def module_policy(module):
+def module_policy(module: Any) -> Callable[[object, int], Callable[[np.ndarray], np.ndarray]]:
     """A policy factory for ``agents.evaluate.play``: deterministic actions of ``module``."""
 
-    def factory(env, episode):
+    def factory(env: object, episode: int) -> Callable[[np.ndarray], np.ndarray]:
         return lambda obs: deterministic_actions(module, obs[None])[0]
 
     return factory

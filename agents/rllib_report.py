@@ -75,7 +75,7 @@ def _rate(x: float) -> str:
 
 
 def placement_table(run: dict) -> list[str]:
-    nodes = {}
+    nodes: dict[str, int] = {}
     for spot in run["runner_placement"]:
         nodes.setdefault(spot["node_id"], len(nodes) + 1)
     lines = ["| env runner | Ray node | node address | on the driver's (head) node | pid |", "|---:|---|---|---|---:|"]
@@ -160,7 +160,7 @@ def main(argv: list[str] | None = None) -> str:
     text = block(args.env, rates, run, results, cluster, time.perf_counter() - start)
     print(text)
     if args.readme:
-        from collision_env._readme import write_block
+        from collision_env.bench.readme import write_block
 
         write_block(args.readme, BLOCK, text)
     return text

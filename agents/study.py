@@ -350,8 +350,8 @@ def split_table(rows: list) -> str:
 
 def rule(rows: list, base: list) -> str:
     """The rule for choosing a training mode, stated with this study's figures."""
-    shares = {env: _engine_share(rs) for (env, setting), rs in _by_preset(rows, base).items() if _shipped(rs[0])}
-    shares = {env: f for env, f in shares.items() if f is not None}
+    measured = {env: _engine_share(rs) for (env, setting), rs in _by_preset(rows, base).items() if _shipped(rs[0])}
+    shares = {env: f for env, f in measured.items() if f is not None}
     lines = []
     for env_id, groups in _by_env_and_mode(rows).items():
         exact_rows = groups.get(("exact", 1))
@@ -518,10 +518,10 @@ def main(argv: list[str] | None = None) -> dict:
     if readme is not None:  # a README without the block's markers would only be found after the study
         from collision_env.bench.readme import markers
 
-        start, end = markers(README_BLOCK)
+        begin, end = markers(README_BLOCK)
         text = readme.read_text() if readme.is_file() else ""
-        if start not in text or end not in text:
-            raise UsageError(f"--readme: {readme} has no {start} ... {end} block to write into")
+        if begin not in text or end not in text:
+            raise UsageError(f"--readme: {readme} has no {begin} ... {end} block to write into")
     if args.render:
         path = docs / "study.json"
         if not path.is_file():
@@ -623,7 +623,7 @@ def variants(env_id: str, which: str = "both") -> list:
     plain observation when the entry trains on the predicted one, nudges when it uses velocity
     control. ``which`` picks ``"shipped"``, ``"alternatives"`` or ``"both"``."""
     entry = hyperparams_for(env_id).get("env_kwargs") or {}
-    out = [{}] if which in ("both", "shipped") else []
+    out: list[dict] = [{}] if which in ("both", "shipped") else []
     if which in ("both", "alternatives"):
         if entry.get("observe", "plain") != "plain":
             out.append({"observe": "plain"})

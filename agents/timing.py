@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import time
 from collections import defaultdict
+from typing import Any
 
 from collision_env.bench.timing import add_timer
 
@@ -37,7 +38,7 @@ PARTS = (
 )
 
 
-def time_split(venv):
+def time_split(venv: Any) -> Any:
     """A stable-baselines3 callback that times the parts of ``learn`` (see the module docstring).
 
     Give it to ``learn`` with the model's vector env ``venv``; after training, ``split(total)``
@@ -51,8 +52,9 @@ def time_split(venv):
         def __init__(self):
             super().__init__()
             self.raw: dict = defaultdict(float)
-            self._mark = None
+            self._mark: float | None = None
             self.engine_timed = False
+            self._wrapped: list[tuple[object, str]] = []  # (object, attribute) of the timers added
 
         def _on_training_start(self) -> None:
             self._timed(self.model.policy, "forward", "act")
@@ -93,7 +95,7 @@ def time_split(venv):
 
         def _timed(self, obj, name: str, key: str) -> None:
             add_timer(obj, name, self.raw, key)
-            self._wrapped = getattr(self, "_wrapped", []) + [(obj, name)]
+            self._wrapped.append((obj, name))
 
         def split(self, total: float) -> dict:
             """Seconds per part (``PARTS``) of a ``learn`` call that took ``total`` seconds."""

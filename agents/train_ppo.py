@@ -36,7 +36,9 @@ from __future__ import annotations
 import argparse
 import shutil
 import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from agents.config import (
     CONFIG_FILE,
@@ -64,6 +66,9 @@ from collision_env.bench.machine import versions
 from collision_env.engine import MODES
 from collision_env.extras import MissingExtra
 
+if TYPE_CHECKING:
+    from stable_baselines3.common.vec_env import VecEnv
+
 DEFAULT_ENV = "CollisionEnv/OneBallTarget-v0"
 VEC_ENVS = ("native", "dummy", "subproc")
 EVAL_SEED_OFFSET = 100_000  # evaluation episodes never share seeds with training episodes
@@ -75,7 +80,7 @@ CALLBACK_DEFAULTS = {"eval_freq": 50_000, "eval_episodes": 20, "save_freq": 250_
 
 def make_vec_env(
     env_id: str, n_envs: int, seed: int, env_kwargs: dict, vec_env: str = "native", monitor_dir: Path | None = None
-):
+) -> VecEnv:
     """An SB3 ``VecEnv`` of ``n_envs`` sub-envs (sub-env i seeded ``seed + i``), monitored.
 
     ``native``: the batched env through :func:`collision_env.envs.sb3.make_sb3_vec_env` (one
@@ -174,10 +179,12 @@ def _callbacks(
         """Keep the VecNormalize statistics that the best model was evaluated with."""
 
         def _on_step(self) -> bool:
-            self.model.get_vec_normalize_env().save(str(run_dir / BEST_VECNORMALIZE_FILE))
+            vec_normalize = self.model.get_vec_normalize_env()
+            assert vec_normalize is not None  # (given to normalised runs only)
+            vec_normalize.save(str(run_dir / BEST_VECNORMALIZE_FILE))
             return True
 
-    out = []
+    out: list[BaseCallback] = []
     if eval_freq:
         out.append(
             SeededEvalCallback(
@@ -221,7 +228,7 @@ def _progress_log(total: int, log, every: float = 0.1):
             done = self.model.num_timesteps
             if done >= self.next:
                 self.next += every * total
-                episodes = list(self.model.ep_info_buffer)
+                episodes = list(self.model.ep_info_buffer or ())
                 success = list(getattr(self.model, "ep_success_buffer", []))
                 line = f"{done:,} / {total:,} steps ({100 * done / total:.0f} %)"
                 if success:
@@ -266,7 +273,7 @@ def train(
     threads: int = 1,
     overwrite: bool = False,
     verbose: int = 0,
-    log=None,
+    log: Callable[[str], None] | None = None,
 ) -> Path:
     """Train PPO on ``env_id`` and write the run folder; returns its path.
 
@@ -435,7 +442,10 @@ def main(argv: list[str] | None = None) -> Path:
     # a run's config.yml supplies the defaults of the run it describes
     data = load_yaml(args.hyperparams)
     run = data if is_run_config(data) else {}
-    pick = lambda given, key, default: given if given is not None else run.get(key, default)  # noqa: E731
+
+    def pick(given: Any, key: str, default: Any) -> Any:
+        return given if given is not None else run.get(key, default)
+
     callbacks = {**CALLBACK_DEFAULTS, **run.get("callbacks", {})}
     run_dir = train(
         pick(args.env, "env_id", DEFAULT_ENV),

@@ -30,12 +30,15 @@ import os
 import platform
 import shutil
 import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from agents.config import (
     CONFIG_FILE,
+    EVAL_SEED,
     UsageError,
     as_int,
     check_env_id,
@@ -90,7 +93,7 @@ def training_kwargs(hp: dict) -> dict:
 
 def build_config(
     env_id: str, env_kwargs: dict, hp: dict, *, env_runners: int, envs_per_runner: int, vectorize: str, seed: int
-):
+) -> Any:
     """The PPOConfig of a run (new API stack, torch, the learner in the driver process)."""
     from ray.rllib.algorithms.ppo import PPOConfig
     from ray.rllib.core.rl_module.default_model_config import DefaultModelConfig
@@ -122,7 +125,7 @@ def build_config(
     )
 
 
-def success_rate(module, env_id: str, env_kwargs: dict, episodes: int, seed: int) -> float:
+def success_rate(module: Any, env_id: str, env_kwargs: dict, episodes: int, seed: int) -> float:
     """Share of ``episodes`` evaluation episodes (episode i from seed + i) the deterministic module wins.
 
     Plays them all at once on the native vector env, whose sub-env i is seeded ``seed + i`` exactly
@@ -164,7 +167,7 @@ def warm_up(env_id: str, env_kwargs: dict) -> None:
     env.close()
 
 
-def runner_placement(algo) -> list[dict]:
+def runner_placement(algo: Any) -> list[dict]:
     """Which Ray node each remote env runner runs on (node id, address, whether it is the head)."""
     import ray
 
@@ -289,19 +292,20 @@ def train(
     target_success: float | None = None,
     overwrite: bool = False,
     threads: int = 1,
-    log=None,
+    log: Callable[[str], None] | None = None,
 ) -> Path:
     """Train RLlib PPO on ``env_id`` and write the run folder; returns its path.
 
     Arguments left as None come from the hyperparameter entry. Everything is validated before Ray
     starts or the run folder is made.
     """
-    from agents.evaluate import EVAL_SEED
-
     log = log or (lambda line: print(line, flush=True))
     check_env_id(env_id)
     hp = hyperparams_for(env_id, hyperparams)
-    pick = lambda value, key, default: hp.get(key, default) if value is None else value  # noqa: E731
+
+    def pick(value: Any, key: str, default: Any) -> Any:
+        return hp.get(key, default) if value is None else value
+
     iterations = as_int("iterations", pick(iterations, "iterations", 100))
     env_runners = as_int("env_runners", pick(env_runners, "env_runners", 2), low=0)
     envs_per_runner = as_int("envs_per_runner", pick(envs_per_runner, "envs_per_runner", 16))

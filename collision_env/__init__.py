@@ -13,8 +13,8 @@ each comes from one entry of the task registry (``collision_env.envs.registry``)
 
 __version__ = "0.1.0"
 
-from collision_env.envs import REGISTERED as _REGISTERED  # noqa: E402 - importing the envs registers them
-from collision_env.envs import TaskConfig as _TaskConfig  # noqa: E402
+from collision_env.envs import REGISTERED as _REGISTERED  # importing the envs registers them
+from collision_env.envs import TaskConfig as _TaskConfig
 
 #: Every registered environment id.
 ENV_IDS = tuple(_REGISTERED)

@@ -27,7 +27,7 @@ EXTRAS: dict[str, tuple[str, ...]] = {
     "plot": ("matplotlib",),
     "peers": ("billiards", "pymunk"),
     "test": ("pytest", "xdist", "hypothesis"),
-    "dev": ("ruff", "build", "twine", "cffconvert"),
+    "dev": ("ruff", "mypy", "yaml-stubs", "build", "twine", "cffconvert"),  # (yaml-stubs: types-PyYAML)
     "docs": ("mkdocs", "material", "mkdocstrings", "mkdocstrings_handlers"),
     "distributed": ("ray", "torch", "yaml"),
 }
@@ -39,7 +39,7 @@ TORCH_EXTRAS = ("train", "distributed")
 class MissingExtra(ModuleNotFoundError):
     """A module of an optional extra is not installed; the message says which extra installs it."""
 
-    def __init__(self, extra: str, module: str, who: str, checkout: bool = False):
+    def __init__(self, extra: str, module: str, who: str, checkout: bool = False) -> None:
         target = f'-e ".[{extra}]"' if checkout else f'"collision_env[{extra}]"'
         torch = " (torch's CPU build first on a machine without a GPU: see the README)" if extra in TORCH_EXTRAS else ""
         super().__init__(f"{who} needs the '{extra}' extra ({module} is missing): pip install {target}{torch}")
@@ -93,8 +93,9 @@ def run_entry_point(
     except MissingExtra as err:
         print(err, file=sys.stderr)
     except ModuleNotFoundError as err:
-        extra = extra_of(err.name or "", prefer=extras)
-        if extra is None:
+        module = err.name or ""
+        missing = extra_of(module, prefer=extras)
+        if missing is None:
             raise
-        print(MissingExtra(extra, err.name, who, checkout), file=sys.stderr)
+        print(MissingExtra(missing, module, who, checkout), file=sys.stderr)
     raise SystemExit(status)

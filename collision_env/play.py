@@ -28,8 +28,14 @@ from __future__ import annotations
 
 import argparse
 import difflib
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
+
+if TYPE_CHECKING:
+    import gymnasium as gym
+
+    from collision_env.envs import CollisionTargetEnv
 
 #: The keys and the mouse, as the module's docstring lists them (printed when the game starts).
 CONTROLS = __doc__[__doc__.index("Controls:") : __doc__.index("\n\nNudges")]
@@ -43,7 +49,7 @@ class Player:
     """The game loop's state, fed pygame events (:meth:`handle`) and advanced a frame at a time
     (:meth:`tick`); :func:`play` drives it from pygame's event queue."""
 
-    def __init__(self, env, seed: int | None = None):
+    def __init__(self, env: gym.Env, seed: int | None = None) -> None:
         import pygame
 
         from collision_env.envs.scripted import as_env_action, towards
@@ -51,11 +57,12 @@ class Player:
         self.pg = pygame
         self._as_action, self._towards = as_env_action, towards
         self.env = env
-        self.cfg = env.unwrapped.config
+        self._bare = cast("CollisionTargetEnv", env.unwrapped)  # the task env under the wrappers
+        self.cfg = self._bare.config
         self.held: set[str] = set()  # arrow keys held down
         self.ball = 0  # index into cfg.controlled of the steered ball
         self.aim: np.ndarray | None = None  # the velocity the steered ball is being nudged to
-        self._press = None  # world point of a mouse press, until it is released
+        self._press: np.ndarray | None = None  # world point of a mouse press, until it is released
         self.paused = False
         self.pending = 0  # single steps asked for while paused
         self.quit = False
@@ -65,7 +72,7 @@ class Player:
         env.reset(seed=seed)
 
     # ------------------------------------------------------------------------------------ input
-    def handle(self, event) -> None:
+    def handle(self, event: Any) -> None:
         """Take one pygame event into account."""
         pg = self.pg
         if event.type == pg.QUIT:
@@ -91,7 +98,7 @@ class Player:
                 self.aim = None
         elif event.type == pg.MOUSEBUTTONDOWN and event.button == 1:
             self._press = np.array(self._world(event.pos))
-            pos = self.env.unwrapped.core.pos[0, list(self.cfg.controlled)]
+            pos = self._bare.core.pos[0, list(self.cfg.controlled)]
             self.ball = int(np.argmin(np.linalg.norm(pos - self._press, axis=1)))
         elif event.type == pg.MOUSEBUTTONUP and event.button == 1 and self._press is not None:
             drag = np.array(self._world(event.pos)) - self._press
@@ -101,7 +108,7 @@ class Player:
             self._press = None
 
     def _world(self, pixel) -> tuple[float, float]:
-        return self.env.unwrapped._get_renderer().to_world(*pixel)
+        return self._bare._get_renderer().to_world(*pixel)
 
     # ------------------------------------------------------------------------------------ steps
     def nudge(self) -> np.ndarray:
@@ -111,7 +118,7 @@ class Player:
         if self.held:
             out[self.ball] = np.sum([ARROWS[k] for k in self.held], axis=0)[: cfg.dimension]
         elif self.aim is not None:
-            v = self.env.unwrapped.core.vel[0, cfg.controlled[self.ball], : cfg.dimension]
+            v = self._bare.core.vel[0, cfg.controlled[self.ball], : cfg.dimension]
             if np.abs(self.aim[: cfg.dimension] - v).max() <= AIMED:
                 self.aim = None  # reached
             else:
@@ -145,10 +152,11 @@ class Player:
     def caption(self) -> str:
         ball = self.cfg.controlled[self.ball]
         state = "paused" if self.paused else "running"
-        return f"{self.env.spec.id}: ball {ball}, return {self.episode_return:.2f}, {state}"
+        env_id = self.env.spec.id if self.env.spec is not None else "..."
+        return f"{env_id}: ball {ball}, return {self.episode_return:.2f}, {state}"
 
 
-def play(env_id: str, seed: int | None = None, trails: bool = False, **env_kwargs) -> Player:
+def play(env_id: str, seed: int | None = None, trails: bool = False, **env_kwargs: Any) -> Player:
     """Open ``env_id``'s window and play until Esc or the window closes; returns the final state."""
     import gymnasium as gym
 

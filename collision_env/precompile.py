@@ -13,10 +13,11 @@ from __future__ import annotations
 
 import sys
 import time
+from typing import Any
 
 #: The env options tried beside each env's defaults: the predicted observation (with its aiming
 #: term), which runs kernels of its own, and velocity control, a branch of the nudge kernel.
-OPTIONS = ({}, {"observe": "predicted", "aim": "predicted", "control": "velocity"})
+OPTIONS: tuple[dict[str, Any], ...] = ({}, {"observe": "predicted", "aim": "predicted", "control": "velocity"})
 
 
 def precompile() -> float:

@@ -116,7 +116,7 @@ def main(argv=None) -> int:
         for tree in trees.values():  # compile each revision's kernels before anything is timed
             subprocess.run([sys.executable, "-m", "collision_env.precompile"], cwd=tree, check=True,
                            env={**os.environ, "PYTHONPATH": str(tree)}, capture_output=True)  # fmt: skip
-        rounds = {name: [] for name in trees}
+        rounds: dict[str, list[dict]] = {name: [] for name in trees}
         for r in range(args.rounds):
             for name, tree in trees.items():
                 rounds[name].append(_run(tree, args.parts))

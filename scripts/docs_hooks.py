@@ -54,8 +54,8 @@ def env_page(env_id: str) -> str:
     reg = REGISTERED[env_id]
     single, vector = reg.single.__name__, reg.vector.__name__
     lines = [f"# `{env_id}`", "", summary(env_id), ""]
-    if gif(env_id):
-        lines += [f'![{env_id}]({relative(gif(env_id), "envs/page.md")}){{ width="480" }}', ""]
+    if picture := gif(env_id):
+        lines += [f'![{env_id}]({relative(picture, "envs/page.md")}){{ width="480" }}', ""]
     lines += [
         f'`gym.make("{env_id}")` makes the single env (`collision_env.envs.{single}`), '
         f'`gym.make_vec("{env_id}", n)` the native vector env on the batched engine (`{vector}`); '
@@ -72,7 +72,7 @@ def env_page(env_id: str) -> str:
             *(f"| `{k}` | `{v!r}` |" for k, v in reg.task.config.items()),
             "",
         ]
-    return "\n".join(lines) + "\n" + inspect.cleandoc(reg.single.__doc__) + "\n"
+    return "\n".join(lines) + "\n" + inspect.cleandoc(reg.single.__doc__ or "") + "\n"
 
 
 def relative(path: str, page_path: str) -> str:
@@ -83,7 +83,8 @@ def relative(path: str, page_path: str) -> str:
 def env_table(page_path: str) -> str:
     rows = ["| id | the task | |", "|---|---|---|"]
     for env_id in collision_env.ENV_IDS:
-        picture = f'![]({relative(gif(env_id), page_path)}){{ width="200" }}' if gif(env_id) else ""
+        path = gif(env_id)
+        picture = f'![]({relative(path, page_path)}){{ width="200" }}' if path else ""
         link = relative(f"envs/{env_slug(env_id)}.md", page_path)
         rows.append(f"| [`{env_id}`]({link}) | {summary(env_id)} | {picture} |")
     return "\n".join(rows)

@@ -24,7 +24,8 @@ def episodes(env, factory, n: int) -> list:
     for i in range(n):
         obs, _ = env.reset(seed=EVAL_SEED + i)
         act = factory(env.unwrapped, i)
-        hits, t, nudge, done = [], 0, 0.0, False
+        hits: list[int] = []
+        t, nudge, done = 0, 0.0, False
         while not done:
             obs, _, term, trunc, info = env.step(act(obs))
             t += 1

@@ -13,25 +13,27 @@ from __future__ import annotations
 import argparse
 import os
 from pathlib import Path
+from typing import cast
 
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 
-import gymnasium as gym  # noqa: E402
-import imageio.v3 as iio  # noqa: E402
-import numpy as np  # noqa: E402
+import gymnasium as gym
+import imageio.v3 as iio
+import numpy as np
 
-import collision_env  # noqa: E402, F401
-from collision_env.envs import PRESET_IDS  # noqa: E402
-from collision_env.envs.rendering import Renderer  # noqa: E402
-from collision_env.envs.scripted import scripted_policy  # noqa: E402
+import collision_env  # noqa: F401
+from collision_env.envs import PRESET_IDS, CollisionTargetEnv
+from collision_env.envs.rendering import Renderer
+from collision_env.envs.scripted import scripted_policy
 
 
 def render_episode(env_id: str, seed: int, ppm: float, every: int):
-    env = gym.make(env_id).unwrapped
+    env = cast(CollisionTargetEnv, gym.make(env_id).unwrapped)
     env.reset(seed=seed)
     core = env.core
     renderer = Renderer(env.config, trails=True, ppm=ppm)
     policy = scripted_policy(env)
+    assert policy is not None  # (every preset has one)
     frames = [renderer.draw(core, 0)]
     still, hit_at = None, None
     for t in range(env.config.n_steps):

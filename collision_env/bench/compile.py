@@ -23,6 +23,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 
 from .machine import cpus, machine, timestamp, versions
 from .readme import write_block
@@ -59,7 +60,7 @@ def rows() -> list[tuple[str, str, float | None]]:
     """``(what, code, goal in CPU seconds or None)`` of every row, in order."""
     from collision_env.engine.modes import MODES
 
-    out = [
+    out: list[tuple[str, str, float | None]] = [
         ("first exact-mode `Simulator.step` (2 elastic balls)", _STEP, 20.0),
         ('first `gym.make("CollisionEnv/OneBallTarget-v0")` + `reset` + `step`', _ENV, 30.0),
         ("`python -m collision_env.precompile` (every kernel)", _PRECOMPILE, 60.0),
@@ -92,7 +93,7 @@ def cpu_seconds(code: str) -> tuple[float, float, str]:
     return cpu, wall, done.stderr
 
 
-def run(repeats: int = 1, log=print) -> dict:
+def run(repeats: int = 1, log: Callable[[str], None] = print) -> dict:
     """Every row, each the fewest CPU seconds of ``repeats`` runs."""
     started = time.perf_counter()
     results = []
@@ -129,7 +130,7 @@ def render_markdown(results: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def main(argv=None) -> int:
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m collision_env.bench.compile", description=__doc__.split("\n")[0])
     parser.add_argument("--repeats", type=int, default=1, help="runs per row (the fewest CPU seconds count)")
     parser.add_argument("--json", help="write the raw figures here")

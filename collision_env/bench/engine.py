@@ -40,6 +40,8 @@ import json
 import math
 import sys
 import time
+from collections.abc import Callable, Iterable
+from typing import Any
 
 import numpy as np
 
@@ -66,7 +68,14 @@ BATCH_BALLS = 4
 
 
 # ---------------------------------------------------------------------------------------- helpers
-def random_balls(rng, n, bounds, radius, speed=1.0, gap=1.05):
+def random_balls(
+    rng: np.random.Generator,
+    n: int,
+    bounds: tuple[float, float, float, float],
+    radius: float,
+    speed: float = 1.0,
+    gap: float = 1.05,
+) -> tuple[np.ndarray, np.ndarray]:
     """``n`` non-overlapping balls of ``radius`` inside ``bounds``, random directions at ``speed``.
 
     Returns ``(positions (n, 2), velocities (n, 2))``; centres are at least ``gap * 2 radius`` apart.
@@ -96,7 +105,7 @@ def _pairs(impacts) -> list[tuple[int, int]]:
     ]
 
 
-def bench_gas(quick, n=50, horizon=20.0):
+def bench_gas(quick: bool, n: int = 50, horizon: float = 20.0) -> dict:
     """Exact mode against billiards on an ``n``-disk gas over ``horizon`` s; see the module doc."""
     peer = make_peer("billiards")
     if isinstance(peer, str):
@@ -120,7 +129,7 @@ def bench_gas(quick, n=50, horizon=20.0):
         for _ in range(n_frames):
             peer.step(FRAME, record=False)
 
-    ours = {}
+    ours: dict[str, Any] = {}
 
     def new_sim(max_events=10_000):
         ours["sim"] = Simulator(scene, pos, vel, masses, radii=radii, mode="exact", max_events=max_events)
@@ -148,6 +157,7 @@ def bench_gas(quick, n=50, horizon=20.0):
     # the peer's impacts over the full horizon, recorded (untimed)
     peer.start(case)
     events = peer.step(horizon)
+    assert events is not None  # (recorded)
     long_peer = _pairs(events)
     long_peer_positions = peer.state()[0]
 
@@ -157,6 +167,7 @@ def bench_gas(quick, n=50, horizon=20.0):
     t_check = 0.5 * (events["time"][k] + events["time"][k + 1])
     peer.start(case)
     peer_short = peer.step(t_check)
+    assert peer_short is not None  # (recorded)
     sim = Simulator(scene, pos, vel, masses, radii=radii, mode="exact")
     our_short = sim.step(t_check)
     same_sequence = _pairs(our_short) == _pairs(peer_short)
@@ -215,7 +226,7 @@ def bench_gas(quick, n=50, horizon=20.0):
 
 
 # ---------------------------------------------------------------------------------------- 2. per step
-def bench_per_step(quick):
+def bench_per_step(quick: bool) -> dict:
     """Microseconds per ``step(1/60)`` of each mode at each ball count (and pymunk's)."""
     pymunk = make_peer("pymunk")
     steps, repeats = (200, 5) if quick else (1000, 25)
@@ -225,7 +236,7 @@ def bench_per_step(quick):
         pos, vel = random_balls(rng, n, PLAY_AREA_2D, STEP_RADIUS)
         masses = rng.uniform(0.5, 2.0, n)
         radii = np.full(n, STEP_RADIUS)
-        row = {"balls": n, "steps": steps, "modes": {}}
+        row: dict[str, Any] = {"balls": n, "steps": steps, "modes": {}}
         for mode, k in MODE_CONFIGS:
             sim = Simulator(Scene(), pos, vel, masses, radii=radii, mode=mode, substeps=k)
             start = sim.get_state()
@@ -261,7 +272,7 @@ def bench_per_step(quick):
 
 
 # ---------------------------------------------------------------------------------------- 3. batch
-def bench_batch(quick):
+def bench_batch(quick: bool) -> dict:
     """Scene-steps per second: one BatchSimulator of 1024 scenes against a loop of Simulators."""
     steps, repeats = (10, 3) if quick else (30, 15)
     rng = np.random.default_rng(11)
@@ -332,7 +343,7 @@ def _fmt(x, digits=3):
     return f"{x:,.{digits}g}" if abs(x) < 1000 else f"{x:,.0f}"
 
 
-def render_markdown(results):
+def render_markdown(results: dict) -> str:
     """The benchmark's figures as Markdown (a string), from :func:`run`'s dict or its JSON."""
     meta = results["meta"]
     v = meta["versions"]
@@ -425,12 +436,14 @@ def render_markdown(results):
 
 
 # ---------------------------------------------------------------------------------------- main
-def run(quick=False, parts=("gas", "per_step", "batch"), log=print):
+def run(
+    quick: bool = False, parts: Iterable[str] = ("gas", "per_step", "batch"), log: Callable[[str], None] = print
+) -> dict:
     """Run the benchmark; returns the raw figures as a JSON-ready dict."""
     t0 = time.perf_counter()
     log("warming up the kernels (numba compile or cache load) ...")
     warm_up()
-    results = {}
+    results: dict[str, Any] = {}
     if "gas" in parts:
         results["gas"] = []
         for n, horizon in GAS_CASES + (() if quick else GAS_CASES_FULL):
@@ -469,7 +482,7 @@ def _jsonable(obj):
     return obj
 
 
-def main(argv=None):
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m collision_env.bench.engine", description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="fewer repeats: about 30 s instead of a few minutes")
     parser.add_argument("--json", metavar="PATH", help="write the raw figures to PATH")

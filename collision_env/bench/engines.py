@@ -13,31 +13,35 @@ optional imports: :func:`peer_runners` returns only those installed, with the re
 
 from __future__ import annotations
 
+import numpy as np
+
 from collision_env.engine import BatchSimulator
 
 from .peers import PEERS, Runner, make_peer
+from .scenes import Case
 
 
 class EngineRunner(Runner):
     """This engine, one mode."""
 
     engine = "collision_env"
+    mode: str
+    _sim: BatchSimulator  # (made by start)
 
-    def __init__(self, mode: str, substeps: int = 1, max_events: int = 10_000):
+    def __init__(self, mode: str, substeps: int = 1, max_events: int = 10_000) -> None:
         self.mode = mode
         self.substeps = substeps
         self.max_events = max_events
         self.iterations = None
-        self._sim = None
         self._capped = False
 
     @property
-    def family(self):
+    def family(self) -> str:
         if self.mode == "posteriori" or (self.mode == "naive" and self.substeps > 1):
             return f"{self.mode} k={self.substeps}"
         return self.mode
 
-    def start(self, case):
+    def start(self, case: Case) -> None:
         self._sim = BatchSimulator(
             case.scene,
             case.positions[None],
@@ -50,31 +54,31 @@ class EngineRunner(Runner):
         )
         self._capped = False
 
-    def step(self, dt, record=True):
+    def step(self, dt: float, record: bool = True) -> np.ndarray:
         rows = self._sim.step(dt)
         if self._sim._capped[0]:
             self._capped = True
         return rows
 
-    def state(self):
+    def state(self) -> tuple[np.ndarray, np.ndarray]:
         return self._sim._pos[0].copy(), self._sim._vel[0].copy()
 
     @property
-    def impact_count(self):
+    def impact_count(self) -> int:
         return self._sim.stats["events"]
 
-    def flags(self):
+    def flags(self) -> dict:
         return {"cap_reached": self._capped}
 
 
 def engine_runners(full: bool) -> list[Runner]:
     """This engine's configurations: naive, posteriori with 1/2/4/8 substeps (quick: 1 and 8), exact."""
     ks = (1, 2, 4, 8) if full else (1, 8)
-    return [EngineRunner("naive")] + [EngineRunner("posteriori", k) for k in ks] + [EngineRunner("exact")]
+    return [EngineRunner("naive"), *(EngineRunner("posteriori", k) for k in ks), EngineRunner("exact")]
 
 
 #: the knobs each peer is measured at, ``(full run, quick run)``
-PEER_KNOBS = {
+PEER_KNOBS: dict[str, tuple[list[dict[str, int]], list[dict[str, int]]]] = {
     "pymunk": (
         [{"iterations": 10}, {"iterations": 10, "substeps": 8}, {"iterations": 30}],
         [{"iterations": 10}, {"iterations": 10, "substeps": 8}],
@@ -85,12 +89,13 @@ PEER_KNOBS = {
 
 def peer_runners(full: bool) -> tuple[list[Runner], dict[str, str]]:
     """Installed peers at their knobs, and the reasons for the ones missing."""
-    runners, missing = [], {}
+    runners: list[Runner] = []
+    missing: dict[str, str] = {}
     for name in PEERS:
         first = make_peer(name)
         if isinstance(first, str):
             missing[name] = first
             continue
         full_knobs, quick_knobs = PEER_KNOBS[name]
-        runners += [make_peer(name, **knobs) for knobs in (full_knobs if full else quick_knobs)]
+        runners += [PEERS[name](**knobs) for knobs in (full_knobs if full else quick_knobs)]  # (installed)
     return runners, missing

@@ -7,6 +7,8 @@ why instead when the environments are not importable or registered.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from collision_env.envs.registry import bench_scenes
 
 from .envs import single_env_us, vector_env_steps_per_s
@@ -30,7 +32,7 @@ def _rates(make_single, make_vector, seconds: float) -> tuple[float, float]:
         venv.close()
 
 
-def env_rates(quick: bool, log=print):
+def env_rates(quick: bool, log: Callable[[str], None] = print) -> list[dict] | str:
     """Rows ``{env, scene, mode, single_steps_per_s, vector_steps_per_s}`` or a string (why not)."""
     try:
         import gymnasium as gym

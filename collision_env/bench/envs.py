@@ -20,12 +20,14 @@ from __future__ import annotations
 
 import argparse
 import time
+from typing import cast
 
 import gymnasium as gym
 import numpy as np
 
 import collision_env
 from collision_env.engine import MODES
+from collision_env.envs import CollisionTargetEnv, CollisionTargetVectorEnv
 
 from .machine import cpus, machine, timestamp, versions
 from .readme import write_block
@@ -90,7 +92,7 @@ def _engine_share(venv: gym.vector.VectorEnv, seconds: float) -> float:
     """The engine's share of a vector env's step time: every engine ``step`` of its core (the
     look-ahead engine's too) is timed inside the env's own run, random actions and resets
     included. (A timer costs well under a microsecond, nothing beside a step of a whole batch.)"""
-    engines = venv.unwrapped.core.engines
+    engines = cast(CollisionTargetVectorEnv, venv.unwrapped).core.engines
     spent = {"engine": 0.0}
     for sim in engines:
         add_timer(sim, "step", spent, "engine")
@@ -107,7 +109,7 @@ def _fmt_rate(x: float) -> str:
     return f"{x / 1e6:.2f} M" if x >= 1e6 else f"{x / 1e3:.0f} k"
 
 
-def main(argv=None) -> None:
+def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(
         prog="python -m collision_env.bench.envs",
         description=__doc__,
@@ -129,7 +131,7 @@ def main(argv=None) -> None:
         for mode in args.modes:
             env = gym.make(env_id, mode=mode)
             us = single_env_us(env, args.seconds)
-            eng = _engine_us(env.unwrapped.core, args.seconds / 2)
+            eng = _engine_us(cast(CollisionTargetEnv, env.unwrapped).core, args.seconds / 2)
             single.append(f"| `{env_id}` | {mode} | {us:.2f} | {eng:.2f} | {us / cart:.2f} |")
             env.close()
 

@@ -38,7 +38,7 @@ import math
 import sys
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -317,14 +317,14 @@ def cells(quick: bool = False) -> list[Cell]:
         n = 3 if r >= 0.5 else 4
         for dt in (1e-3, 0.1):
 
-            def build(r=r, n=n):
+            def build_sized(r=r, n=n):
                 c = gas(n, radius=r, packing=n * math.pi * r * r / 8.0, speed=1.0, seed=6)
                 return c
 
             add(
                 f"gas{n} r={r:g} dt={dt:g}",
                 "radius",
-                build,
+                build_sized,
                 dt,
                 5.0,
                 _box_rate(n, 1.0, PLAY_AREA_2D, r),
@@ -567,7 +567,7 @@ def _three_balls(e):
     )
 
 
-def _run_exact(case, dt, duration):
+def _run_exact(case: Case, dt: float, duration: float) -> tuple[np.ndarray, Simulator]:
     """The impacts of ``case`` in exact mode over ``duration`` (steps of ``dt``) and the final simulator."""
     sim = Simulator(*case, mode="exact")
     rows = [sim.batch.step(dt) for _ in range(max(1, int(round(duration / dt))))]
@@ -825,7 +825,7 @@ def run_cell(cell: Cell, mode: str, substeps: int, budget: float) -> dict:
     ke0 = sim.kinetic_energy()
     ke_prev = ke0
     count = 0
-    keep = []
+    keep: list[np.ndarray] | None = []
     kept = 0
     worst_step = 0.0
     engine_time = 0.0
@@ -923,7 +923,12 @@ def repro(cell: Cell) -> str:
     )
 
 
-def run_extremes(quick: bool, budget: float | None = None, modes=MODES, log=print) -> list[dict]:
+def run_extremes(
+    quick: bool,
+    budget: float | None = None,
+    modes: Sequence[tuple[str, int]] = MODES,
+    log: Callable[[str], None] = print,
+) -> list[dict]:
     budget = budget if budget is not None else (5.0 if quick else 30.0)
     rows = []
     grid = cells(quick)
@@ -1011,7 +1016,7 @@ def extremes_markdown(rows: list[dict], quick: bool, budget: float) -> str:
     return "\n".join(lines)
 
 
-def write_csv(path, rows, fields):
+def write_csv(path: str | Path, rows: list[dict], fields: Sequence[str]) -> None:
     with open(path, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=fields, extrasaction="ignore")
         w.writeheader()
@@ -1019,7 +1024,7 @@ def write_csv(path, rows, fields):
             w.writerow({k: r.get(k, "") for k in fields})
 
 
-def main(argv=None):
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m collision_env.bench.extremes", description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="a subset of the grid (about 15 s)")
     parser.add_argument("--out", default="docs/bench", help="output folder (default docs/bench)")

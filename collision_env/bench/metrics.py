@@ -21,8 +21,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any, cast
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from collision_env.engine import WALL_NAMES
 
@@ -38,7 +40,7 @@ IMPACTS = np.dtype(
 )
 
 
-def as_impacts(impacts) -> np.ndarray:
+def as_impacts(impacts: Any) -> np.ndarray:
     """Impacts as an :data:`IMPACTS` array.
 
     Accepts an :data:`IMPACTS` or engine ``IMPACT_DTYPE`` array, a list of engine ``Impact``
@@ -47,7 +49,7 @@ def as_impacts(impacts) -> np.ndarray:
     """
     if isinstance(impacts, np.ndarray) and impacts.dtype.names is not None:
         out = np.empty(len(impacts), dtype=IMPACTS)
-        for name in IMPACTS.names:
+        for name in IMPACTS.names or ():
             out[name] = impacts[name]
         return out
     rows = []
@@ -107,7 +109,7 @@ class Match:
         }
 
 
-def match_impacts(run, ref, window: float, neighbours: int = 4) -> Match:
+def match_impacts(run: np.ndarray, ref: np.ndarray, window: float, neighbours: int = 4) -> Match:
     """Pair ``run`` impacts with ``ref`` impacts one to one.
 
     Two impacts can pair only if they have the same key (:func:`impact_keys`) and their times
@@ -161,7 +163,8 @@ def match_impacts(run, ref, window: float, neighbours: int = 4) -> Match:
         d_all.append(d[keep])
         j_all.append(ref_idx[q[keep]])
         i_all.append(run_idx[which[keep]])
-    pr, pf = [], []
+    matched_run: list[int] = []
+    matched_ref: list[int] = []
     if d_all:
         d = np.concatenate(d_all)
         j = np.concatenate(j_all)
@@ -174,15 +177,15 @@ def match_impacts(run, ref, window: float, neighbours: int = 4) -> Match:
             if run_used[ii] or ref_used[jj]:
                 continue
             run_used[ii] = ref_used[jj] = True
-            pr.append(ii)
-            pf.append(jj)
-            if len(pr) == most:
+            matched_run.append(ii)
+            matched_ref.append(jj)
+            if len(matched_run) == most:
                 break
     else:
         run_used = np.zeros(len(run), dtype=bool)
         ref_used = np.zeros(len(ref), dtype=bool)
-    pr = np.array(pr, dtype=np.int64)
-    pf = np.array(pf, dtype=np.int64)
+    pr = np.array(matched_run, dtype=np.int64)
+    pf = np.array(matched_ref, dtype=np.int64)
     time_error = np.abs(run["time"][pr] - ref["time"][pf])
     point_error = np.hypot(run["x"][pr] - ref["x"][pf], run["y"][pr] - ref["y"][pf])
     run_pairs = {k for k in run_keys if k[2] < 0}
@@ -199,7 +202,7 @@ def match_impacts(run, ref, window: float, neighbours: int = 4) -> Match:
 
 
 # --------------------------------------------------------------------------- conservation, validity
-def drift(series, reference=None, scale=None) -> float:
+def drift(series: ArrayLike, reference: float | None = None, scale: float | None = None) -> float:
     """Largest relative deviation of ``series`` from ``reference``.
 
     ``series`` is ``(T,)`` or ``(T, d)`` (a vector per time: its deviation is the Euclidean norm).
@@ -219,24 +222,31 @@ def drift(series, reference=None, scale=None) -> float:
     return worst / scale if scale > 0 else worst
 
 
-def kinetic_energy(vel, masses) -> np.ndarray:
+def kinetic_energy(vel: ArrayLike, masses: ArrayLike) -> np.ndarray:
     """Total kinetic energy of ``vel`` ``(..., N, 2)``, J."""
     return 0.5 * (np.asarray(masses) * (np.asarray(vel) ** 2).sum(-1)).sum(-1)
 
 
-def momentum(vel, masses) -> np.ndarray:
+def momentum(vel: ArrayLike, masses: ArrayLike) -> np.ndarray:
     """Total momentum of ``vel`` ``(..., N, 2)``, kg m/s."""
     return (np.asarray(masses)[:, None] * np.asarray(vel)).sum(-2)
 
 
-def final_state_error(pos, vel, ref_pos, ref_vel, radii, speed_scale) -> tuple[float, float]:
+def final_state_error(
+    pos: np.ndarray,
+    vel: np.ndarray,
+    ref_pos: np.ndarray,
+    ref_vel: np.ndarray,
+    radii: np.ndarray,
+    speed_scale: float,
+) -> tuple[float, float]:
     """``(max_i |x_i - x_ref,i| / r_i, max_i |v_i - v_ref,i| / speed_scale)``."""
     dx = np.hypot(*(np.asarray(pos) - np.asarray(ref_pos)).T) / np.asarray(radii)
     dv = np.hypot(*(np.asarray(vel) - np.asarray(ref_vel)).T) / speed_scale
     return float(dx.max()), float(dv.max())
 
 
-def escapes(positions, bounds, dimension=2) -> np.ndarray:
+def escapes(positions: ArrayLike, bounds: tuple[float, float, float, float] | None, dimension: int = 2) -> np.ndarray:
     """``(N,)`` bool: balls whose centre is outside the border in any of ``positions`` ``([T,] N, 2)``.
 
     A ball that merely overlaps a wall has not escaped (see :func:`wall_penetration`); one whose
@@ -252,10 +262,12 @@ def escapes(positions, bounds, dimension=2) -> np.ndarray:
     if dimension == 2:
         out |= (p[..., 1] < ymin) | (p[..., 1] > ymax)
     out |= ~np.isfinite(p).all(-1)
-    return out.any(0)
+    return cast(np.ndarray, out.any(0))  # (p has three axes)
 
 
-def wall_penetration(positions, radii, bounds, dimension=2) -> float:
+def wall_penetration(
+    positions: ArrayLike, radii: ArrayLike, bounds: tuple[float, float, float, float] | None, dimension: int = 2
+) -> float:
     """Deepest overlap of a ball with a wall over ``positions`` ``([T,] N, 2)``, in radii (0: none)."""
     if bounds is None:
         return 0.0
@@ -270,7 +282,7 @@ def wall_penetration(positions, radii, bounds, dimension=2) -> float:
     return float(max(0.0, np.nanmax(depth / r)))
 
 
-def max_overlap(positions, radii, chunk=256) -> float:
+def max_overlap(positions: ArrayLike, radii: ArrayLike, chunk: int = 256) -> float:
     """Deepest ball-ball overlap over ``positions`` ``([T,] N, 2)``, relative to the radii sum (0: none)."""
     p = np.asarray(positions, dtype=np.float64)
     if p.ndim == 2:
@@ -290,7 +302,7 @@ def max_overlap(positions, radii, chunk=256) -> float:
     return max(0.0, worst)
 
 
-def collisions_per_ball(impacts, n) -> np.ndarray:
+def collisions_per_ball(impacts: np.ndarray, n: int) -> np.ndarray:
     """``(n,)`` number of impacts each ball took part in (a ball-ball impact counts for both)."""
     imp = as_impacts(impacts)
     count = np.bincount(imp["ball"], minlength=n).astype(np.float64)
@@ -299,7 +311,7 @@ def collisions_per_ball(impacts, n) -> np.ndarray:
     return count
 
 
-def short_horizon(impacts, n, per_ball=5.0, default=None) -> float | None:
+def short_horizon(impacts: np.ndarray, n: int, per_ball: float = 5.0, default: float | None = None) -> float | None:
     """A time between two impacts at which the balls have had ``per_ball`` impacts on average.
 
     ``impacts`` must be in time order (a reference run). Returns ``default`` if the run never
@@ -315,7 +327,7 @@ def short_horizon(impacts, n, per_ball=5.0, default=None) -> float | None:
 
 
 # --------------------------------------------------------------------------- statistics
-def ks_rayleigh(speeds, masses=None, kT=None) -> float:
+def ks_rayleigh(speeds: ArrayLike, masses: ArrayLike | None = None, kT: float | None = None) -> float:
     """Kolmogorov-Smirnov distance between sampled speeds and the 2D Maxwell-Boltzmann (Rayleigh) law.
 
     ``F(v) = 1 - exp(-m v^2 / (2 kT))``. With several masses, each speed is scaled by

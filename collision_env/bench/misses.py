@@ -61,7 +61,7 @@ class LineCache:
     lines it had to fetch while ``counting`` is on; and per ``(tag, site)`` too, in ``sites``, once
     that is set to a dict (the traced arrays then name the source line of each access)."""
 
-    def __init__(self, lines: int):
+    def __init__(self, lines: int) -> None:
         self.lines = lines
         self.held: OrderedDict[int, None] = OrderedDict()
         self.counting = False
@@ -201,7 +201,7 @@ def render_markdown(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def main(argv=None) -> int:
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m collision_env.bench.misses", description=__doc__.split("\n")[0])
     parser.add_argument("--sizes", type=int, nargs="+", default=list(SIZES), help="gases of these many disks")
     parser.add_argument("--cache-kib", type=int, default=CACHE_KIB, help="the modelled cache's size (KiB)")

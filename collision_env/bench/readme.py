@@ -13,7 +13,7 @@ def markers(name: str) -> tuple[str, str]:
     return f"<!-- {name}:start -->", f"<!-- {name}:end -->"
 
 
-def replace_block(path, name: str, block: str) -> bool:
+def replace_block(path: str | Path, name: str, block: str) -> bool:
     """Replace the text between block ``name``'s markers in ``path``; False if they are missing."""
     start_mark, end_mark = markers(name)
     p = Path(path)
@@ -26,7 +26,7 @@ def replace_block(path, name: str, block: str) -> bool:
     return True
 
 
-def write_block(path, name: str, block: str) -> None:
+def write_block(path: str | Path, name: str, block: str) -> None:
     """:func:`replace_block`, saying on stdout what happened."""
     if replace_block(path, name, block):
         print(f"{path}: {name} block updated")

@@ -10,11 +10,12 @@ import csv
 import math
 import re
 from collections import defaultdict
+from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 
 import numpy as np
 
-from .sweep import FIELDS  # noqa: F401 (re-exported for the CSV writer and tests)
+from .sweep import FIELDS
 
 #: Final-state errors (in radii) at or below this are round-off: such runs "match exact".
 ROUND_OFF = 1e-9
@@ -26,7 +27,7 @@ README_BLOCK = "bench:study"
 
 
 # --------------------------------------------------------------------------- CSV
-def write_csv(path, rows, fields=FIELDS):
+def write_csv(path: str | Path, rows: list[dict], fields: Sequence[str] = FIELDS) -> None:
     with open(path, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=fields, extrasaction="ignore")
         w.writeheader()
@@ -44,7 +45,7 @@ def _csv_value(v):
     return v
 
 
-def read_csv(path) -> list[dict]:
+def read_csv(path: str | Path) -> list[dict]:
     """Rows back from :func:`write_csv`, numbers as numbers."""
     out = []
     with open(path, newline="") as fh:
@@ -66,11 +67,11 @@ def _parse(v):
 
 
 # --------------------------------------------------------------------------- helpers
-def ok_rows(rows):
+def ok_rows(rows: list[dict]) -> list[dict]:
     return [r for r in rows if r.get("status") == "ok"]
 
 
-def family_order(rows) -> list[str]:
+def family_order(rows: list[dict]) -> list[str]:
     """Families in a stable, meaningful order: ours (naive, posteriori by k, exact), then peers."""
     fams = list(dict.fromkeys(r["family"] for r in rows))
 
@@ -117,7 +118,7 @@ def _err(r):
 
 
 # --------------------------------------------------------------------------- tables
-def results_markdown(rows, missing, env_rows, quick, meta) -> str:
+def results_markdown(rows: list[dict], missing: dict, env_rows: list[dict] | str | None, quick: bool, meta: str) -> str:
     ok = ok_rows(rows)
     fams = family_order(ok)
     mid_dt = 0.01 if any(r["dt"] == 0.01 for r in ok) else sorted({r["dt"] for r in ok})[0]
@@ -156,7 +157,7 @@ def results_markdown(rows, missing, env_rows, quick, meta) -> str:
         "| scene | n | engine / mode | " + " | ".join(f"dt={d:g}" for d in dts) + " |",
         "|---|---:|---|" + "---:|" * len(dts),
     ]
-    largest = {}
+    largest: dict[str, int] = {}
     for r in ok:
         largest[r["scene"]] = max(largest.get(r["scene"], 0), r["n"])
     for scene, n in largest.items():
@@ -188,7 +189,7 @@ def results_markdown(rows, missing, env_rows, quick, meta) -> str:
     return "\n".join(lines)
 
 
-def env_markdown(env_rows) -> str:
+def env_markdown(env_rows: list[dict] | str) -> str:
     if isinstance(env_rows, str):
         return f"### Environment steps per second\n\n{env_rows}\n"
     lines = [
@@ -218,7 +219,7 @@ def _style(fams):
     return style
 
 
-def plot_all(rows, out: Path) -> list[str]:
+def plot_all(rows: list[dict], out: Path) -> list[str]:
     """The three plots as PNG files in ``out``; returns their file names."""
     import matplotlib
 
@@ -231,7 +232,7 @@ def plot_all(rows, out: Path) -> list[str]:
     names = []
 
     # 1. Pareto front: error vs cost, one panel per scene at its largest ball count
-    largest = {}
+    largest: dict[str, int] = {}
     for r in ok:
         largest[r["scene"]] = max(largest.get(r["scene"], 0), r["n"])
     scenes = list(largest)
@@ -356,7 +357,7 @@ ELASTIC = ("elastic scenes (e = 1)", lambda r: r["elasticity"] == 1.0)
 INELASTIC = ("inelastic scenes (e < 1)", lambda r: r["elasticity"] < 1.0)
 
 
-def floors(rows) -> dict:
+def floors(rows: list[dict]) -> dict:
     """Per ``(scene, n)``: the spread of exact mode's own runs around the reference (its round-off,
     amplified by chaos over the horizon), at least :data:`ROUND_OFF`. Errors below it are ties."""
     out: dict = {}
@@ -368,7 +369,14 @@ def floors(rows) -> dict:
     return out
 
 
-def thresholds(rows, family, level, key="speed_dt_over_r", where=lambda r: True, floor=None):
+def thresholds(
+    rows: list[dict],
+    family: str,
+    level: float,
+    key: str = "speed_dt_over_r",
+    where: Callable[[dict], bool] = lambda r: True,
+    floor: dict | None = None,
+) -> tuple[float, int, int]:
     """``(Y, runs below Y, all runs)``: every run of ``family`` with ``key < Y`` has error <= ``level``.
 
     Y is the smallest ``key`` at which the family's error exceeded ``level`` (inf if it never did).
@@ -383,13 +391,15 @@ def thresholds(rows, family, level, key="speed_dt_over_r", where=lambda r: True,
     return y, below, len(fr)
 
 
-def miss_threshold(rows, family, key="speed_dt_over_r", where=lambda r: True):
+def miss_threshold(
+    rows: list[dict], family: str, key: str = "speed_dt_over_r", where: Callable[[dict], bool] = lambda r: True
+) -> tuple[float, int]:
     fr = [r for r in ok_rows(rows) if r["family"] == family and where(r)]
     bad = [r[key] for r in fr if r["missed"] > 0 or r["spurious"] > 0]
     return (min(bad) if bad else math.inf), len(fr)
 
 
-def pareto_check(rows):
+def pareto_check(rows: list[dict]) -> tuple[list[tuple], list[tuple]]:
     """Per (scene, n): runs faster than exact's fastest run that are more accurate than it beyond the
     case's floor (dominated), and those within the floor (ties). Returns (dominated, ties)."""
     ok = ok_rows(rows)
@@ -414,7 +424,9 @@ def pareto_check(rows):
     return dominated, ties
 
 
-def cost_ratios(rows, num="exact", den="naive", counts=(1, 2, 4)):
+def cost_ratios(
+    rows: list[dict], num: str = "exact", den: str = "naive", counts: Iterable[int] = (1, 2, 4)
+) -> tuple[float, float, int]:
     """Per-step cost ratio ``num / den`` at the same scene, n and dt, for n in ``counts``: (median, max, k)."""
     ok = ok_rows(rows)
     index = {(r["scene"], r["n"], r["dt"], r["family"]): r for r in ok}
@@ -456,7 +468,7 @@ def _exact_unmatched(exact) -> str:
     return text + "."
 
 
-def summary_markdown(rows, extreme_rows, stat_rows, quick, meta) -> str:
+def summary_markdown(rows: list[dict], extreme_rows: list[dict], stat_rows: list[dict], quick: bool, meta: str) -> str:
     ok = ok_rows(rows)
     fams = family_order(ok)
     floor = floors(ok)
@@ -596,7 +608,7 @@ def summary_markdown(rows, extreme_rows, stat_rows, quick, meta) -> str:
         for mode in dict.fromkeys(r["mode"] for r in extreme_rows):
             rs = [r for r in extreme_rows if r["mode"] == mode]
             fails = [r for r in rs if r["status"] != "pass"]
-            reasons = defaultdict(int)
+            reasons: defaultdict[str, int] = defaultdict(int)
             for r in fails:
                 for reason in str(r["status"]).split(", "):
                     reasons[reason] += 1
@@ -670,7 +682,7 @@ def summary_markdown(rows, extreme_rows, stat_rows, quick, meta) -> str:
     return "\n".join(lines)
 
 
-def readme_block(rows, plots, out_rel: str, quick) -> str:
+def readme_block(rows: list[dict], plots: list[str], out_rel: str, quick: bool) -> str:
     """The short table and the plot links for the README."""
     ok = ok_rows(rows)
     fams = family_order(ok)

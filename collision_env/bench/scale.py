@@ -38,6 +38,7 @@ import math
 import sys
 import time
 import tracemalloc
+from collections.abc import Callable, Iterable
 
 import numpy as np
 
@@ -63,7 +64,9 @@ SLICES = 3
 MIN_SLICE_S = 0.2
 
 
-def lattice_gas(n: int, packing: float = PACKING, radius: float = RADIUS, seed: int = 0):
+def lattice_gas(
+    n: int, packing: float = PACKING, radius: float = RADIUS, seed: int = 0
+) -> tuple[Scene, np.ndarray, np.ndarray]:
     """``n`` disks on a square lattice in a square box at area fraction ``packing``."""
     side = math.sqrt(n * math.pi * radius**2 / packing)
     per_row = math.ceil(math.sqrt(n))
@@ -83,7 +86,7 @@ class TimedGas:
     """One gas of ``n`` disks: built and warmed up, then timed in slices of frames
     (:meth:`time_slice`, called in rounds that take every size in turn), then checked (:meth:`row`)."""
 
-    def __init__(self, n: int, trace_memory: bool = True):
+    def __init__(self, n: int, trace_memory: bool = True) -> None:
         self.n = n
         self.scene, pos, vel = lattice_gas(n)
         if trace_memory:  # (tracing slows Python code: the engine's Python path, ten times)
@@ -95,6 +98,7 @@ class TimedGas:
         )
         self.build_s = time.perf_counter() - t0
         self.e0 = _energy(self.sim)
+        assert self.scene.bounds is not None  # (a box: lattice_gas)
         xmin, ymin, xmax, ymax = self.scene.bounds
         self.area = (xmax - xmin) * (ymax - ymin)
         nu = enskog_rate(n / self.area, 2 * RADIUS, PACKING, self.e0 / n, 1.0)  # 2D: kT = mean kinetic energy
@@ -133,6 +137,7 @@ class TimedGas:
         p = sim.positions[0]
         r = sim.radii[0]
         i, j = first_overlap(p, r, 1e-9)
+        assert self.scene.bounds is not None  # (a box: lattice_gas)
         xmin, ymin, xmax, ymax = self.scene.bounds
         slack = 1e-12 * (xmax - xmin)
         outside = int(
@@ -171,7 +176,9 @@ def _log_row(row: dict, log) -> None:
     )
 
 
-def bench_sizes(sizes, log=print, min_slice_s: float = MIN_SLICE_S) -> list[dict]:
+def bench_sizes(
+    sizes: Iterable[int], log: Callable[[str], None] = print, min_slice_s: float = MIN_SLICE_S
+) -> list[dict]:
     """Build and warm up a gas of each size, time them in :data:`SLICES` rounds that take every
     size in turn (so that the machine's load drifts over all sizes alike), and check them."""
     gases = [TimedGas(n) for n in sizes]
@@ -184,7 +191,7 @@ def bench_sizes(sizes, log=print, min_slice_s: float = MIN_SLICE_S) -> list[dict
     return rows
 
 
-def bench_size(n: int, log=print, min_slice_s: float = MIN_SLICE_S) -> dict:
+def bench_size(n: int, log: Callable[[str], None] = print, min_slice_s: float = MIN_SLICE_S) -> dict:
     """Build, warm up, time and check one gas of ``n`` disks."""
     return bench_sizes([n], log, min_slice_s)[0]
 
@@ -249,7 +256,7 @@ def bench_frames(n: int = 50, horizon: float = 20.0, repeats: int = 5) -> dict:
     }
 
 
-def run(quick: bool = False, log=print) -> dict:
+def run(quick: bool = False, log: Callable[[str], None] = print) -> dict:
     t0 = time.perf_counter()
     warm_up()
     first_call_s = time.perf_counter() - t0
@@ -317,7 +324,7 @@ def render_markdown(results: dict) -> str:
     return "\n".join(lines)
 
 
-def main(argv=None) -> int:
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m collision_env.bench.scale", description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="sizes up to 10^4 only")
     parser.add_argument("--json", help="write the raw figures here")

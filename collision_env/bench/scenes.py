@@ -124,7 +124,7 @@ def inelastic(n: int = 2, flavour: str = "stick") -> Case:
 
 
 # --------------------------------------------------------------------------- gases
-def gas_box(n: int, radius: float, packing: float, aspect: float = 2.0):
+def gas_box(n: int, radius: float, packing: float, aspect: float = 2.0) -> tuple[float, float, float, float]:
     """Bounds of a box of aspect ``aspect`` (width/height) holding ``n`` disks at packing fraction ``packing``."""
     area = n * math.pi * radius**2 / packing
     h = math.sqrt(area / aspect)
@@ -136,12 +136,13 @@ def _lattice(n, bounds, radius, rng, jitter):
     """``n`` centres on a rectangular lattice filling ``bounds``, each jittered by up to ``jitter``."""
     xmin, ymin, xmax, ymax = bounds
     w, h = xmax - xmin, ymax - ymin
-    best = None
+    best: tuple[float, int, int] | None = None
     for nx in range(1, n + 1):
         ny = math.ceil(n / nx)
         s = min(w / nx, h / ny)
         if best is None or s > best[0]:
             best = (s, nx, ny)
+    assert best is not None  # (n >= 1)
     _, nx, ny = best
     sx, sy = w / nx, h / ny
     if min(sx, sy) < 2 * radius * (1 + 1e-9):

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 
 import numpy as np
 
@@ -56,7 +57,7 @@ def _runners():
     return out + [peer for peer in peers if not isinstance(peer, str)]
 
 
-def gas_statistics(quick: bool, log=print) -> list[dict]:
+def gas_statistics(quick: bool, log: Callable[[str], None] = print) -> list[dict]:
     rows = []
     per_ball = 30.0 if quick else 100.0
     dts = (0.01, 0.1)
@@ -65,6 +66,7 @@ def gas_statistics(quick: bool, log=print) -> list[dict]:
         n = 64
         case = spec.case(n)
         b = case.scene.bounds
+        assert b is not None  # (a bounded scene)
         area = (b[2] - b[0]) * (b[3] - b[1])
         r = float(case.radii[0])
         m = float(case.masses[0])

@@ -44,7 +44,7 @@ def _stderr(msg):
     print(msg, file=sys.stderr, flush=True)
 
 
-def main(argv=None):
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m collision_env.bench [study]", description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="a subset: about a minute")
     parser.add_argument("--out", default="docs/bench", help="output folder (default docs/bench)")

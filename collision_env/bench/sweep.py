@@ -26,6 +26,7 @@ from __future__ import annotations
 import math
 import time
 import traceback
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -106,7 +107,7 @@ class Record:
     flags: dict
 
 
-def record_run(runner: Runner, case: Case, steps) -> Record:
+def record_run(runner: Runner, case: Case, steps: Sequence[float]) -> Record:
     runner.start(case)
     n = len(case.masses)
     s = len(steps)
@@ -125,7 +126,7 @@ def record_run(runner: Runner, case: Case, steps) -> Record:
     return Record(collect(chunks), times, pos, vel, runner.flags())
 
 
-def timed_run(runner: Runner, case: Case, steps, min_time: float, max_repeats: int) -> float:
+def timed_run(runner: Runner, case: Case, steps: Sequence[float], min_time: float, max_repeats: int) -> float:
     """Best wall time (s) of the stepping loop over ``steps`` (construction excluded)."""
     best = math.inf
     total = 0.0
@@ -157,7 +158,8 @@ def reference(spec: SceneSpec, n: int) -> Reference:
     horizon = spec.horizon
     if spec.chaotic:
         first = record_run(exact, case, [horizon / REFERENCE_STEPS] * REFERENCE_STEPS)
-        horizon = M.short_horizon(first.impacts, n, COLLISIONS_PER_BALL, default=horizon)
+        short = M.short_horizon(first.impacts, n, COLLISIONS_PER_BALL, default=horizon)
+        horizon = horizon if short is None else short
     rec = record_run(exact, case, [horizon / REFERENCE_STEPS] * REFERENCE_STEPS)
     v_peak = float(np.sqrt((rec.velocities**2).sum(-1)).max())
     per_ball = M.collisions_per_ball(rec.impacts, n).mean() if len(rec.impacts) else 0.0
@@ -208,7 +210,16 @@ def _note(spec: SceneSpec, rec: Record) -> str:
     return ""
 
 
-def sweep_case(spec: SceneSpec, n: int, runners, dts, *, min_time: float, max_repeats: int, log=print) -> list[dict]:
+def sweep_case(
+    spec: SceneSpec,
+    n: int,
+    runners: list[Runner],
+    dts: Iterable[float],
+    *,
+    min_time: float,
+    max_repeats: int,
+    log: Callable[[str], None] = print,
+) -> list[dict]:
     """All runners at all control steps on one scene and ball count; one row per run."""
     ref = reference(spec, n)
     case = ref.case
@@ -268,7 +279,7 @@ COST_HORIZON = 0.5
 ALL_PAIRS_PEER_MAX_BALLS = 256
 
 
-def cost_case(spec: SceneSpec, n: int, runners, *, min_time: float, max_repeats: int) -> list[dict]:
+def cost_case(spec: SceneSpec, n: int, runners: list[Runner], *, min_time: float, max_repeats: int) -> list[dict]:
     """Every runner's cost per step on one scene at a large ball count (status "timed": no accuracy)."""
     case = spec.case(n)
     steps = schedule(COST_HORIZON, COST_DT)
@@ -308,7 +319,7 @@ def cost_case(spec: SceneSpec, n: int, runners, *, min_time: float, max_repeats:
     return rows
 
 
-def warm_up():
+def warm_up() -> None:
     """Compile or load every kernel before anything is timed."""
     for spec_name, n in (("explore_2d", 2), ("inelastic", 2), ("newtons_cradle", 4), ("inelastic_pileup", 4)):
         case = SCENES[spec_name].case(n)
@@ -319,7 +330,7 @@ def warm_up():
             runner.step(1.0)
 
 
-def cases(quick: bool, scenes=None):
+def cases(quick: bool, scenes: Iterable[str] | None = None) -> list[tuple[SceneSpec, int]]:
     """``(spec, n)`` pairs the sweep covers."""
     out = []
     for name, spec in SCENES.items():
@@ -330,11 +341,13 @@ def cases(quick: bool, scenes=None):
     return out
 
 
-def run_sweep(quick: bool, scenes=None, peers=True, log=print) -> tuple[list[dict], dict]:
+def run_sweep(
+    quick: bool, scenes: Iterable[str] | None = None, peers: bool = True, log: Callable[[str], None] = print
+) -> tuple[list[dict], dict]:
     """The whole sweep; returns the rows and what was left out (missing peers)."""
     warm_up()
     runners = engine_runners(full=not quick)
-    missing = {}
+    missing: dict[str, str] = {}
     if peers:
         extra, missing = peer_runners(full=not quick)
         runners = runners + extra

@@ -59,7 +59,12 @@ import pickle
 import shutil
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    import numpy as np
 
 try:  # numba is an optional accelerator, not a requirement of the core install
     import numba as _numba
@@ -165,6 +170,8 @@ if HAVE_NUMBA:
     from numba.core import types as _types
     from numba.core.caching import CompileResultCacheImpl, FunctionCache, _CacheLocator
     from numba.core.registry import CPUDispatcher
+    from numba.core.types.containers import BaseTuple as _BaseTuple  # (not in numba's stubs of types)
+    from numba.core.types.misc import unliteral as _unliteral
 
     class _SourceHashLocator(_CacheLocator):
         """Numba cache locator: one folder for the whole package, named by its source hash."""
@@ -207,14 +214,14 @@ if HAVE_NUMBA:
         """The type a kernel called from another is compiled for: literals as their plain type, and
         every integer as int64 (an index read from an int32 array and one counted in a loop then
         share one compiled version)."""
-        t = _types.unliteral(t)
+        t = _unliteral(t)
         return _types.int64 if isinstance(t, _types.Integer) else t
 
     def _closure_key(func) -> bytes:
         """What identifies a closure's constants across processes: each cell's pickled value, or for
         a cell holding a kernel, that kernel's name and the key of its own cells (its code is
         covered by :data:`SOURCE_HASH`)."""
-        parts = []
+        parts: list[object] = []
         for cell in func.__closure__ or ():
             value = cell.cell_contents
             if isinstance(value, CPUDispatcher):
@@ -247,7 +254,7 @@ if HAVE_NUMBA:
     class _KernelDispatcher(CPUDispatcher):
         """A CPU dispatcher compiled for plain (non-literal) argument types, cached by source hash."""
 
-        label = None  #: what :class:`_CompileNotice` calls it (None: named only inside a labelled one)
+        label: str | None = None  #: what :class:`_CompileNotice` calls it (None: named only inside a labelled one)
 
         def get_call_template(self, args, kws):
             args = tuple(_plain(a) for a in args)
@@ -276,21 +283,28 @@ if HAVE_NUMBA:
             )
 
 
-def _in_package(func) -> bool:
+def _in_package(func: Callable[..., Any]) -> bool:
     try:
         return Path(func.__code__.co_filename).resolve().is_relative_to(PACKAGE_DIR)
     except (OSError, ValueError):
         return False
 
 
-def compile_for(kernel, *example_args) -> None:
+def compile_for(kernel: Any, *example_args: Any) -> None:
     """Compile ``kernel`` now for the types of ``example_args`` (or load it from the cache), rather
     than at its first call; without numba, nothing to do."""
     if HAVE_NUMBA:
         kernel.compile(tuple(_numba.typeof(a) for a in example_args))
 
 
-def njit(func=None, *, refcount=True, label=None, python=None, **options):
+def njit(
+    func: Callable[..., Any] | None = None,
+    *,
+    refcount: bool = True,
+    label: str | None = None,
+    python: bool | None = None,
+    **options: Any,
+) -> Any:
     """Compile ``func`` with numba in nopython mode (cached), or return it unchanged.
 
     Use bare (``@njit``) or with extra numba options (``@njit(inline="always")``);
@@ -331,7 +345,7 @@ if HAVE_NUMBA:
     def prefetch(typingctx, array, index):
         """Ask for the cache line of ``array[index]`` (``index``: an integer, or a tuple of one per
         axis) to be brought in for reading. A hint: it changes no value and cannot fault."""
-        indices = tuple(index) if isinstance(index, _types.BaseTuple) else (index,)
+        indices = tuple(index) if isinstance(index, _BaseTuple) else (index,)
         if not (isinstance(array, _types.Array) and len(indices) == array.ndim):
             return None
         if not all(isinstance(i, _types.Integer) for i in indices):
@@ -340,7 +354,7 @@ if HAVE_NUMBA:
         def codegen(context, builder, signature, args):
             array_type, index_type = signature.args
             view = context.make_array(array_type)(context, builder, args[0])
-            if isinstance(index_type, _types.BaseTuple):
+            if isinstance(index_type, _BaseTuple):
                 values, types = _cgutils.unpack_tuple(builder, args[1]), tuple(index_type)
             else:
                 values, types = [args[1]], (index_type,)
@@ -361,5 +375,5 @@ if HAVE_NUMBA:
 
 else:
 
-    def prefetch(array, index):
+    def prefetch(array: np.ndarray, index: int | tuple[int, ...]) -> None:
         """Ask for the cache line of ``array[index]`` ahead of its use: nothing to do in Python."""

@@ -16,6 +16,8 @@ for. Without numba the kernels are called with the arrays themselves and no pack
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Sequence
+
 import numpy as np
 
 from ._jit import HAVE_NUMBA
@@ -24,7 +26,7 @@ from ._jit import HAVE_NUMBA
 SLOT = 4
 
 
-def pack_arrays(arrays, extra_slots: int = 0) -> np.ndarray:
+def pack_arrays(arrays: Sequence[np.ndarray], extra_slots: int = 0) -> np.ndarray:
     """The addresses and shapes of ``arrays`` (C-contiguous, at most three dimensions) as one
     int64 array, slot ``k`` (entries ``4k .. 4k + 3``) for ``arrays[k]``, followed by
     ``extra_slots`` empty slots (for :func:`set_slots`)."""
@@ -33,7 +35,7 @@ def pack_arrays(arrays, extra_slots: int = 0) -> np.ndarray:
     return out
 
 
-def set_slots(h: np.ndarray, first: int, arrays) -> None:
+def set_slots(h: np.ndarray, first: int, arrays: Iterable[np.ndarray]) -> None:
     """Point slots ``first, first + 1, ...`` of pack ``h`` at ``arrays``."""
     for k, a in enumerate(arrays, start=first):
         if not (isinstance(a, np.ndarray) and a.flags.c_contiguous and 1 <= a.ndim < SLOT):

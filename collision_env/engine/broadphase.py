@@ -38,7 +38,15 @@ CHEAP_CELLS_PER_BALL = 4
 CELL_MARGIN = 1.0 + 1e-6
 
 
-def grid_geometry(bounds, positions, radii, use_grid, reach=1.0, balls_per_cell=1.0, cells_per_ball=1):
+def grid_geometry(
+    bounds: tuple[float, float, float, float] | None,
+    positions: np.ndarray,
+    radii: np.ndarray,
+    use_grid: np.ndarray,
+    reach: float = 1.0,
+    balls_per_cell: float = 1.0,
+    cells_per_ball: float = 1,
+) -> tuple[np.ndarray, np.ndarray]:
     """Per-scene grid ``(x0, y0, hx, hy)`` and ``(nx, ny)`` for ``(B, N, 2)`` positions and
     ``(B, N)`` radii; scenes with ``use_grid`` False get a single cell. The cells are at least
     ``reach * CELL_MARGIN`` largest diameters wide, hold about ``balls_per_cell`` balls each, and

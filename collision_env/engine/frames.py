@@ -14,6 +14,8 @@ once, not again inside a loop of its own.
 
 from __future__ import annotations
 
+from typing import Any
+
 from ._jit import njit
 from .layout import B_VX, B_X, FRAME_FIRST, FRAME_LAST, FRAME_ROWS, FRAME_STEPPED, FRAME_STOPPED_AT
 from .state import RUN_FRAMES, START_NEXT, START_STEP, unpack_frames, unpack_state
@@ -69,7 +71,7 @@ def _take_frame(f, rows, state, out):
     return True
 
 
-def frames_kernel(step, label: str, frames_slot: int):
+def frames_kernel(step: Any, label: str, frames_slot: int) -> Any:
     """A mode's stepping kernel, ``kernel(h, dt, start)``, from its step (an inlined function of
     the same arguments, see :mod:`~collision_env.engine.state` for ``start``): one step, whose
     return value it returns, or with ``start = RUN_FRAMES`` forward steps of ``dt`` for the frames

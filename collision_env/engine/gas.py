@@ -45,6 +45,7 @@ class Gas(NamedTuple):
     @property
     def area(self) -> float:
         """The box's or cell's area."""
+        assert self.scene.bounds is not None  # (a gas is always in a box or cell)
         x0, y0, x1, y1 = self.scene.bounds
         return (x1 - x0) * (y1 - y0)
 

@@ -10,12 +10,11 @@ changes.
 from __future__ import annotations
 
 import copy
-import functools
 import inspect
 import numbers
 import warnings
-from collections.abc import Mapping
-from typing import Any, NamedTuple
+from collections.abc import Mapping, Sequence
+from typing import Any, NamedTuple, cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -185,14 +184,14 @@ class BatchSimulator:
     _single = False
 
     def __new__(cls, *args: Any, **kwargs: Any) -> BatchSimulator:
-        check_keywords(kwargs, _keywords(cls))  # before __init__, whose TypeError names no close match
+        check_keywords(kwargs, _BATCH_KEYWORDS)  # before __init__, whose TypeError names no close match
         return super().__new__(cls)
 
     def __init__(
         self,
         scene: Scene,
-        positions: ArrayLike,
-        velocities: ArrayLike,
+        positions: ArrayLike | Sequence[ArrayLike],
+        velocities: ArrayLike | Sequence[ArrayLike],
         masses: ArrayLike,
         radii: ArrayLike | str | None = None,
         *,
@@ -224,7 +223,7 @@ class BatchSimulator:
         self._collapse_floor = float(collapse_floor)
 
         try:
-            shape = np.shape(positions)
+            shape = np.shape(cast(ArrayLike, positions))  # (numpy's ArrayLike leaves out lists of arrays)
         except ValueError:  # numpy refuses ragged nesting
             shape = None
         if shape is None or len(shape) != 3 or shape[-1] != 2:
@@ -309,7 +308,7 @@ class BatchSimulator:
         if rows is None:
             rows = self._spec.impact_rows(self.scene, self._n, self._uses_grid())
         self._imp = np.empty(rows, dtype=IMPACT_DTYPE)
-        self._imp_bytes = memoryview(self._imp.view(np.uint8))
+        self._imp_bytes = self._imp.view(np.uint8).data
         counts = getattr(self, "_n_imp", None)  # (kept when the buffer grows in the middle of a step)
         self._n_imp = np.zeros(3, dtype=np.int64)  # rows filled, scenes that reached the cap, stalled
         if counts is not None:
@@ -456,7 +455,7 @@ class BatchSimulator:
         return Frames(times, positions, velocities, impacts)
 
     @staticmethod
-    def _frame_rows(positions, velocities):
+    def _frame_rows(positions: np.ndarray, velocities: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(F, B, N, 2) frames as the kernels record them: (F, B * N, 2) views."""
         f, b, n, _ = positions.shape
         return positions.reshape(f, b * n, 2), velocities.reshape(f, b * n, 2)
@@ -611,7 +610,7 @@ class BatchSimulator:
         return (self._mass[..., None] * self._vel).sum(1)
 
     # ------------------------------------------------------------------ changing the state
-    def nudge(self, dv: ArrayLike, check: bool = True) -> None:
+    def nudge(self, dv: ArrayLike | Sequence[ArrayLike], check: bool = True) -> None:
         """Change every ball's velocity by ``dv`` (``(B, N, 2)``), as an impulse ``m dv``.
 
         A member of a stuck cluster passes the impulse to the whole cluster (linear and angular).
@@ -627,8 +626,8 @@ class BatchSimulator:
     def set_scenes(
         self,
         index: ArrayLike,
-        positions: ArrayLike,
-        velocities: ArrayLike,
+        positions: ArrayLike | Sequence[ArrayLike],
+        velocities: ArrayLike | Sequence[ArrayLike],
         masses: ArrayLike | None = None,
         radii: ArrayLike | str | None = None,
         time: ArrayLike = 0.0,
@@ -641,7 +640,7 @@ class BatchSimulator:
         """
         time = real_number(time, "time")
         check_seconds(time, "time")
-        idx = np.arange(self._n_scenes)[index]
+        idx = np.arange(self._n_scenes)[cast(Any, index)]  # (indices or a mask: numpy's indexing decides)
         idx = np.atleast_1d(idx)
         if masses is None:
             masses = self._mass[idx]
@@ -778,6 +777,10 @@ class BatchSimulator:
         return self.copy()
 
 
+#: The keyword arguments BatchSimulator takes (a misspelled one is named with the closest of them).
+_BATCH_KEYWORDS = tuple(inspect.signature(BatchSimulator.__init__).parameters)[1:]
+
+
 class Simulator:
     """One scene: the engine's public surface for a single simulation.
 
@@ -804,11 +807,13 @@ class Simulator:
         if shape is None or len(shape) != 2:
             got = "a ragged sequence" if shape is None else shape
             raise ValueError(f"positions: expected shape (N, 2), got {got}")
-        check_keywords(options, _keywords(BatchSimulator))
+        check_keywords(options, _BATCH_KEYWORDS)
         # a batch of one whose errors give shapes as this simulator takes them
-        self._batch = BatchSimulator.__new__(BatchSimulator)
+        self._batch = object.__new__(BatchSimulator)
         self._batch._single = True
-        self._batch.__init__(scene, [positions], [velocities], masses, radii, mode=mode, substeps=substeps, **options)
+        BatchSimulator.__init__(
+            self._batch, scene, [positions], [velocities], masses, radii, mode=mode, substeps=substeps, **options
+        )
 
     @property
     def batch(self) -> BatchSimulator:
@@ -887,12 +892,6 @@ class Simulator:
         return new
 
     __copy__ = copy
-
-
-@functools.cache
-def _keywords(cls: type) -> tuple[str, ...]:
-    """The keyword arguments ``cls.__init__`` takes."""
-    return tuple(inspect.signature(cls.__init__).parameters)[1:]
 
 
 def _snapshot(array: np.ndarray) -> np.ndarray:

@@ -22,6 +22,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
+from numpy.typing import DTypeLike
 
 from ._jit import HAVE_NUMBA, njit
 from .argpack import pack_arrays, set_slots
@@ -159,7 +160,7 @@ def physics(fparams, iparams):
     )
 
 
-def aligned_zeros(shape, dtype, align=64) -> np.ndarray:
+def aligned_zeros(shape: int | tuple[int, ...], dtype: DTypeLike, align: int = 64) -> np.ndarray:
     """Zeros whose rows start on ``align``-byte boundaries: a 64-byte calendar record or ball state
     row is then one cache line (numpy itself aligns to 16 bytes)."""
     dtype = np.dtype(dtype)
@@ -169,7 +170,7 @@ def aligned_zeros(shape, dtype, align=64) -> np.ndarray:
     return buffer[start : start + size].view(dtype).reshape(shape)
 
 
-def aligned_copy(array: np.ndarray, align=64) -> np.ndarray:
+def aligned_copy(array: np.ndarray, align: int = 64) -> np.ndarray:
     """A copy of ``array`` in :func:`aligned_zeros` memory."""
     out = aligned_zeros(array.shape, array.dtype, align)
     out[...] = array
@@ -189,7 +190,7 @@ def pack(*bundles: NamedTuple, frames: bool = False) -> np.ndarray | tuple:
 def with_frames(h: np.ndarray | tuple, slot: int, frames: FramesOut) -> np.ndarray | tuple:
     """Pack ``h`` (made with room for frames) with ``frames`` at ``slot``; without numba, the
     tuple of bundles with ``frames`` last."""
-    if not HAVE_NUMBA:
+    if isinstance(h, tuple):  # (without numba)
         return (*h, frames)
     set_slots(h, slot, frames)
     return h
@@ -274,22 +275,22 @@ if HAVE_NUMBA:
 
 else:
 
-    def unpack_state(h):
+    def unpack_state(h: tuple) -> State:
         """The :class:`State` of ``h`` (the tuple of bundles)."""
         return h[0]
 
-    def unpack_calendar(h):
+    def unpack_calendar(h: tuple) -> Calendar:
         """The :class:`Calendar` of an exact-mode ``h``."""
         return h[1]
 
-    def unpack_exact_scratch(h):
+    def unpack_exact_scratch(h: tuple) -> ExactScratch:
         """The :class:`ExactScratch` of an exact-mode ``h``."""
         return h[2]
 
-    def unpack_substep_scratch(h):
+    def unpack_substep_scratch(h: tuple) -> SubstepScratch:
         """The :class:`SubstepScratch` of a cheap-mode ``h``."""
         return h[1]
 
-    def unpack_frames(h, s):
+    def unpack_frames(h: tuple, s: int) -> FramesOut:
         """The :class:`FramesOut` of ``h`` (its last bundle)."""
         return h[-1]

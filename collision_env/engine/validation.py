@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numbers
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -30,12 +31,12 @@ MAX_MAGNITUDE = 1e150
 MIN_RADIUS_ULPS = 2.0**16
 
 
-def is_real(x) -> bool:
+def is_real(x: object) -> bool:
     """A real number that is not a boolean (Python or numpy scalar types alike)."""
     return isinstance(x, numbers.Real) and not isinstance(x, (bool, np.bool_))
 
 
-def real_number(value, field: str) -> float:
+def real_number(value: Any, field: str) -> float:
     """``value`` as a float: a real number (numpy scalar types included), not a boolean or a string."""
     if isinstance(value, float):  # the common case (np.float64 too), at the cost of one test
         return value
@@ -48,7 +49,7 @@ def real_number(value, field: str) -> float:
     return float(value)
 
 
-def positive_integer(value, field: str) -> int:
+def positive_integer(value: Any, field: str) -> int:
     """``value`` as an int: a whole number of at least 1 (not a boolean)."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral) or value < 1:
         raise ValueError(f"{field}: must be a positive integer, got {value!r}")
@@ -61,7 +62,7 @@ def check_seconds(value: float, field: str) -> None:
         raise ValueError(f"{field}: must be finite and at most {MAX_MAGNITUDE:g} s, got {value}")
 
 
-def real_array(value, shapes: list, field: str, where: Callable, label: Labels | None = None) -> np.ndarray:
+def real_array(value: Any, shapes: list, field: str, where: Callable, label: Labels | None = None) -> np.ndarray:
     """A float64 copy of ``value``: real numbers (no booleans, strings or complex numbers) in one of
     ``shapes``, the last of them the batched one. ``where(index)`` names the ball of an element, and
     ``label`` shows shapes (for the error message)."""
@@ -96,7 +97,7 @@ class Labels:
     """How errors name a ball (``"scene s, ball i: "`` in a batch, ``"ball i: "`` in a batch of one)
     and shapes (without the batch axis for a ``single`` simulator, which has none)."""
 
-    def __init__(self, n_scenes: int, single: bool = False):
+    def __init__(self, n_scenes: int, single: bool = False) -> None:
         self.n_scenes = n_scenes
         self.single = single
 
@@ -109,7 +110,9 @@ class Labels:
         return f"{where}ball {ball}: " if ball is not None else (f"scene {sc}: " if self.n_scenes > 1 else "")
 
 
-def checked_balls(scene: Scene, label: Labels, scenes, n: int, positions, velocities, masses, radii) -> tuple:
+def checked_balls(
+    scene: Scene, label: Labels, scenes: np.ndarray, n: int, positions: Any, velocities: Any, masses: Any, radii: Any
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Validate and return float64 copies ``(pos, vel, mass, radius)`` of the balls of ``scenes``
     (indices into the batch), ``n`` balls each (raises ValueError)."""
     k = len(scenes)
@@ -219,7 +222,7 @@ def check_reach(pos: np.ndarray, vel: np.ndarray, dt: float, label: Labels) -> N
         )
 
 
-def checked_nudge(dv, scene: Scene, vel, mass, label: Labels) -> np.ndarray:
+def checked_nudge(dv: Any, scene: Scene, vel: np.ndarray, mass: np.ndarray, label: Labels) -> np.ndarray:
     """``dv`` as a float64 ``(B, N, 2)`` velocity change: finite, 0 along y in 1D, and giving speeds
     that stay representable (bounded through the clusters' spin by the largest change of any of
     their members: a rigid impulse moves no point faster than that)."""

@@ -14,8 +14,9 @@ import dataclasses
 import difflib
 import inspect
 import math
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -138,7 +139,7 @@ class TaskConfig:
     n_balls: int = 1
     mass_range: tuple = (1.0, 1.0)
     others_mass_range: tuple | None = None
-    radius: object = "mass"
+    radius: str | float = "mass"
     layout: str = "random"
     speed_range: tuple = (0.3, 0.8)
     others_speed_range: tuple = (0.0, 0.0)
@@ -174,15 +175,17 @@ class TaskConfig:
         check_keywords(kwargs, field_names())  # before the generated __init__, which names no close match
         return super().__new__(cls)
 
-    def __post_init__(self):  # noqa: C901 - one check per field, in order
+    def __post_init__(self):  # one check per field, in order
         s = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
         if self.dimension not in (1, 2) or isinstance(self.dimension, bool):
             raise ValueError(f"dimension: must be 1 or 2, got {self.dimension!r}")
         s("dimension", int(self.dimension))
-        if self.bounds is None:
-            s("bounds", PLAY_AREA_1D if self.dimension == 1 else PLAY_AREA_2D)
+        bounds = self.bounds
+        if bounds is None:
+            bounds = PLAY_AREA_1D if self.dimension == 1 else PLAY_AREA_2D
+            s("bounds", bounds)
         try:
-            b = tuple(float(v) for v in self.bounds)
+            b = tuple(float(v) for v in bounds)
         except (TypeError, ValueError):
             raise ValueError(f"bounds: expected (xmin, ymin, xmax, ymax), got {self.bounds!r}") from None
         if len(b) != 4 or not all(math.isfinite(v) for v in b) or not (b[0] < b[2] and b[1] < b[3]):
@@ -200,10 +203,11 @@ class TaskConfig:
         s("mass_range", _pair("mass_range", self.mass_range))
         if self.mass_range[0] <= 0:
             raise ValueError(f"mass_range: masses must be > 0, got {self.mass_range!r}")
-        if self.others_mass_range is None:
-            s("others_mass_range", self.mass_range)
-        s("others_mass_range", _pair("others_mass_range", self.others_mass_range))
-        if self.others_mass_range[0] <= 0:
+        others = _pair(
+            "others_mass_range", self.mass_range if self.others_mass_range is None else self.others_mass_range
+        )
+        s("others_mass_range", others)
+        if others[0] <= 0:
             raise ValueError(f"others_mass_range: masses must be > 0, got {self.others_mass_range!r}")
         if isinstance(self.radius, str):
             if self.radius not in RADIUS_RULES:
@@ -277,7 +281,7 @@ class TaskConfig:
         s("max_events", _number("max_events", self.max_events, low=1, integer=True))
         s("n_steps", max(1, int(round(self.time_limit / self.dt))))
         # geometric feasibility: every ball must fit, and the balls must be placeable
-        extremes = np.array([*self.mass_range, *self.others_mass_range])
+        extremes = np.array([*self.mass_range, *others])
         r_big = float(self.radius_of(extremes).max())
         if 2 * r_big >= min(b[2] - b[0], b[3] - b[1]):
             raise ValueError(f"radius: a ball of radius {r_big:.4g} m does not fit in bounds {b}")
@@ -346,7 +350,7 @@ class TaskConfig:
             mask[:] = True
         return mask
 
-    def replace(self, **changes) -> TaskConfig:
+    def replace(self, **changes: Any) -> TaskConfig:
         return dataclasses.replace(self, **changes)
 
 
@@ -361,7 +365,7 @@ def field_names() -> tuple[str, ...]:
     return tuple(f.name for f in dataclasses.fields(TaskConfig) if f.init)
 
 
-def keywords_of(*functions) -> tuple[str, ...]:
+def keywords_of(*functions: Callable[..., Any]) -> tuple[str, ...]:
     """The named parameters of ``functions`` (an env's ``__init__``, ``gym.make``): what ``also`` offers."""
     kinds = (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)
     return tuple(
@@ -372,7 +376,7 @@ def keywords_of(*functions) -> tuple[str, ...]:
     )
 
 
-def make_config(preset: str | None = "one_ball", *, also: Iterable[str] = (), **overrides) -> TaskConfig:
+def make_config(preset: str | None = "one_ball", *, also: Iterable[str] = (), **overrides: Any) -> TaskConfig:
     """The preset's :class:`TaskConfig` with ``overrides`` applied (``preset=None``: the defaults).
 
     An unknown preset is a ``ValueError``; an unknown keyword an

@@ -11,8 +11,10 @@ nudges and the engine's impact records into hits, reward and observations (the k
 from __future__ import annotations
 
 import warnings
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import DTypeLike
 
 from collision_env.engine.modes import MODES
 from collision_env.engine.scene import WALL_NAMES
@@ -34,6 +36,9 @@ from collision_env.envs.task.layout import (
 from collision_env.envs.task.nudge import nudge_kernel
 from collision_env.envs.task.predict import predict_kernel
 
+if TYPE_CHECKING:
+    from collision_env.engine import BatchSimulator
+
 
 class Impacts:
     """The impacts of one step as the engine reported them: a read-only view of its record array.
@@ -49,7 +54,7 @@ class Impacts:
 
     __slots__ = ("records",)
 
-    def __init__(self, records: np.ndarray):
+    def __init__(self, records: np.ndarray) -> None:
         self.records = records
 
     def __len__(self) -> int:
@@ -67,7 +72,7 @@ class Impacts:
         a, b = self.records, other.records
         return a.dtype == b.dtype and a.shape == b.shape and bool(np.all(a == b))
 
-    __hash__ = None
+    # (unhashable: a class that defines __eq__ and not __hash__ gets __hash__ = None)
 
     @property
     def point(self) -> np.ndarray:
@@ -86,9 +91,11 @@ class Impacts:
         """One dict per impact: time, ball, other (None for a wall), wall (name or None), point, speed."""
         from collision_env.engine import WALL_NAMES
 
+        names = self.records.dtype.names
+        assert names is not None  # (a structured array)
         out = []
         for r in self.records.tolist():
-            rec = dict(zip(self.records.dtype.names, r, strict=True))
+            rec = dict(zip(names, r, strict=True))
             out.append(
                 {
                     "time": rec["time"],
@@ -115,7 +122,15 @@ class Episodes:
 
     __slots__ = ("positions", "velocities", "masses", "radii", "t_wall", "t_geo")
 
-    def __init__(self, positions, velocities, masses, radii, t_wall, t_geo):
+    def __init__(
+        self,
+        positions: np.ndarray,
+        velocities: np.ndarray,
+        masses: np.ndarray,
+        radii: np.ndarray,
+        t_wall: np.ndarray,
+        t_geo: np.ndarray,
+    ) -> None:
         self.positions = positions
         self.velocities = velocities
         self.masses = masses
@@ -124,7 +139,7 @@ class Episodes:
         self.t_geo = t_geo
 
 
-def packed(columns: tuple, dtype, **values) -> np.ndarray:
+def packed(columns: Any, dtype: DTypeLike, **values: float) -> np.ndarray:
     """A vector laid out as ``columns`` (a ``task.layout`` layout) with every field given by name."""
     missing = sorted(set(columns._fields) - set(values))
     unknown = sorted(set(values) - set(columns._fields))
@@ -152,12 +167,13 @@ class EpisodeSampler:
     the vector env and a single env seeded alike therefore draw the same episodes.
     """
 
-    def __init__(self, cfg: TaskConfig):
+    def __init__(self, cfg: TaskConfig) -> None:
         self.cfg = cfg
         n, k = cfg.n_balls, cfg.n_targets
         self.block = block_size(n, k, PLACEMENT_TRIES)
         self.ctrl_mask = np.zeros(n, dtype=bool)
         self.ctrl_mask[list(cfg.controlled)] = True
+        assert cfg.bounds is not None and cfg.target_walls is not None  # (None only as arguments of TaskConfig)
         self.walls = np.array([WALL_NAMES.index(w) for w in cfg.target_walls], dtype=np.int64)
         xmin, ymin, xmax, ymax = cfg.bounds
         (speed_low, speed_high), (others_low, others_high) = cfg.speed_range, cfg.others_speed_range
@@ -186,9 +202,10 @@ class EpisodeSampler:
             tries=PLACEMENT_TRIES,
         )
 
-    def _build(self, uniforms: np.ndarray) -> tuple:
+    def _build(self, uniforms: np.ndarray) -> tuple[Episodes, np.ndarray]:
         cfg = self.cfg
         r, n, k = uniforms.shape[0], cfg.n_balls, cfg.n_targets
+        assert cfg.others_mass_range is not None  # (None only as an argument of TaskConfig)
         lo = np.where(self.ctrl_mask, cfg.mass_range[0], cfg.others_mass_range[0])
         hi = np.where(self.ctrl_mask, cfg.mass_range[1], cfg.others_mass_range[1])
         masses = lo + (hi - lo) * uniforms[:, :n]
@@ -216,8 +233,8 @@ class EpisodeSampler:
 
     def sample(self, rngs: list) -> Episodes:
         uniforms = np.empty((len(rngs), self.block))
-        for row, rng in enumerate(rngs):
-            uniforms[row] = rng.random(self.block)
+        for i, rng in enumerate(rngs):
+            uniforms[i] = rng.random(self.block)
         eps, ok = self._build(uniforms)
         for row in np.flatnonzero(~ok):  # rare: draw fresh blocks for the rows that did not fit
             for _ in range(MAX_ATTEMPTS):
@@ -253,7 +270,7 @@ class TaskCore:
     engine's own. The named properties below are views.
     """
 
-    def __init__(self, cfg: TaskConfig, num_scenes: int):
+    def __init__(self, cfg: TaskConfig, num_scenes: int) -> None:
         from collision_env.engine import IMPACT_DTYPE, BatchSimulator, Scene
 
         self.cfg = cfg
@@ -266,6 +283,7 @@ class TaskCore:
             inelastic=cfg.inelastic,
             ball_collisions=cfg.ball_collisions,
         )
+        assert cfg.bounds is not None  # (None only as an argument of TaskConfig)
         xmin, ymin, xmax, ymax = cfg.bounds
         params = packed(
             PARAMS,
@@ -337,7 +355,7 @@ class TaskCore:
         # ahead at every observation (scratch: it holds no state of the task between calls). The cheap
         # modes keep their sub-step length: the look-ahead takes as many sub-steps as the control steps
         # it spans would.
-        self.ahead = None
+        self.ahead: BatchSimulator | None = None
         if cfg.observe == "predicted" or switches[SWITCHES.aim_predicted]:
             ahead_substeps = cfg.substeps * max(1, round(cfg.lookahead / cfg.dt)) if MODES[cfg.mode].substeps else 1
             self.ahead = engine(ahead_substeps)
@@ -400,7 +418,7 @@ class TaskCore:
         self._write_episode(idx, eps)
 
     @staticmethod
-    def check_actions(actions, field: str = "action") -> None:
+    def check_actions(actions: Any, field: str = "action") -> None:
         """Raise ValueError unless ``actions`` holds real numbers: a complex, string or boolean action
         would otherwise be cast to float64 silently (its imaginary part dropped, ``"0.5"`` parsed,
         ``True`` read as 1). The envs call this on the action as given, before they convert it."""
@@ -436,19 +454,19 @@ class TaskCore:
         """
         task_kernel(self._pack, flags, imp, obs)
         if self.ahead is not None:
-            self._predict(flags, obs)
+            self._predict(self.ahead, flags, obs)
         return obs
 
-    def _predict(self, flags: np.ndarray, obs: np.ndarray) -> None:
+    def _predict(self, ahead: BatchSimulator, flags: np.ndarray, obs: np.ndarray) -> None:
         """Run a copy of the engine ``lookahead`` s ahead of every scene (no nudge): each ball's
         predicted next wall impact goes into the observation and/or the aiming potential
         (``task.predict.predict_kernel``)."""
         from collision_env.engine import EventCapWarning
 
-        self.ahead.load(self.batch)  # (its calendar too: nothing is predicted afresh)
+        ahead.load(self.batch)  # (its calendar too: nothing is predicted afresh)
         with warnings.catch_warnings():  # a capped look-ahead only predicts less far
             warnings.simplefilter("ignore", EventCapWarning)
-            imp = self.ahead.step(self.cfg.lookahead)
+            imp = ahead.step(self.cfg.lookahead)
         imp.flags.writeable = False
         predict_kernel(self._pack, flags, imp, obs)
 

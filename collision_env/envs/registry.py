@@ -77,8 +77,8 @@ class RegisteredEnv:
     """A registered id: its single and native vector env classes, and the task it runs (if a preset)."""
 
     env_id: str
-    single: type
-    vector: type
+    single: type[CollisionTargetEnv]
+    vector: type[CollisionTargetVectorEnv]
     bench_scene: str
     task: Task | None = field(default=None)
 
@@ -93,7 +93,13 @@ def _entry_point(cls: type) -> str:
     return f"{cls.__module__}:{cls.__qualname__}"
 
 
-def register_env(env_id: str, single: type, vector: type, bench_scene: str, task: Task | None = None) -> None:
+def register_env(
+    env_id: str,
+    single: type[CollisionTargetEnv],
+    vector: type[CollisionTargetVectorEnv],
+    bench_scene: str,
+    task: Task | None = None,
+) -> None:
     """Register ``env_id`` with Gymnasium (single and vector entry points) and in ``REGISTERED``."""
     steps = make_config(single.preset).n_steps
     if env_id not in _gym_registry:  # re-importing (e.g. importlib.reload) must not re-register

@@ -15,12 +15,17 @@ from __future__ import annotations
 import math
 import os
 import sys
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from collision_env.engine.scene import WALL_BOTTOM, WALL_LEFT, WALL_RIGHT
 from collision_env.envs.task.layout import TARGET_FAILED, TARGET_GEOMETRY, TARGET_HIT, TARGET_PENDING
 from collision_env.extras import require
+
+if TYPE_CHECKING:
+    from collision_env.envs._config import TaskConfig
+    from collision_env.envs._core import TaskCore
 
 #: Above this many balls, balls that are neither controlled nor scoring are drawn plain (a gas).
 CROWD = 16
@@ -50,7 +55,7 @@ def _pygame():
     os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
     require("render", "rendering")
     import pygame
-    import pygame.gfxdraw  # noqa: F401
+    import pygame.gfxdraw
 
     return pygame
 
@@ -72,8 +77,14 @@ class Renderer:
     """Draws scene ``b`` of a :class:`~collision_env.envs._core.TaskCore`."""
 
     def __init__(
-        self, cfg, trails: bool = False, ppm: float = 150.0, margin: int = 26, bar: int = 26, trail_length: int = 40
-    ):
+        self,
+        cfg: TaskConfig,
+        trails: bool = False,
+        ppm: float = 150.0,
+        margin: int = 26,
+        bar: int = 26,
+        trail_length: int = 40,
+    ) -> None:
         self.pg = _pygame()
         self.cfg = cfg
         self.trails = trails
@@ -81,12 +92,14 @@ class Renderer:
         self.ppm = ppm
         self.margin = margin
         self.bar = bar
-        xmin, ymin, xmax, ymax = cfg.bounds
+        assert cfg.bounds is not None  # (None only as an argument of TaskConfig)
+        self.bounds: tuple[float, float, float, float] = cfg.bounds
+        xmin, ymin, xmax, ymax = self.bounds
         self.width = int(round((xmax - xmin) * ppm)) + 2 * margin
         self.height = int(round((ymax - ymin) * ppm)) + 2 * margin + bar
         self.surf = self.pg.Surface((self.width, self.height))
-        self.window = None
-        self.clock = None
+        self.window: Any = None  # pygame's display surface and clock, once shown (pygame is imported lazily)
+        self.clock: Any = None
         self.start()
 
     # ------------------------------------------------------------------------------------- #
@@ -95,7 +108,7 @@ class Renderer:
         self._trail: list = []
         self._flashes: list = []
 
-    def record(self, core, b: int, imp: np.ndarray) -> None:
+    def record(self, core: TaskCore, b: int, imp: np.ndarray) -> None:
         """Remember this step's impacts of scene ``b`` (flashes) and the balls' positions (trails)."""
         if self.trails:
             self._trail.append(core.pos[b].copy())
@@ -108,16 +121,16 @@ class Renderer:
 
     # ------------------------------------------------------------------------------------- #
     def _px(self, x, y):
-        xmin, ymin, xmax, ymax = self.cfg.bounds
+        xmin, ymin, xmax, ymax = self.bounds
         return (self.margin + (x - xmin) * self.ppm, self.bar + self.margin + (ymax - y) * self.ppm)
 
     def to_world(self, px: float, py: float) -> tuple[float, float]:
         """The point (m) that the frame's pixel (``px``, ``py``) shows (the inverse of the drawing's mapping)."""
-        xmin, ymin, xmax, ymax = self.cfg.bounds
+        xmin, ymin, xmax, ymax = self.bounds
         return (xmin + (px - self.margin) / self.ppm, ymax - (py - self.bar - self.margin) / self.ppm)
 
     def _segment_px(self, wall, c, hw, out=5):
-        xmin, ymin, xmax, ymax = self.cfg.bounds
+        xmin, ymin, xmax, ymax = self.bounds
         if wall == WALL_LEFT:
             a, b_, d = self._px(xmin, c - hw), self._px(xmin, c + hw), (-out, 0)
         elif wall == WALL_RIGHT:
@@ -137,12 +150,12 @@ class Renderer:
                 return True
         return False
 
-    def draw(self, core, b: int) -> np.ndarray:
+    def draw(self, core: TaskCore, b: int) -> np.ndarray:
         pg = self.pg
         gfx = pg.gfxdraw
         surf = self.surf
         cfg = self.cfg
-        xmin, ymin, xmax, ymax = cfg.bounds
+        xmin, ymin, xmax, ymax = self.bounds
         now = float(core.time[b])
         surf.fill(BG)
         x0, y0 = self._px(xmin, ymax)

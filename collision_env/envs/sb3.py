@@ -14,7 +14,7 @@ per sub-env holding ``is_success``, ``TimeLimit.truncated`` and, when the episod
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, cast
 
 import gymnasium as gym
 import numpy as np
@@ -25,6 +25,7 @@ from collision_env.extras import require
 require("train", "collision_env.envs.sb3", modules=("stable_baselines3",))  # an optional extra: say how to get it
 
 from stable_baselines3.common.vec_env import VecEnv, VecMonitor  # noqa: E402
+from stable_baselines3.common.vec_env.base_vec_env import VecEnvIndices  # noqa: E402
 
 from collision_env.envs.vector import CollisionTargetVectorEnv  # noqa: E402
 
@@ -42,9 +43,9 @@ class CollisionSB3VecEnv(VecEnv):
         self,
         env_id: str | None = None,
         n_envs: int = 1,
-        venv: CollisionTargetVectorEnv | None = None,
+        venv: gym.vector.VectorEnv | None = None,
         **env_kwargs: Any,
-    ):
+    ) -> None:
         if venv is None:
             if env_id is None:
                 raise ValueError("give env_id (a registered id) or venv (a native vector env)")
@@ -65,7 +66,7 @@ class CollisionSB3VecEnv(VecEnv):
             )
         self.venv = venv
         super().__init__(venv.num_envs, venv.single_observation_space, venv.single_action_space)
-        self._actions = None
+        self._actions: np.ndarray | None = None
 
     # ------------------------------------------------------------------------------------- #
     def reset(self) -> np.ndarray:
@@ -75,7 +76,8 @@ class CollisionSB3VecEnv(VecEnv):
             if any(o != self._options[0] for o in self._options):
                 raise ValueError("per-sub-env reset options differ; the batched env takes one options dict")
             options = dict(self._options[0])
-        obs, info = self.venv.reset(seed=seeds, options=options)
+        # (one seed per sub-env, as CollisionTargetVectorEnv.reset takes; VectorEnv declares int | None)
+        obs, info = self.venv.reset(seed=cast(Any, seeds), options=options)
         self.reset_infos = self._split(info, np.ones(self.num_envs, dtype=bool))
         self._reset_seeds()
         self._reset_options()
@@ -120,25 +122,27 @@ class CollisionSB3VecEnv(VecEnv):
     # ------------------------------------------------------------------------------------- #
     def get_images(self) -> list[np.ndarray | None]:
         frames = self.venv.render()
-        return list(frames) if frames is not None else [None] * self.num_envs
+        return cast("list[np.ndarray | None]", list(frames)) if frames is not None else [None] * self.num_envs
 
-    def get_attr(self, attr_name: str, indices=None) -> list:
+    def get_attr(self, attr_name: str, indices: VecEnvIndices = None) -> list:
         value = getattr(self.venv, attr_name)
         return [value for _ in self._get_indices(indices)]
 
-    def set_attr(self, attr_name: str, value: Any, indices=None) -> None:
+    def set_attr(self, attr_name: str, value: Any, indices: VecEnvIndices = None) -> None:
         if indices is not None and len(list(self._get_indices(indices))) != self.num_envs:
             raise ValueError("set_attr: the batched env shares its attributes; set them for all sub-envs at once")
         setattr(self.venv, attr_name, value)
 
-    def env_method(self, method_name: str, *method_args, indices=None, **method_kwargs) -> list:
+    def env_method(
+        self, method_name: str, *method_args: Any, indices: VecEnvIndices = None, **method_kwargs: Any
+    ) -> list:
         result = getattr(self.venv, method_name)(*method_args, **method_kwargs)
         idx = list(self._get_indices(indices))
         if isinstance(result, tuple) and len(result) == self.num_envs:
             return [result[i] for i in idx]
         return [result for _ in idx]
 
-    def env_is_wrapped(self, wrapper_class, indices=None) -> list:
+    def env_is_wrapped(self, wrapper_class: type[gym.Wrapper], indices: VecEnvIndices = None) -> list[bool]:
         return [False for _ in self._get_indices(indices)]
 
 

@@ -29,9 +29,11 @@ from __future__ import annotations
 
 import copy
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from collision_env.engine.scene import WALL_BOTTOM, WALL_LEFT, WALL_RIGHT, WALL_TOP
 from collision_env.envs.task.layout import TARGET_GEOMETRY, TARGET_HIT, TARGET_PENDING
@@ -41,15 +43,26 @@ from collision_env.envs.task.nudge import capped_change
 #: control by :func:`as_env_action` when it is played).
 Plan = Callable[[int, object], np.ndarray]
 
+if TYPE_CHECKING:
+    import gymnasium as gym
 
-def on_target(core, b: int, k: int, wall: int, x: float, y: float, t: float) -> bool:
+    from collision_env.envs._core import TaskCore
+    from collision_env.envs.target_env import CollisionTargetEnv
+
+
+def _bare(env: gym.Env) -> CollisionTargetEnv:
+    """The task env under ``env``'s wrappers (or ``env`` itself)."""
+    return cast("CollisionTargetEnv", env.unwrapped)
+
+
+def on_target(core: TaskCore, b: int, k: int, wall: int, x: float, y: float, t: float) -> bool:
     """Whether an impact at wall code ``wall``, point (x, y), time t lands on target k of scene b."""
     c, hw, t_open, t_close = core.target_geo[b, k]
     s = y if wall in (WALL_LEFT, WALL_RIGHT) else x
     return core.t_wall[b, k] == wall and abs(s - c) <= hw and t_open <= t <= t_close
 
 
-def first_wall_impact(records: np.ndarray, ball: int | None = None):
+def first_wall_impact(records: np.ndarray, ball: int | None = None) -> np.void | None:
     for r in records:
         if r["wall"] >= 0 and (ball is None or r["ball"] == ball):
             return r
@@ -63,14 +76,14 @@ class ScriptedPolicy:
     :func:`as_env_action`, so one plan serves both controls.
     """
 
-    def __init__(self, env):
-        self.env = env.unwrapped
+    def __init__(self, env: gym.Env) -> None:
+        self.env = _bare(env)
 
-    def nudge(self, obs=None) -> np.ndarray:
+    def nudge(self, obs: np.ndarray | None = None) -> np.ndarray:
         """The nudge action for this step (one component per axis and controlled ball)."""
         raise NotImplementedError
 
-    def __call__(self, obs=None) -> np.ndarray:
+    def __call__(self, obs: np.ndarray | None = None) -> np.ndarray:
         return as_env_action(self.env, self.nudge(obs))
 
 
@@ -83,12 +96,12 @@ class AimingPolicy(ScriptedPolicy):
     step; it returns the action.
     """
 
-    def __init__(self, env, speed: float = 1.2, lookahead: float = 6.0, directions: int = 144):
+    def __init__(self, env: gym.Env, speed: float = 1.2, lookahead: float = 6.0, directions: int = 144) -> None:
         super().__init__(env)
         self.speed = speed
         self.lookahead = lookahead
         self.angles = np.linspace(-math.pi, math.pi, directions, endpoint=False)
-        self.want = {}
+        self.want: dict[int, np.ndarray | None] = {}
 
     def _pending(self) -> list:
         core, cfg = self.env.core, self.env.config
@@ -97,7 +110,7 @@ class AimingPolicy(ScriptedPolicy):
             return [k] if k < core.t_wall.shape[1] else []
         return np.flatnonzero(core.t_status[0] == TARGET_PENDING).tolist()
 
-    def predicts_hit(self, ball: int, dv: np.ndarray, targets) -> bool:
+    def predicts_hit(self, ball: int, dv: np.ndarray, targets: Iterable[int]) -> bool:
         """Does ``ball`` hit one of ``targets`` next if its velocity changes by ``dv`` now?"""
         core = self.env.core
         sim = core.batch.copy()
@@ -107,7 +120,7 @@ class AimingPolicy(ScriptedPolicy):
         r = first_wall_impact(sim.step(self.lookahead), ball=ball)
         return r is not None and any(on_target(core, 0, k, r["wall"], r["x"], r["y"], r["time"]) for k in targets)
 
-    def nudge(self, obs=None) -> np.ndarray:
+    def nudge(self, obs: np.ndarray | None = None) -> np.ndarray:
         core, cfg = self.env.core, self.env.config
         action = no_nudge(self.env)
         pending = self._pending()
@@ -143,7 +156,7 @@ class SteeringPolicy(AimingPolicy):
     (a copy of the engine run ``lookahead`` s ahead) is made per step.
     """
 
-    def nudge(self, obs=None) -> np.ndarray:
+    def nudge(self, obs: np.ndarray | None = None) -> np.ndarray:
         core, cfg = self.env.core, self.env.config
         action = no_nudge(self.env)
         pending = self._pending()
@@ -164,19 +177,19 @@ class SteeringPolicy(AimingPolicy):
 # --------------------------------------------------------------------------------------------- #
 
 
-def no_nudge(env) -> np.ndarray:
+def no_nudge(env: gym.Env) -> np.ndarray:
     """The nudge action that changes nothing."""
-    cfg = env.unwrapped.config
+    cfg = _bare(env).config
     return np.zeros(len(cfg.controlled) * cfg.dimension, np.float32)
 
 
-def towards(env, want, v) -> np.ndarray:
+def towards(env: gym.Env, want: ArrayLike, v: np.ndarray) -> np.ndarray:
     """One ball's nudge components that change velocity ``v`` towards ``want`` (m/s), each axis by at
     most ``max_dv``."""
-    return np.clip((np.asarray(want) - v) / env.unwrapped.config.max_dv, -1.0, 1.0).astype(np.float32)
+    return np.clip((np.asarray(want) - v) / _bare(env).config.max_dv, -1.0, 1.0).astype(np.float32)
 
 
-def as_env_action(env, nudge) -> np.ndarray:
+def as_env_action(env: gym.Env, nudge: ArrayLike) -> np.ndarray:
     """A nudge action (velocity changes over ``max_dv``, as every policy here plans them) in the
     form ``env``'s ``control`` reads, as a new float32 array: the nudge itself for "nudge"; for
     "velocity", per controlled ball the velocity the nudge leads to (over ``max_speed``, after the
@@ -188,8 +201,8 @@ def as_env_action(env, nudge) -> np.ndarray:
     is steered towards a velocity no longer than ``max_speed`` (a named velocity never is), and a
     nudge that turns a ball at the cap can change one axis by more than ``max_dv``, which one
     velocity step cannot."""
-    env = env.unwrapped
-    cfg = env.config
+    bare = _bare(env)
+    cfg = bare.config
     if cfg.control == "nudge":
         return np.array(nudge, np.float32)
     dim = cfg.dimension
@@ -197,7 +210,7 @@ def as_env_action(env, nudge) -> np.ndarray:
     out = np.empty((len(cfg.controlled), dim + 1), np.float32)
     max_dv, max_speed = float(cfg.max_dv), float(cfg.max_speed)
     for j, i in enumerate(cfg.controlled):
-        vx, vy = (float(x) for x in env.core.vel[0, i])
+        vx, vy = (float(x) for x in bare.core.vel[0, i])
         dy = float(a[j, 1]) * max_dv if dim == 2 else 0.0
         dx, dy = capped_change(vx, vy, float(a[j, 0]) * max_dv, dy, max_speed)  # as the env caps the nudge
         named = np.array([vx + dx, vy + dy][:dim]) / max_speed
@@ -207,21 +220,23 @@ def as_env_action(env, nudge) -> np.ndarray:
     return out.ravel()
 
 
-def push(direction, steps: int, delay: int = 0) -> Plan:
+def push(direction: ArrayLike, steps: int, delay: int = 0) -> Plan:
     """A plan: a full nudge along ``direction`` for ``steps`` steps after ``delay``, then nothing."""
     d = np.asarray(direction, np.float32)
     zero = np.zeros_like(d)
     return lambda t, env: d if delay <= t < delay + steps else zero
 
 
-def planning_copy(env):
+def planning_copy(env: CollisionTargetEnv) -> CollisionTargetEnv:
     """A copy of the (unwrapped) env to plan on: same task and state, no renderer, no render mode."""
     planner = copy.deepcopy(env)  # the env's __getstate__ leaves its renderer behind
     planner.render_mode = None
     return planner
 
 
-def shoot(env, plans, horizon: int, planner=None):
+def shoot(
+    env: CollisionTargetEnv, plans: list[Plan], horizon: int, planner: CollisionTargetEnv | None = None
+) -> tuple[Plan, int, np.ndarray] | tuple[None, None, None]:
     """The first plan whose predicted rollout hits a target within ``horizon`` steps.
 
     Each plan (of nudges, each converted by :func:`as_env_action`) runs on ``planner`` (default: a
@@ -247,7 +262,7 @@ def _target_point(cfg, wall: int, c: float):
     return {WALL_LEFT: (xmin, c), WALL_RIGHT: (xmax, c), WALL_BOTTOM: (c, ymin), WALL_TOP: (c, ymax)}[wall]
 
 
-def billiards_plans(env) -> list:
+def billiards_plans(env: CollisionTargetEnv) -> list[Plan]:
     """Ghost-ball shots: send the cue ball at the spot from which each object ball heads for each target."""
     core, cfg = env.core, env.config
     pos, r = core.pos[0], core.radii[0]
@@ -267,13 +282,13 @@ def billiards_plans(env) -> list:
     return plans
 
 
-def stuck(env) -> bool:
+def stuck(env: CollisionTargetEnv) -> bool:
     """Is ball 0 part of a cluster?"""
     core = env.core
     return bool((core.body[0] == core.body[0, 0]).sum() > 1)
 
 
-def cluster_plans(env) -> list:
+def cluster_plans(env: CollisionTargetEnv) -> list[Plan]:
     """Once stuck: push the cluster in one of 64 directions for 8, 20 or 40 steps."""
     if not stuck(env):
         return []
@@ -284,7 +299,7 @@ def cluster_plans(env) -> list:
     ]
 
 
-def ram(env) -> np.ndarray:
+def ram(env: CollisionTargetEnv) -> np.ndarray:
     """Steer ball 0 straight at ball 1 (to form a cluster)."""
     core = env.core
     d = core.pos[0, 1] - core.pos[0, 0]
@@ -292,7 +307,7 @@ def ram(env) -> np.ndarray:
     return towards(env, want, core.vel[0, 0])
 
 
-def line_plans(env) -> list:
+def line_plans(env: CollisionTargetEnv) -> list[Plan]:
     """Pushes of the first ball either way, of several lengths and delays."""
     return [push((s,), steps, delay) for delay in (0, 20, 40, 60, 90) for steps in (2, 6, 12) for s in (1.0, -1.0)]
 
@@ -305,18 +320,18 @@ class ShootingPolicy(ScriptedPolicy):
     on by a step: call it (or the policy) once per env step.
     """
 
-    def __init__(self, env, candidates: Callable, fallback: Callable | None = None, retry: int = 10):
+    def __init__(self, env: gym.Env, candidates: Callable, fallback: Callable | None = None, retry: int = 10) -> None:
         super().__init__(env)
         self.candidates = candidates
         self.fallback = fallback
         self.retry = retry
-        self.plan = None
+        self.plan: Plan | None = None
         self.t = 0
-        self.hit_step = None
+        self.hit_step: int | None = None
         self.wait = 0
         self.planner = planning_copy(self.env)
 
-    def nudge(self, obs=None) -> np.ndarray:
+    def nudge(self, obs: np.ndarray | None = None) -> np.ndarray:
         env = self.env
         if self.plan is None and self.wait <= 0:
             horizon = env.config.n_steps - int(env.core.steps[0])
@@ -333,18 +348,19 @@ class ShootingPolicy(ScriptedPolicy):
             return no_nudge(env)
         action = self.plan(self.t, env)
         self.t += 1
+        assert self.hit_step is not None  # (set with the plan)
         if self.t > self.hit_step:
             self.plan = None  # the predicted hit happens in this step: plan afresh next step
         return action
 
 
-def scripted_policy(env) -> ScriptedPolicy | None:
+def scripted_policy(env: gym.Env) -> ScriptedPolicy | None:
     """A scripted policy for the env's preset (``None`` when there is none): ``policy(obs) -> action``.
 
     ``env`` is a ``gym.make`` env or the bare env; the policy reads the state of the bare env. It
     plans nudges and hands them over in the form the env's ``control`` reads (:func:`as_env_action`).
     """
-    env = env.unwrapped
+    env = _bare(env)
     cfg = env.config
     if (
         cfg.dimension == 2

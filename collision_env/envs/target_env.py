@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import copy
-from typing import Any, SupportsFloat
+from typing import TYPE_CHECKING, Any, SupportsFloat
 
 import gymnasium as gym
 import numpy as np
@@ -14,6 +14,9 @@ from collision_env.engine import BatchSimulator
 from collision_env.envs._config import PRESETS, TaskConfig, keywords_of, make_config
 from collision_env.envs._core import Impacts, TaskCore
 from collision_env.envs.task.layout import ROW_RESET, ROW_STEPPED, SCENE_FLOATS, SCENE_INTS
+
+if TYPE_CHECKING:
+    from collision_env.envs.rendering import Renderer
 
 _CLASS_PRESET = "__class_preset__"
 
@@ -132,7 +135,7 @@ class CollisionTargetEnv(gym.Env):
 
     def __init__(
         self, preset: str | None = _CLASS_PRESET, render_mode: str | None = None, trails: bool = False, **overrides: Any
-    ):
+    ) -> None:
         if preset is _CLASS_PRESET:
             preset = type(self).preset
         self.config: TaskConfig = make_config(preset, also=keywords_of(type(self).__init__, gym.make), **overrides)
@@ -153,7 +156,7 @@ class CollisionTargetEnv(gym.Env):
         self._action = np.zeros((1, cfg.action_dim))
         self._dt = cfg.dt
         self._trails = bool(trails)
-        self._renderer = None
+        self._renderer: Renderer | None = None
 
     def _obs(self):
         return np.empty((1, self._core.obs_dim), dtype=np.float32)  # fresh on every call
@@ -235,13 +238,14 @@ class CollisionTargetEnv(gym.Env):
                 f'render_mode at initialization, e.g. gym.make("{env_id}", render_mode="rgb_array")'
             )
             return None
-        frame = self._get_renderer().draw(self._core, 0)
+        renderer = self._get_renderer()
+        frame = renderer.draw(self._core, 0)
         if self.render_mode == "human":
-            self._renderer.show(frame, self.metadata["render_fps"])
+            renderer.show(frame, self.metadata["render_fps"])
             return None
         return frame
 
-    def _get_renderer(self):
+    def _get_renderer(self) -> Renderer:
         if self._renderer is None:
             from collision_env.envs.rendering import Renderer
 

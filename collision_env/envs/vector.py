@@ -12,7 +12,7 @@ per-env ``Impacts``); ``Impacts.for_scene(i)`` splits it.
 from __future__ import annotations
 
 import copy
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import gymnasium as gym
 import numpy as np
@@ -26,6 +26,9 @@ from numpy.typing import ArrayLike
 from collision_env.envs._config import TaskConfig, keywords_of, make_config
 from collision_env.envs._core import Impacts, TaskCore
 from collision_env.envs.task.layout import ROW_OBSERVE, ROW_RESET, ROW_SKIP, ROW_STEPPED
+
+if TYPE_CHECKING:
+    from collision_env.envs.rendering import Renderer
 
 _CLASS_PRESET = "__class_preset__"
 _SCALAR_KEYS = ("event_cap", "nudge", "energy", "time", "targets_hit", "is_success")
@@ -47,7 +50,7 @@ class CollisionTargetVectorEnv(VectorEnv):
     metadata = {"render_modes": ["rgb_array"], "render_fps": 20, "autoreset_mode": AutoresetMode.NEXT_STEP}
     preset: str | None = "one_ball"
     # set before __init__ can fail: gymnasium < 1.3's VectorEnv.__del__ closes a half-made env
-    _renderers: list | None = None
+    _renderers: list[Renderer] | None = None
 
     def __init__(
         self,
@@ -58,7 +61,7 @@ class CollisionTargetVectorEnv(VectorEnv):
         preset: str | None = _CLASS_PRESET,
         trails: bool = False,
         **overrides: Any,
-    ):
+    ) -> None:
         if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
             raise ValueError(f"num_envs: must be a positive integer, got {num_envs!r}")
         if max_episode_steps is not None and (
@@ -102,6 +105,7 @@ class CollisionTargetVectorEnv(VectorEnv):
     # ------------------------------------------------------------------------------------- #
     def _seed_envs(self, seed, mask) -> None:
         n = self.num_envs
+        seeds: list[int | None]
         if seed is None:
             seeds = [None] * n
         elif isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
@@ -134,7 +138,7 @@ class CollisionTargetVectorEnv(VectorEnv):
         return info
 
     def reset(
-        self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None
+        self, *, seed: int | list[int | None] | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
         options = dict(options) if options else {}
         mask = options.pop("reset_mask", None)
@@ -200,7 +204,7 @@ class CollisionTargetVectorEnv(VectorEnv):
             self._autoreset = term | trunc
             info = self._info(energy, event_cap, nudge, success, n_hit, imp)
             if self._renderers is not None:
-                self._record(imp, resetting if any_reset else None)
+                self._record(self._renderers, imp, resetting if any_reset else None)
             return obs, reward, term, trunc, info
 
         # SAME_STEP: step everything, then reset the sub-envs that ended and report their last step
@@ -212,7 +216,7 @@ class CollisionTargetVectorEnv(VectorEnv):
             trunc |= core.steps >= cap_limit
         done = term | trunc
         if self._renderers is not None:
-            self._record(imp, None)
+            self._record(self._renderers, imp, None)
         if not done.any():
             return obs, reward, term, trunc, self._info(energy, event_cap, nudge, success, n_hit, imp)
         idx = np.flatnonzero(done)
@@ -253,8 +257,8 @@ class CollisionTargetVectorEnv(VectorEnv):
         return obs, reward, term, trunc, info
 
     # ------------------------------------------------------------------------------------- #
-    def _record(self, imp, skip) -> None:
-        for i, r in enumerate(self._renderers):
+    def _record(self, renderers: list[Renderer], imp: np.ndarray, skip: np.ndarray | None) -> None:
+        for i, r in enumerate(renderers):
             if skip is not None and skip[i]:
                 r.start()
             else:
@@ -266,7 +270,7 @@ class CollisionTargetVectorEnv(VectorEnv):
             return None
         return tuple(r.draw(self._core, i) for i, r in enumerate(self._get_renderers()))
 
-    def _get_renderers(self) -> list:
+    def _get_renderers(self) -> list[Renderer]:
         if self._renderers is None:
             from collision_env.envs.rendering import Renderer
 

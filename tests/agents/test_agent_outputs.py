@@ -13,9 +13,9 @@ import pytest
 pytest.importorskip("stable_baselines3")
 pytest.importorskip("yaml")
 
-from agents import curve, evaluate, train_ppo, train_rllib  # noqa: E402
-from agents.config import UsageError  # noqa: E402
-from collision_env.extras import MissingExtra  # noqa: E402
+from agents import curve, evaluate, train_ppo, train_rllib
+from agents.config import UsageError
+from collision_env.extras import MissingExtra
 
 ROOT = Path(__file__).resolve().parents[2]
 TINY = ["--timesteps", "2048", "--n-envs", "4", "--eval-freq", "0", "--save-freq", "0"]

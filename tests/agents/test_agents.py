@@ -12,9 +12,9 @@ import pytest
 pytest.importorskip("stable_baselines3")
 pytest.importorskip("yaml")
 
-import collision_env  # noqa: E402
-from agents import config, evaluate, study, timing, train_ppo  # noqa: E402
-from agents import main as main_job  # noqa: E402
+import collision_env
+from agents import config, evaluate, study, timing, train_ppo
+from agents import main as main_job
 
 ROOT = Path(__file__).resolve().parents[2]
 TINY = ["--timesteps", "2048", "--n-envs", "4", "--no-progress"]

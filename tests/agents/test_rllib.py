@@ -10,8 +10,8 @@ import pytest
 pytest.importorskip("ray.rllib")
 pytest.importorskip("yaml")
 
-from agents import evaluate, train_rllib  # noqa: E402
-from agents.config import load_yaml  # noqa: E402
+from agents import evaluate, train_rllib
+from agents.config import load_yaml
 
 ROOT = Path(__file__).resolve().parents[2]
 ENV_ID = "CollisionEnv/OneBallTarget-v0"

@@ -8,7 +8,7 @@ import pytest
 
 pytest.importorskip("stable_baselines3")
 
-from agents import config, evaluate, train_ppo  # noqa: E402
+from agents import config, evaluate, train_ppo
 
 
 @pytest.mark.study

@@ -6,10 +6,10 @@ os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 
-import gymnasium as gym  # noqa: E402
-import pytest  # noqa: E402
+import gymnasium as gym
+import pytest
 
-import collision_env  # noqa: E402
+import collision_env
 
 ENV_IDS = list(collision_env.ENV_IDS)
 PRESET_IDS = [i for i in ENV_IDS if not i.endswith("/Target-v0")]

@@ -11,6 +11,8 @@ To add a peer: a module here with one ``Runner`` subclass, and an entry in :data
 
 from __future__ import annotations
 
+from typing import Any
+
 from .base import Runner, collect
 from .billiards import BilliardsRunner
 from .pymunk import PymunkRunner
@@ -19,7 +21,7 @@ from .pymunk import PymunkRunner
 PEERS: dict[str, type[Runner]] = {"pymunk": PymunkRunner, "billiards": BilliardsRunner}
 
 
-def make_peer(name: str, **knobs) -> Runner | str:
+def make_peer(name: str, **knobs: Any) -> Runner | str:
     """Peer ``name`` at ``knobs``, or a string saying why it is not available."""
     try:
         return PEERS[name](**knobs)

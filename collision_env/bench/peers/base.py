@@ -8,6 +8,8 @@ chunks, which :func:`collect` converts).
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 import numpy as np
 
 from ..metrics import IMPACTS, as_impacts
@@ -20,10 +22,14 @@ class Runner:
     """Common interface: ``start(case)``, ``step(dt, record)`` -> impacts or None, ``state()``."""
 
     engine = "?"
-    family = "?"  # what a curve in the plots is: "naive", "posteriori k=4", "exact", "pymunk", "billiards"
     mode: str | None = None
     substeps = 1
     iterations: int | None = None
+
+    @property
+    def family(self) -> str:
+        """What a curve in the plots is: "naive", "posteriori k=4", "exact", "pymunk", "billiards"."""
+        return "?"
 
     @property
     def label(self) -> str:
@@ -55,7 +61,7 @@ class Runner:
         return {}
 
 
-def collect(chunks) -> np.ndarray:
+def collect(chunks: Iterable[np.ndarray | None]) -> np.ndarray:
     """Impacts returned by a runner's steps, as one :data:`~collision_env.bench.metrics.IMPACTS` array."""
-    chunks = [c for c in chunks if c is not None and len(c)]
-    return as_impacts(np.concatenate(chunks)) if chunks else _EMPTY.copy()
+    kept = [c for c in chunks if c is not None and len(c)]
+    return as_impacts(np.concatenate(kept)) if kept else _EMPTY.copy()

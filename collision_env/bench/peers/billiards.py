@@ -26,7 +26,7 @@ class BilliardsRunner(Runner):
     engine = "billiards"
     family = "billiards"
 
-    def __init__(self):
+    def __init__(self) -> None:
         import billiards
 
         self._b = billiards

@@ -28,7 +28,9 @@ class PymunkRunner(Runner):
 
     engine = "pymunk"
 
-    def __init__(self, iterations: int = 10, substeps: int = 1, wall_radius: float = 0.05, slop_ratio: float = 0.01):
+    def __init__(
+        self, iterations: int = 10, substeps: int = 1, wall_radius: float = 0.05, slop_ratio: float = 0.01
+    ) -> None:
         import pymunk
 
         self._pymunk = pymunk
@@ -38,7 +40,7 @@ class PymunkRunner(Runner):
         self.slop_ratio = slop_ratio
 
     @property
-    def family(self):
+    def family(self) -> str:
         return f"pymunk it={self.iterations}" + (f" k={self.substeps}" if self.substeps > 1 else "")
 
     def unsupported(self, case: Case) -> str | None:
@@ -88,7 +90,7 @@ class PymunkRunner(Runner):
         self._space = space
         self._time = 0.0
         self._now = 0.0
-        self._log = []
+        self._log: list[tuple] = []
         self._count = 0
         self._recording = False
         space.on_collision(begin=self._begin)

@@ -33,7 +33,8 @@ scene never compiles it.
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from collections.abc import Callable
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -150,7 +151,7 @@ BUCKETS_PER_BALL = 0.5
 EVENTS_PER_BUCKET = 16
 
 
-def bucket_count(n):
+def bucket_count(n: int) -> int:
     """Buckets in the ring of a scene of ``n`` balls (0: every event in the heap)."""
     return int(BUCKETS_PER_BALL * n) if n >= QUEUE_MIN_BALLS else 0
 
@@ -173,7 +174,7 @@ ARITY = 8
 HEAP_OFFSET = ARITY - 1
 
 
-def heap_rows(n):
+def heap_rows(n: int) -> int:
     """Rows of a scene's heap array for ``n`` balls: the offset, then whole cache lines."""
     return -(-(n + HEAP_OFFSET) // ARITY) * ARITY
 
@@ -658,11 +659,11 @@ class QueueOps(NamedTuple):
     afresh, move an event after its time changed, the ball whose event comes first, rebase its
     times at a step's end, and a step of the walk ahead of the next bucket."""
 
-    build: object
-    schedule: object
-    first: object
-    rebase: object
-    walk: object
+    build: Callable[..., Any]
+    schedule: Callable[..., Any]
+    first: Callable[..., Any]
+    rebase: Callable[..., Any]
+    walk: Callable[..., Any]
 
 
 #: A heap of every ball (scenes of fewer than :data:`QUEUE_MIN_BALLS` balls), and Paul's two-level

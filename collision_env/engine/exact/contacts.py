@@ -33,7 +33,7 @@ from ..physics.walls import wall_contact, wall_count, wall_normal, wall_point
 MAX_SWEEPS = 1000
 
 
-def contact_capacity(n):
+def contact_capacity(n: int) -> int:
     """Most contacts a contact group of ``n`` balls can have: the contact graph of disks that do not
     overlap is planar (at most 3n - 6 edges), and a ball touches at most two walls (four in a box
     no wider than the ball)."""

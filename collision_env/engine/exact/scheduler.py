@@ -51,7 +51,7 @@ Reverse steps are run forward on negated velocities with restitution 1/e (the ca
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -636,7 +636,7 @@ def _step(kind: Kind):
 _KERNELS: dict = {}
 
 
-def step_kernel(kind: Kind):
+def step_kernel(kind: Kind) -> Any:
     """The compiled stepping kernel for scenes of ``kind`` (built on first use):
     ``kernel(h, dt_abs, start)`` on a pack of a ``State``, a ``Calendar``, an ``ExactScratch`` and
     room for frames (see :func:`~collision_env.engine.frames.frames_kernel`)."""

@@ -26,7 +26,7 @@ class CellLists(NamedTuple):
     ny: int  #: cells along y
 
 
-def scratch_size(n):
+def scratch_size(n: int) -> int:
     """Length of the int scratch of the cell lists for ``n`` balls (at most
     ``broadphase.CHEAP_CELLS_PER_BALL`` cells per ball)."""
     return (2 + 2 * CHEAP_CELLS_PER_BALL) * n

@@ -7,6 +7,8 @@ kernel is built (:func:`step_kernel`), so each mode compiles only its own.
 
 from __future__ import annotations
 
+from typing import Any
+
 from .._jit import njit
 from ..clock import finish_step
 from ..exact.grid import scene_geometry
@@ -93,7 +95,7 @@ def _step(resolve):
 _KERNELS: dict = {}
 
 
-def step_kernel(mode: str):
+def step_kernel(mode: str) -> Any:
     """The compiled stepping kernel of cheap ``mode`` ("naive" or "posteriori", built on first
     use): ``kernel(h, dt_abs, start)`` on a pack of a ``State``, a ``SubstepScratch`` and room for
     frames (see :func:`~collision_env.engine.frames.frames_kernel`)."""

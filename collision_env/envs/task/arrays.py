@@ -86,6 +86,6 @@ if HAVE_NUMBA:
 
 else:
 
-    def unpack(h):
+    def unpack(h: tuple) -> tuple[Engine, TaskState, TaskParams]:
         """The :class:`Engine`, :class:`TaskState` and :class:`TaskParams` of ``h`` (the tuple)."""
         return h

@@ -12,7 +12,7 @@ it is the number of columns. The meanings stay attached to the layout's class
 from __future__ import annotations
 
 from collections import namedtuple
-from typing import Any
+from typing import Any, cast
 
 from collision_env.engine.scene import WALL_NAMES
 
@@ -25,7 +25,7 @@ def layout(name: str, rows: tuple) -> Any:
     (Typed ``Any``: its fields are made from the table.)
     """
     fields = [field for names, _ in rows for field in names.split()]
-    cls: Any = namedtuple(name, fields)  # type: ignore[misc]
+    cls = cast(Any, namedtuple(name, fields))
     cls.layout_rows = tuple((tuple(names.split()), meaning) for names, meaning in rows)
     return cls(*range(len(fields)))
 
