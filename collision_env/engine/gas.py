@@ -20,6 +20,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from .scene import Scene
+from .simulator import Simulator
 from .validation import is_real
 
 #: The densest packing of equal disks (the triangular lattice): ``pi / (2 sqrt 3)``.
@@ -58,10 +59,8 @@ class Gas(NamedTuple):
         """``sum(m v^2) / 2``: ``N kT`` in two dimensions."""
         return float(0.5 * np.sum(self.masses * np.sum(self.velocities**2, axis=1)))
 
-    def simulator(self, **options: Any):
+    def simulator(self, **options: Any) -> Simulator:
         """A :class:`~collision_env.engine.Simulator` of the gas (``options``: mode, max_events, ...)."""
-        from .simulator import Simulator
-
         return Simulator(self.scene, self.positions, self.velocities, self.masses, self.radii, **options)
 
 
