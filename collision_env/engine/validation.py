@@ -28,11 +28,22 @@ MAX_MAGNITUDE = 1e150
 #: A radius must span this many units in the last place of the scene's coordinates: contact is then
 #: resolved to better than 1e-4 of the radius (``tolerance.contact_tolerance``) anywhere in the scene.
 MIN_RADIUS_ULPS = 2.0**16
+#: Most sub-steps per step (naive and posteriori modes): a compiled step cannot be interrupted, so
+#: this bounds its work, to 1e5 sub-steps of ~20-50 ns per ball each (the broad phase keeps a
+#: sub-step's work linear in the balls).
+MAX_SUBSTEPS = 100_000
+#: The largest finite float64: a Python int beyond it has no float64 value (``float`` raises).
+_LARGEST_FLOAT = int(np.finfo(np.float64).max)
 
 
 def is_real(x) -> bool:
     """A real number that is not a boolean (Python or numpy scalar types alike)."""
     return isinstance(x, numbers.Real) and not isinstance(x, (bool, np.bool_))
+
+
+def _magnitude(x: int) -> str:
+    """A huge integer in short: its sign and order of magnitude."""
+    return f"an integer of about {'-' if x < 0 else ''}1e{len(str(abs(x))) - 1}"
 
 
 def real_number(value, field: str) -> float:
@@ -45,13 +56,18 @@ def real_number(value, field: str) -> float:
         raise ValueError(
             f"{field}: expected a number (real, not a boolean or a string), got {value!r} ({type(value).__name__})"
         )
-    return float(value)
+    try:
+        return float(value)
+    except OverflowError:  # an int beyond float64's range
+        raise ValueError(f"{field}: must be within float64's range, got {_magnitude(value)}") from None
 
 
-def positive_integer(value, field: str) -> int:
-    """``value`` as an int: a whole number of at least 1 (not a boolean)."""
+def positive_integer(value, field: str, most: int | None = None) -> int:
+    """``value`` as an int: a whole number of at least 1 (not a boolean), and at most ``most``."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral) or value < 1:
         raise ValueError(f"{field}: must be a positive integer, got {value!r}")
+    if most is not None and value > most:
+        raise ValueError(f"{field}: must be at most {most:,}, got {value:,}")
     return int(value)
 
 
@@ -80,6 +96,8 @@ def real_array(value, shapes: list, field: str, where: Callable) -> np.ndarray:
                         f"{where(index)}{field} must be real numbers (not booleans, strings or complex), "
                         f"got {x!r} ({type(x).__name__})"
                     )
+                if isinstance(x, numbers.Integral) and not abs(x) <= _LARGEST_FLOAT:
+                    raise ValueError(f"{where(index)}{field} must be within float64's range, got {_magnitude(x)}")
         arr = obj.astype(np.float64) if obj.shape in shapes else obj
     if arr.shape not in shapes:
         raise ValueError(f"{field}: expected shape {' or '.join(map(str, shapes))}, got {arr.shape}")
@@ -97,9 +115,12 @@ class Labels:
         return f"{where}ball {ball}: " if ball is not None else (f"scene {sc}: " if self.n_scenes > 1 else "")
 
 
-def checked_balls(scene: Scene, label: Labels, scenes, n: int, positions, velocities, masses, radii) -> tuple:
+def checked_balls(
+    scene: Scene, label: Labels, scenes, n: int, positions, velocities, masses, radii, overlaps: bool = False
+) -> tuple:
     """Validate and return float64 copies ``(pos, vel, mass, radius)`` of the balls of ``scenes``
-    (indices into the batch), ``n`` balls each (raises ValueError)."""
+    (indices into the batch), ``n`` balls each (raises ValueError). ``overlaps``: accept balls that
+    overlap (a state of a mode whose steps may leave them so)."""
     k = len(scenes)
 
     def where(index):
@@ -184,7 +205,7 @@ def checked_balls(scene: Scene, label: Labels, scenes, n: int, positions, veloci
                 f"got {tuple(pos[s, i])} with radius {r[s, i]:.6g}"
             ),
         )
-    if scene.ball_collisions and n > 1:
+    if scene.ball_collisions and n > 1 and not overlaps:
         for s_ in range(k):
             i, j = first_overlap(pos[s_], r[s_], START_CONTACT_RTOL)
             if i >= 0:
