@@ -661,11 +661,12 @@ class BatchSimulator:
         """Restore a state from :meth:`get_state`.
 
         Checked as the constructor checks its balls (shapes, number types, finite and representable
-        values, balls inside the border and apart), and beyond that: the
+        values, balls inside the border and apart, none spanning the box), and beyond that: the
         clusters are ball indices whose roots are their own roots (every ball its own cluster unless
         the scene sticks), spins are within 1e150 rad/s, the clocks are times the constructor would accept, each
         with a compensation below an ulp of it. In naive and posteriori modes, whose steps may end
-        with balls overlapping, overlaps are accepted. Bad input raises a ``ValueError`` naming
+        with balls overlapping, overlaps (and touching balls from wall to wall, which these modes
+        step like any others) are accepted. Bad input raises a ``ValueError`` naming
         the scene, ball and field, and changes nothing.
         """
         shapes = {

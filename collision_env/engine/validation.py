@@ -16,7 +16,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .broadphase import first_overlap
+from .broadphase import first_overlap, wall_to_wall
 from .physics.tolerance import CONTACT_RTOL, EPS, roundoff
 from .scene import CONSTANT_RADIUS, Scene, radius_from_mass
 
@@ -120,7 +120,7 @@ def checked_balls(
 ) -> tuple:
     """Validate and return float64 copies ``(pos, vel, mass, radius)`` of the balls of ``scenes``
     (indices into the batch), ``n`` balls each (raises ValueError). ``overlaps``: accept balls that
-    overlap (a state of a mode whose steps may leave them so)."""
+    overlap, or touch from wall to wall (a state of a mode whose steps may leave them so)."""
     k = len(scenes)
 
     def where(index):
@@ -213,6 +213,16 @@ def checked_balls(
                 raise ValueError(
                     f"{label(scenes[s_], i)}position overlaps ball {j} "
                     f"(centres {dist:.6g} m apart, radii sum to {r[s_, i] + r[s_, j]:.6g} m)"
+                )
+    if scene.bounds is not None and not overlaps:
+        bounds = np.array(scene.bounds)
+        for s_ in range(k):
+            i, axis, size = wall_to_wall(pos[s_], r[s_], bounds, scene.dimension, scene.ball_collisions)
+            if i >= 0:
+                walls = ("left and right walls", "bottom and top walls")[axis]
+                raise ValueError(
+                    f"{label(scenes[s_], i)}position leaves no room to move along {'xy'[axis]}: the ball is one "
+                    f"of {size} touching balls that reach from wall to wall ({walls}), jammed between them"
                 )
     return pos, vel, m, r
 
