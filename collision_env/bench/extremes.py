@@ -7,9 +7,11 @@ The grid (:func:`cells`) spans speeds 1e-6 to 1e4 m/s, radii 1e-4 to 0.5 m, mass
 1, control steps 1e-6 to 1 s, episodes up to 1e5 s of simulated time and 1e6 steps, balls touching
 at the start (each other and the walls), exact corner hits and grazing contacts, scenes 1e6 m from
 the origin, slow pairs beside a fast ball, inputs at the edge of float64 (and just beyond it, which
-must be refused) and balls as tall as the box (refused). Each cell is one scene, one control step
-and one duration; every mode runs it, stepping the public :class:`~collision_env.engine.Simulator`
-and checking after every step:
+must be refused) and balls as tall as the box (refused), rows and lattices of touching balls that
+span the box along x or y (2 to 4,096 balls, e = 1, 0.5 and 0; refused, and run with room to
+move), ``set_state`` with each kind of bad field (refused, the state untouched) and 1e9 sub-steps
+(refused). Each cell is one scene, one control step and one duration; every mode runs it, stepping
+the public :class:`~collision_env.engine.Simulator` and checking after every step:
 
 - **NaN**: a position or velocity is not finite;
 - **escape**: a ball sticks out of the reflecting border by more than ``1e-9 (r + |x|)``;
@@ -41,6 +43,7 @@ import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -503,6 +506,8 @@ def cells(quick: bool = False) -> list[Cell]:
             delta=delta,
         )
     _add_robustness_cells(add)
+    _add_spanning_cells(add)
+    _add_state_cells(add)
     return [c for c in out if c.quick] if quick else out
 
 
@@ -557,7 +562,7 @@ def _near_wall(e):
     )
 
 
-def _three_balls(e):
+def _three_balls(e: float) -> Case:
     return _case(
         Scene(bounds=PLAY_AREA_2D, elasticity=e),
         [[-1.2, -0.4], [0.0, 0.3], [1.1, -0.2]],
@@ -778,6 +783,141 @@ def _add_robustness_cells(add):
             _refuses(lambda e=e: Simulator(*_wedged(e, 0.0)), "ball 0: radius 1 m leaves no room to move"),
             q=e == 1.0,
             e=e,
+        )
+
+
+# --------------------------------------------------------------------------- spanning the box
+# Touching balls that reach from a wall to the opposite one are jammed between them (a row or a
+# square lattice cannot move along that axis at all), so every state with them is refused (where a
+# state enters: the constructor, set_state, set_balls, env resets). Each cell runs the same row or
+# lattice with room to move (gaps between the balls and at the walls), which the clock must get
+# through, and checks that the touching one is refused.
+_SPAN_BOX = {0: (-1.0, -2.0, 1.0, 2.0), 1: (-2.0, -1.0, 2.0, 1.0)}  # 2 m along the spanning axis
+
+
+def _spanning(shape, axis, e, gap):
+    """``shape = (along, across)`` balls in a square lattice (a row: across = 1) whose ``along``
+    balls fill the 2 m of ``axis`` but for ``gap``, centred, their radii ``gap / 2`` short of
+    touching (gap 0: touching each other and the walls), moving as one block (lattice) or each its
+    own way (row); equal radii, masses 1 to 3 kg."""
+    along, across = shape
+    r = (2.0 - gap) / (2 * along)
+    k_along, k_across = np.meshgrid(np.arange(along), np.arange(across), indexing="ij")
+    u = (2 * k_along.ravel() + 1 - along) * r  # touching along the axis, centred
+    w = (2 * k_across.ravel() + 1 - across) * r
+    pos = np.stack([u, w], 1) if axis == 0 else np.stack([w, u], 1)
+    n = len(pos)
+    rng = np.random.default_rng(7)
+    vel = np.tile([0.3, 0.2], (n, 1)) if across > 1 else rng.uniform(-1.0, 1.0, (n, 2))
+    masses = 1.0 + 2.0 * rng.random(n)
+    return _case(Scene(bounds=_SPAN_BOX[axis], elasticity=e), pos, vel, masses, np.full(n, r * (1.0 - gap / 2)))
+
+
+def _check_clock_reaches(t_end):
+    def check(sim, count, impacts):
+        return None if abs(sim.time - t_end) <= 1e-12 * t_end else f"clock at {sim.time!r} s, expected {t_end:g} s"
+
+    return check
+
+
+def _check_all(*checks):
+    def check(sim, count, impacts):
+        return next((m for m in (c(sim, count, impacts) for c in checks) if m), None)
+
+    return check
+
+
+def _add_spanning_cells(add):
+    for axis in (0, 1):
+        for shape in ((2, 1), (3, 1), (3, 3), (8, 8), (64, 64)):
+            kind = f"row of {shape[0]}" if shape[1] == 1 else f"{shape[0]}x{shape[1]} lattice"
+            for e in (1.0, 0.5, 0.0):
+                add(
+                    f"{kind} spans {'xy'[axis]} e={e:g}",
+                    "spanning",
+                    lambda shape=shape, axis=axis, e=e: _spanning(shape, axis, e, 0.1),
+                    0.05,
+                    0.5,
+                    2e3 * shape[0] * shape[1],
+                    _check_all(
+                        _check_clock_reaches(0.5),
+                        _refuses(
+                            lambda shape=shape, axis=axis, e=e: Simulator(*_spanning(shape, axis, e, 0.0)),
+                            f"leaves no room to move along {'xy'[axis]}",
+                        ),
+                    ),
+                    q=shape == (3, 1) and e == 0.0,
+                    e=e,
+                    balls=shape[0] * shape[1],
+                )
+
+
+def _bad_state(field):
+    """A three-ball simulator and its state with ``field`` made bad (as the constructor would refuse
+    it; "spanning": three touching balls from the left wall to the right one)."""
+    sim = Simulator(*_three_balls(1.0))
+    state = sim.get_state()
+    bads: dict[str, dict[str, Any]] = {
+        "masses": dict(masses=[-1.0, 2.0, 0.5]),
+        "radii": dict(radii=[0.0, 0.25, 0.15]),
+        "overlap": dict(positions=[[-1.2, -0.4], [-1.1, -0.4], [1.1, -0.2]]),
+        "outside": dict(positions=[[-2.5, -0.4], [0.0, 0.3], [1.1, -0.2]]),
+        "velocity 1e200": dict(velocities=[[1e200, 0.0], [0.0, 0.0], [0.0, 0.0]]),
+        "clusters": dict(clusters=[0, 1, 3]),
+        "time 1e300": dict(time=1e300),
+        "time compensation": dict(time_compensation=1.0),
+        "spanning": dict(positions=[[-4 / 3, 0.0], [0.0, 0.0], [4 / 3, 0.0]], radii=[2 / 3] * 3),
+    }
+    state.update({key: np.asarray(value) for key, value in bads[field].items()})
+    return sim, state
+
+
+def _add_state_cells(add):
+    messages = {
+        "masses": "ball 0: mass must be positive",
+        "radii": "ball 0: radius must be positive",
+        "overlap": "ball 0: position overlaps ball 1",
+        "outside": "ball 0: position must keep the ball inside",
+        "velocity 1e200": "ball 0: velocity must be finite, speed within",
+        "clusters": "state clusters: ball 2",
+        "time 1e300": "state time: must be finite and at most",
+        "time compensation": "state time_compensation: must be within an ulp",
+        "spanning": "ball 0: position leaves no room to move along x",
+    }
+
+    def untouched(field, match):
+        def check(sim, count, impacts):
+            target, state = _bad_state(field)
+            before = target.get_state()
+            message = _refuses(lambda: target.set_state(state), match)(sim, count, impacts)
+            same = all(np.array_equal(v, target.get_state()[k]) for k, v in before.items())
+            return message or (None if same else "a refused set_state changed the state")
+
+        return check
+
+    for name, match in messages.items():
+        add(
+            f"set_state {name}",
+            "set_state",
+            lambda: _three_balls(1.0),
+            0.1,
+            0.2,
+            10.0,
+            untouched(name, match),
+            q=name == "velocity 1e200",
+        )
+    for mode in ("naive", "posteriori"):
+        add(
+            f"{mode} substeps=1e9",
+            "overflow",
+            lambda: _three_balls(1.0),
+            0.01,
+            0.02,
+            10.0,
+            _refuses(
+                lambda mode=mode: Simulator(*_three_balls(1.0), mode=mode, substeps=10**9), "substeps: must be at most"
+            ),
+            q=mode == "naive",
         )
 
 

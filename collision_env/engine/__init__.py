@@ -24,13 +24,24 @@ from .scene import (
     Scene,
     radius_from_mass,
 )
-from .simulator import IMPACT_DTYPE, MODES, BatchSimulator, EventCapWarning, Frames, Impact, Simulator, warm_up
+from .simulator import (
+    IMPACT_DTYPE,
+    MAX_SUBSTEPS,
+    MODES,
+    BatchSimulator,
+    EventCapWarning,
+    Frames,
+    Impact,
+    Simulator,
+    warm_up,
+)
 
 __all__ = [
     "BACKEND",
     "BALL_DENSITY",
     "CONSTANT_RADIUS",
     "IMPACT_DTYPE",
+    "MAX_SUBSTEPS",
     "MODES",
     "PLAY_AREA_1D",
     "PLAY_AREA_2D",

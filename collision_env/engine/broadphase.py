@@ -22,6 +22,8 @@ import math
 import numpy as np
 
 from ._jit import njit
+from .physics.tolerance import balls_touch
+from .physics.walls import wall_contact, wall_count, wall_of
 
 #: Scenes with fewer balls keep one cell (every ball is every other's neighbour): below this size
 #: the grid's bookkeeping costs more than the pairs it saves (measured by the engine benchmark).
@@ -106,12 +108,10 @@ def block(c, nx, ny):
 
 
 @njit
-def first_overlap(pos, radius, rtol):
-    """The first pair ``(i, j)``, ``i < j`` in lexicographic order, whose disks overlap by more than
-    ``rtol`` of their radii sum, or ``(-1, -1)``; O(N) expected time on a grid of the balls' box."""
+def _ball_cells(pos, radius):
+    """Cell lists of the balls on a grid of their box, cells one largest diameter wide (with the
+    margin): ``(head, nxt, cell, nx, ny)``, each cell's balls in index order."""
     n = pos.shape[0]
-    if n < 2:
-        return -1, -1
     x0 = pos[0, 0]
     y0 = pos[0, 1]
     x1 = x0
@@ -138,6 +138,17 @@ def first_overlap(pos, radius, rtol):
         cell[i] = c
         nxt[i] = head[c]
         head[c] = i
+    return head, nxt, cell, nx, ny
+
+
+@njit
+def first_overlap(pos, radius, rtol):
+    """The first pair ``(i, j)``, ``i < j`` in lexicographic order, whose disks overlap by more than
+    ``rtol`` of their radii sum, or ``(-1, -1)``; O(N) expected time on a grid of the balls' box."""
+    n = pos.shape[0]
+    if n < 2:
+        return -1, -1
+    head, nxt, cell, nx, ny = _ball_cells(pos, radius)
     best_i = -1
     best_j = -1
     for i in range(n):
@@ -158,3 +169,57 @@ def first_overlap(pos, radius, rtol):
         if best_i >= 0:
             return best_i, best_j
     return -1, -1
+
+
+@njit(inline="always")
+def _root(parent, i):
+    while parent[i] != i:
+        parent[i] = parent[parent[i]]  # (path halving)
+        i = parent[i]
+    return i
+
+
+@njit
+def wall_to_wall(pos, radius, bounds, dim, pairs):
+    """A network of touching balls that reaches from a wall to the opposite one, or ``(-1, -1, 0)``.
+
+    Balls touch each other and the walls within the engine's contact tolerance (``balls_touch``,
+    ``wall_contact``: 1e-9 of the radii, or the round-off of the coordinates), as the event loop
+    judges contact; ``pairs`` False: each ball is a network of its own. Returns ``(ball, axis,
+    size)``: the lowest-numbered ball of the first such network, the axis along which it spans the
+    box (0: x, left to right; 1: y, bottom to top) and how many balls it has. Such a network is
+    jammed between the walls (a straight row, or a square lattice, has no velocity along that axis
+    that closes none of its contacts), which resolving its impacts one pair at a time never gets
+    through. O(N) expected time (union-find over the contacts of a cell grid).
+    """
+    n = pos.shape[0]
+    parent = np.arange(n)
+    if pairs and n > 1:
+        head, nxt, cell, nx, ny = _ball_cells(pos, radius)
+        for i in range(n):
+            cx0, cx1, cy0, cy1 = block(cell[i], nx, ny)
+            for cy in range(cy0, cy1 + 1):
+                for cx in range(cx0, cx1 + 1):
+                    j = head[cy * nx + cx]
+                    while j >= 0:
+                        if j > i and balls_touch(i, j, pos, radius):
+                            a = _root(parent, i)
+                            b = _root(parent, j)
+                            if a != b:
+                                parent[max(a, b)] = min(a, b)
+                        j = nxt[j]
+    walls = np.zeros(n, dtype=np.int64)  # per root: a bit per wall its network touches
+    size = np.zeros(n, dtype=np.int64)
+    for i in range(n):
+        a = _root(parent, i)
+        size[a] += 1
+        for wall in range(wall_count(dim)):
+            if wall_contact(i, wall, pos, radius, bounds):
+                walls[a] |= 1 << wall
+    for i in range(n):
+        a = _root(parent, i)
+        for axis in range(dim):
+            both = (1 << wall_of(axis, False)) | (1 << wall_of(axis, True))
+            if walls[a] & both == both:
+                return a, axis, size[a]
+    return -1, -1, 0

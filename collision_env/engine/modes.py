@@ -35,6 +35,7 @@ class Mode(NamedTuple):
     grid: dict  #: how ``broadphase.grid_geometry`` lays out its grid
     impact_rows: Callable  #: ``impact_rows(scene, n, uses_grid)``: rows of the impact buffer
     sorted_impacts: bool  #: its impacts come in time order within each scene
+    leaves_overlaps: bool  #: its steps may end with balls overlapping (which its ``set_state`` accepts)
     kernels: Callable  #: ``kernels()``: every kernel it can build (for scenes of any kind)
 
 
@@ -72,6 +73,7 @@ def _cheap(name: str, summary: str) -> Mode:
         grid=dict(reach=2.0, balls_per_cell=0.0, cells_per_ball=CHEAP_CELLS_PER_BALL),
         impact_rows=_substep_rows,
         sorted_impacts=False,
+        leaves_overlaps=True,
         kernels=lambda: [substep.step_kernel(name)],
     )
 
@@ -91,6 +93,7 @@ MODES: dict[str, Mode] = {
         grid=dict(balls_per_cell=EXACT_BALLS_PER_CELL, cells_per_ball=EXACT_CELLS_PER_BALL),
         impact_rows=_exact_rows,
         sorted_impacts=True,
+        leaves_overlaps=False,
         kernels=lambda: [scheduler.step_kernel(kind) for kind in scheduler.KINDS],
     ),
 }

@@ -55,7 +55,10 @@ def _real_tuple(values, field, expected):
     for v in items:
         if not _is_real(v):
             raise ValueError(f"{field}: expected real numbers {expected}, got {v!r} ({type(v).__name__}) in {values!r}")
-    return tuple(float(v) for v in items)
+    try:
+        return tuple(float(v) for v in items)
+    except OverflowError:  # an int beyond float64's range
+        raise ValueError(f"{field}: expected numbers within float64's range {expected}") from None
 
 
 def radius_from_mass(mass: ArrayLike) -> np.ndarray:
@@ -114,7 +117,7 @@ class Scene:
             object.__setattr__(self, "bounds", b)
         if not _is_real(self.elasticity):
             raise ValueError(f"scene elasticity: expected a number in [0, 1], got {self.elasticity!r}")
-        if not (0.0 <= float(self.elasticity) <= 1.0):
+        if not (0 <= self.elasticity <= 1):  # (compared as given: a huge int has no float)
             raise ValueError(f"scene elasticity: must lie in [0, 1], got {self.elasticity!r}")
         object.__setattr__(self, "elasticity", float(self.elasticity))
         if not (isinstance(self.inelastic, str) and self.inelastic in ("slip", "stick")):

@@ -58,6 +58,7 @@ from .scene import Scene
 from .state import RESUME, RUN_FRAMES, START_STEP, FramesOut, State, aligned_copy, aligned_zeros, pack, with_frames
 from .validation import (
     MAX_MAGNITUDE,
+    MAX_SUBSTEPS,
     Labels,
     check_reach,
     check_seconds,
@@ -160,8 +161,9 @@ class BatchSimulator:
         Lab's first engine's overlap-time reconstruction) or ``"naive"`` (move, then reflect overlaps);
         see :data:`~collision_env.engine.modes.MODES`.
     substeps:
-        Equal sub-steps per step for naive and posteriori (their speed/accuracy knob). Exact mode
-        is exact at any step, so it takes only 1.
+        Equal sub-steps per step for naive and posteriori (their speed/accuracy knob), at most
+        :data:`MAX_SUBSTEPS` (1e5: a compiled step cannot be interrupted, so this bounds a step's
+        work). Exact mode is exact at any step, so it takes only 1.
     max_events:
         Cap on events per scene per step in exact mode. A scene that reaches it stops at its last
         event, in a valid state; :attr:`cap_reached` flags it and an :class:`EventCapWarning` is
@@ -206,7 +208,7 @@ class BatchSimulator:
         if not (isinstance(mode, str) and mode in MODE_REGISTRY):
             raise ValueError(f"mode: must be one of {MODES}, got {mode!r}")
         spec = MODE_REGISTRY[mode]
-        substeps = positive_integer(substeps, "substeps")
+        substeps = positive_integer(substeps, "substeps", MAX_SUBSTEPS)
         if not spec.substeps and substeps != 1:
             raise ValueError(f"substeps: {mode} mode resolves every event at its exact time; substeps must be 1")
         max_events = positive_integer(max_events, "max_events")
@@ -672,8 +674,17 @@ class BatchSimulator:
         }
 
     def set_state(self, state: Mapping[str, ArrayLike]) -> None:
-        """Restore a state from :meth:`get_state` (shapes, number types and finiteness are checked;
-        the physics of the values is trusted)."""
+        """Restore a state from :meth:`get_state`.
+
+        Checked as the constructor checks its balls (shapes, number types, finite and representable
+        values, balls inside the border and apart, none spanning the box), and beyond that: the
+        clusters are ball indices whose roots are their own roots (every ball its own cluster unless
+        the scene sticks), spins are within 1e150 rad/s, the clocks are times the constructor would accept, each
+        with a compensation below an ulp of it. In naive and posteriori modes, whose steps may end
+        with balls overlapping, overlaps (and touching balls from wall to wall, which these modes
+        step like any others) are accepted. Bad input raises a ``ValueError`` naming
+        the scene, ball and field, and changes nothing.
+        """
         shapes = {
             "positions": self._pos.shape,
             "velocities": self._vel.shape,
@@ -684,10 +695,13 @@ class BatchSimulator:
             "time": self._time.shape,
             "time_compensation": self._time.shape,
         }
+        if not isinstance(state, Mapping):
+            raise TypeError(f"state: expected a dict with the keys {list(shapes)}, got {type(state).__name__}")
+        missing = [key for key in shapes if key not in state]
+        if missing:
+            raise ValueError(f"state: missing {missing} (a state has the keys {list(shapes)}, as get_state gives)")
         arrays = {}
         for key, shape in shapes.items():
-            if key not in state:
-                raise ValueError(f"state: missing {key!r}")
             a = np.asarray(state[key])
             if a.shape != shape:
                 raise ValueError(
@@ -701,17 +715,59 @@ class BatchSimulator:
             if not np.isfinite(a).all():
                 raise ValueError(f"state {key}: values must be finite")
             arrays[key] = a
-        np.copyto(self._pos, arrays["positions"])
-        np.copyto(self._vel, arrays["velocities"])
-        np.copyto(self._mass, arrays["masses"])
-        np.copyto(self._inv_mass, 1.0 / arrays["masses"])
-        np.copyto(self._radius, arrays["radii"])
+        scenes = np.arange(self._n_scenes)
+        pos, vel, mass, radius = checked_balls(
+            self.scene,
+            self._label,
+            scenes,
+            self._n,
+            arrays["positions"],
+            arrays["velocities"],
+            arrays["masses"],
+            arrays["radii"],
+            overlaps=self._spec.leaves_overlaps,
+        )
+        self._check_clusters(arrays["clusters"], arrays["omega"])
+        for sc in scenes:
+            time, compensation = float(arrays["time"][sc]), float(arrays["time_compensation"][sc])
+            check_seconds(time, f"state time: {self._label(sc)}".rstrip(": "))
+            if not abs(compensation) <= np.spacing(abs(time)):
+                raise ValueError(
+                    f"state time_compensation: {self._label(sc)}must be within an ulp of the time "
+                    f"({np.spacing(abs(time)):.3g} s at {time:g} s), got {compensation:g}"
+                )
+        np.copyto(self._pos, pos)
+        np.copyto(self._vel, vel)
+        np.copyto(self._mass, mass)
+        np.copyto(self._inv_mass, 1.0 / mass)
+        np.copyto(self._radius, radius)
         np.copyto(self._body, arrays["clusters"])
         np.copyto(self._omega, arrays["omega"])
         np.copyto(self._time, arrays["time"])
         self._clock[:, 0] = arrays["time"]
         self._clock[:, 1] = arrays["time_compensation"]
-        self._invalidate(np.arange(self._n_scenes))
+        self._invalidate(scenes)
+
+    def _check_clusters(self, clusters, omega):
+        """``set_state``'s clusters and spins: each ball's root is a ball index and its own root (every
+        ball its own without stick clusters), and spins are representable (raises ValueError)."""
+        n = self._n
+        bad = (clusters < 0) | (clusters >= n)
+        if not bad.any():
+            roots = np.take_along_axis(clusters, clusters, axis=1)
+            bad = roots != clusters
+            if not self.scene.sticky:
+                bad |= clusters != np.arange(n)
+        if bad.any():
+            s, i = np.argwhere(bad)[0]
+            expected = "a ball index whose cluster is its own" if self.scene.sticky else f"{i} (no stick clusters)"
+            raise ValueError(f"state clusters: {self._label(s, i)}expected {expected}, got {clusters[s, i]}")
+        spin = ~(np.abs(omega) <= MAX_MAGNITUDE)
+        if spin.any():
+            s, i = np.argwhere(spin)[0]
+            raise ValueError(
+                f"state omega: {self._label(s, i)}expected within {MAX_MAGNITUDE:g} rad/s, got {omega[s, i]}"
+            )
 
     def copy(self) -> BatchSimulator:
         """An independent copy (for planning: step it ahead without touching this one)."""
@@ -883,6 +939,9 @@ class Simulator:
         return {key: value[0] for key, value in self._batch.get_state().items()}
 
     def set_state(self, state: Mapping[str, ArrayLike]) -> None:
+        """Restore a state from :meth:`get_state`, checked as :meth:`BatchSimulator.set_state` checks it."""
+        if not isinstance(state, Mapping):
+            raise TypeError(f"state: expected a dict, as get_state gives, got {type(state).__name__}")
         self._batch.set_state({key: np.asarray(value)[None] for key, value in state.items()})
 
     def copy(self) -> Simulator:

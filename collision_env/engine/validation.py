@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from .broadphase import first_overlap
+from .broadphase import first_overlap, wall_to_wall
 from .physics.tolerance import CONTACT_RTOL, EPS, roundoff
 from .scene import CONSTANT_RADIUS, Scene, radius_from_mass
 
@@ -29,11 +29,22 @@ MAX_MAGNITUDE = 1e150
 #: A radius must span this many units in the last place of the scene's coordinates: contact is then
 #: resolved to better than 1e-4 of the radius (``tolerance.contact_tolerance``) anywhere in the scene.
 MIN_RADIUS_ULPS = 2.0**16
+#: Most sub-steps per step (naive and posteriori modes): a compiled step cannot be interrupted, so
+#: this bounds its work, to 1e5 sub-steps of ~20-50 ns per ball each (the broad phase keeps a
+#: sub-step's work linear in the balls).
+MAX_SUBSTEPS = 100_000
+#: The largest finite float64: a Python int beyond it has no float64 value (``float`` raises).
+_LARGEST_FLOAT = int(np.finfo(np.float64).max)
 
 
 def is_real(x: object) -> bool:
     """A real number that is not a boolean (Python or numpy scalar types alike)."""
     return isinstance(x, numbers.Real) and not isinstance(x, (bool, np.bool_))
+
+
+def _magnitude(x: int) -> str:
+    """A huge integer in short: its sign and order of magnitude."""
+    return f"an integer of about {'-' if x < 0 else ''}1e{len(str(abs(x))) - 1}"
 
 
 def real_number(value: Any, field: str) -> float:
@@ -46,13 +57,18 @@ def real_number(value: Any, field: str) -> float:
         raise ValueError(
             f"{field}: expected a number (real, not a boolean or a string), got {value!r} ({type(value).__name__})"
         )
-    return float(value)
+    try:
+        return float(value)
+    except OverflowError:  # an int beyond float64's range
+        raise ValueError(f"{field}: must be within float64's range, got {_magnitude(value)}") from None
 
 
-def positive_integer(value: Any, field: str) -> int:
-    """``value`` as an int: a whole number of at least 1 (not a boolean)."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral) or value < 1:
+def positive_integer(value: Any, field: str, most: int | None = None) -> int:
+    """``value`` as an int: a whole number of at least 1 (not a boolean), and at most ``most``."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral) or int(value) < 1:
         raise ValueError(f"{field}: must be a positive integer, got {value!r}")
+    if most is not None and int(value) > most:
+        raise ValueError(f"{field}: must be at most {most:,}, got {value:,}")
     return int(value)
 
 
@@ -86,6 +102,8 @@ def real_array(value: Any, shapes: list, field: str, where: Callable, label: Lab
                         f"{where(index)}{field} must be real numbers (not booleans, strings or complex), "
                         f"got {x!r} ({type(x).__name__})"
                     )
+                if isinstance(x, numbers.Integral) and not abs(int(x)) <= _LARGEST_FLOAT:
+                    raise ValueError(f"{where(index)}{field} must be within float64's range, got {_magnitude(int(x))}")
         arr = obj.astype(np.float64) if obj.shape in shapes else obj
     if arr.shape not in shapes:
         got = label.shape(arr.shape, arr.ndim == rank) if label else str(arr.shape)
@@ -111,10 +129,19 @@ class Labels:
 
 
 def checked_balls(
-    scene: Scene, label: Labels, scenes: np.ndarray, n: int, positions: Any, velocities: Any, masses: Any, radii: Any
+    scene: Scene,
+    label: Labels,
+    scenes: np.ndarray,
+    n: int,
+    positions: Any,
+    velocities: Any,
+    masses: Any,
+    radii: Any,
+    overlaps: bool = False,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Validate and return float64 copies ``(pos, vel, mass, radius)`` of the balls of ``scenes``
-    (indices into the batch), ``n`` balls each (raises ValueError)."""
+    (indices into the batch), ``n`` balls each (raises ValueError). ``overlaps``: accept balls that
+    overlap, or touch from wall to wall (a state of a mode whose steps may leave them so)."""
     k = len(scenes)
 
     def where(index):
@@ -199,7 +226,7 @@ def checked_balls(
                 f"got {tuple(pos[s, i])} with radius {r[s, i]:.6g}"
             ),
         )
-    if scene.ball_collisions and n > 1:
+    if scene.ball_collisions and n > 1 and not overlaps:
         for s_ in range(k):
             i, j = first_overlap(pos[s_], r[s_], START_CONTACT_RTOL)
             if i >= 0:
@@ -207,6 +234,23 @@ def checked_balls(
                 raise ValueError(
                     f"{label(scenes[s_], i)}position overlaps ball {j} "
                     f"(centres {dist:.6g} m apart, radii sum to {r[s_, i] + r[s_, j]:.6g} m)"
+                )
+    if scene.bounds is not None and not overlaps:
+        bounds = np.array(scene.bounds)
+        # only a scene with balls at two opposite walls can have a network between them (this test
+        # is looser than the kernel's contact test, so it never skips one)
+        near = CONTACT_RTOL * 2.0 * r[..., None] + 2.0 * roundoff(extent[:, None])[..., None]
+        gaps = np.stack([pos[..., 0] - r - bounds[0], bounds[2] - r - pos[..., 0]], -1)
+        if scene.dimension == 2:
+            gaps = np.concatenate([gaps, np.stack([pos[..., 1] - r - bounds[1], bounds[3] - r - pos[..., 1]], -1)], -1)
+        at = (gaps <= near).any(axis=1)  # (k, walls): some ball of the scene touches the wall
+        for sc in np.flatnonzero((at[:, 0::2] & at[:, 1::2]).any(-1)):
+            i, axis, size = wall_to_wall(pos[sc], r[sc], bounds, scene.dimension, scene.ball_collisions)
+            if i >= 0:
+                walls = ("left and right walls", "bottom and top walls")[axis]
+                raise ValueError(
+                    f"{label(scenes[sc], i)}position leaves no room to move along {'xy'[axis]}: the ball is one "
+                    f"of {size} touching balls that reach from wall to wall ({walls}), jammed between them"
                 )
     return pos, vel, m, r
 

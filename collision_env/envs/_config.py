@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from collision_env.engine import MODES
+from collision_env.engine import MAX_SUBSTEPS, MODES
 from collision_env.engine.keywords import check_keywords
 from collision_env.engine.scene import PLAY_AREA_1D, PLAY_AREA_2D, WALL_NAMES, radius_from_mass
 from collision_env.envs.task.layout import BALL_OBS, GLOBAL_OBS, PREDICTED_OBS, TARGET_OBS
@@ -127,8 +127,8 @@ class TaskConfig:
     Episode:
         ``time_limit`` (s of simulated time; the env truncates after round(time_limit / dt) steps).
     Engine:
-        ``mode`` (one of ``collision_env.engine.MODES``), ``substeps`` (>= 1), ``max_events`` (event cap
-        per step and scene).
+        ``mode`` (one of ``collision_env.engine.MODES``), ``substeps`` (1 to
+        ``collision_env.engine.MAX_SUBSTEPS``), ``max_events`` (event cap per step and scene).
     """
 
     dimension: int = 2
@@ -277,7 +277,7 @@ class TaskConfig:
                 raise ValueError(f"window: {self.window} s is longer than time_limit {self.time_limit} s")
         if self.mode not in MODES:
             raise ValueError(f"mode: expected one of {MODES}, got {self.mode!r}")
-        s("substeps", _number("substeps", self.substeps, low=1, integer=True))
+        s("substeps", _number("substeps", self.substeps, low=1, high=MAX_SUBSTEPS, integer=True))
         s("max_events", _number("max_events", self.max_events, low=1, integer=True))
         s("n_steps", max(1, int(round(self.time_limit / self.dt))))
         # geometric feasibility: every ball must fit, and the balls must be placeable

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import DTypeLike
 
+from collision_env.engine import MAX_SUBSTEPS
 from collision_env.engine.modes import MODES
 from collision_env.engine.scene import WALL_NAMES
 from collision_env.envs._config import TaskConfig
@@ -259,6 +260,16 @@ def sample_episode(cfg: TaskConfig, rng: np.random.Generator) -> Episodes:
 # --------------------------------------------------------------------------------------------- #
 
 
+def check_state_keys(state, keys: tuple, source: str) -> None:
+    """Raise unless ``state`` is a dict holding ``keys`` (the state ``source`` gives): a
+    ``TypeError`` for anything but a mapping, a ``ValueError`` naming the missing keys."""
+    if not isinstance(state, dict):
+        raise TypeError(f"set_state: expected a dict with the keys {list(keys)} ({source}), got {type(state).__name__}")
+    missing = [key for key in keys if key not in state]
+    if missing:
+        raise ValueError(f"set_state: missing {missing}; expected a dict with the keys {list(keys)} ({source})")
+
+
 class TaskCore:
     """A batch of B task instances on one BatchSimulator.
 
@@ -354,10 +365,11 @@ class TaskCore:
         # observe="predicted": a second engine of the same mode, loaded with the scenes' state and run
         # ahead at every observation (scratch: it holds no state of the task between calls). The cheap
         # modes keep their sub-step length: the look-ahead takes as many sub-steps as the control steps
-        # it spans would.
+        # it spans would, up to the engine's MAX_SUBSTEPS.
         self.ahead: BatchSimulator | None = None
         if cfg.observe == "predicted" or switches[SWITCHES.aim_predicted]:
             ahead_substeps = cfg.substeps * max(1, round(cfg.lookahead / cfg.dt)) if MODES[cfg.mode].substeps else 1
+            ahead_substeps = min(ahead_substeps, MAX_SUBSTEPS)
             self.ahead = engine(ahead_substeps)
         self._pack = self._make_pack()
 
@@ -499,9 +511,7 @@ class TaskCore:
         return state
 
     def set_state(self, state: dict) -> None:
-        missing = [name for name in (*self._TASK_FIELDS, "engine") if name not in state]
-        if missing:
-            raise ValueError(f"set_state: missing field(s) {missing} (not a state from get_state?)")
+        check_state_keys(state, (*self._TASK_FIELDS, "engine"), "as get_state gives")
         arrays = {}
         for name in self._TASK_FIELDS:  # check everything before changing anything
             arr = np.asarray(state[name])

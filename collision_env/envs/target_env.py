@@ -12,7 +12,7 @@ from numpy.typing import ArrayLike
 
 from collision_env.engine import BatchSimulator
 from collision_env.envs._config import PRESETS, TaskConfig, keywords_of, make_config
-from collision_env.envs._core import Impacts, TaskCore
+from collision_env.envs._core import Impacts, TaskCore, check_state_keys
 from collision_env.envs.task.layout import ROW_RESET, ROW_STEPPED, SCENE_FLOATS, SCENE_INTS
 
 if TYPE_CHECKING:
@@ -263,8 +263,12 @@ class CollisionTargetEnv(gym.Env):
         return {"core": self._core.get_state(), "rng": copy.deepcopy(self.np_random.bit_generator.state)}
 
     def set_state(self, state: dict) -> None:
+        """Restore a snapshot from :meth:`get_state` (checked; on error nothing changes)."""
+        check_state_keys(state, ("core", "rng"), "as get_state gives")
+        rng = copy.deepcopy(self.np_random)
+        rng.bit_generator.state = copy.deepcopy(state["rng"])  # (checked by numpy before the core changes)
         self._core.set_state(state["core"])
-        self.np_random.bit_generator.state = copy.deepcopy(state["rng"])
+        self.np_random.bit_generator.state = rng.bit_generator.state
         if self._renderer is not None:
             self._renderer.start()
 

@@ -24,7 +24,7 @@ from gymnasium.vector.utils import batch_space
 from numpy.typing import ArrayLike
 
 from collision_env.envs._config import TaskConfig, keywords_of, make_config
-from collision_env.envs._core import Impacts, TaskCore
+from collision_env.envs._core import Impacts, TaskCore, check_state_keys
 from collision_env.envs.task.layout import ROW_OBSERVE, ROW_RESET, ROW_SKIP, ROW_STEPPED
 
 if TYPE_CHECKING:
@@ -293,15 +293,29 @@ class CollisionTargetVectorEnv(VectorEnv):
         }
 
     def set_state(self, state: dict) -> None:
-        self._core.set_state(state["core"])
-        self._autoreset = np.asarray(state["autoreset"], dtype=bool).copy()
+        """Restore a snapshot from :meth:`get_state` (checked; on error nothing changes)."""
+        check_state_keys(state, ("core", "autoreset", "rngs"), "as get_state gives")
+        autoreset = np.asarray(state["autoreset"])
+        if autoreset.shape != self._autoreset.shape or autoreset.dtype != np.bool_:
+            raise ValueError(f"set_state: autoreset must be {self._autoreset.shape} booleans, got {autoreset!r}")
+        if len(state["rngs"]) != len(self._rngs):
+            raise ValueError(f"set_state: rngs must hold {len(self._rngs)} generator states, got {len(state['rngs'])}")
+        rngs = []  # (each state checked by numpy before anything changes)
         for i, st in enumerate(state["rngs"]):
-            if st is None:
+            rng = None
+            if st is not None:
+                rng = np.random.Generator(np.random.PCG64()) if self._rngs[i] is None else copy.deepcopy(self._rngs[i])
+                rng.bit_generator.state = copy.deepcopy(st)
+            rngs.append(rng)
+        self._core.set_state(state["core"])
+        self._autoreset = autoreset.copy()
+        for i, rng in enumerate(rngs):
+            if rng is None:
                 self._rngs[i] = None
-            else:
-                if self._rngs[i] is None:
-                    self._rngs[i] = np.random.Generator(np.random.PCG64())
-                self._rngs[i].bit_generator.state = copy.deepcopy(st)
+            elif self._rngs[i] is None:
+                self._rngs[i] = rng
+            else:  # (the same generator object, which callers may hold)
+                self._rngs[i].bit_generator.state = rng.bit_generator.state
 
     def __getstate__(self):
         state = self.__dict__.copy()

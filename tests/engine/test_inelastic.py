@@ -5,6 +5,8 @@ import time
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from collision_env.engine import PLAY_AREA_1D, EventCapWarning, Scene, Simulator
 
@@ -248,3 +250,53 @@ def test_copies_and_pickles_keep_the_time_direction_right():
             got = [(h.time, h.ball) for h in s.step(-0.3)] + [(h.time, h.ball) for h in s.step(0.5)]
             assert got == expect
             np.testing.assert_array_equal(s.positions, ref.positions)
+
+
+def _slip_scene(seed, n, e):
+    """``n`` balls of random sizes and masses at random places and velocities in PhET's box."""
+    rng = np.random.default_rng(seed)
+    radii = rng.uniform(0.1, 0.3, n)
+    pos = []
+    while len(pos) < n:
+        p = rng.uniform([-1.7, -0.7], [1.7, 0.7])
+        if all(np.hypot(*(p - q)) > radii[len(pos)] + radii[k] + 1e-3 for k, q in enumerate(pos)):
+            pos.append(p)
+    return Scene(elasticity=e), np.array(pos), rng.normal(size=(n, 2)), rng.uniform(0.5, 3.0, n), radii
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    seed=st.integers(0, 10**6),
+    n=st.integers(3, 8),
+    split=st.floats(0.05, 0.95),
+    ratio=st.sampled_from([1e-12, 1e-9, 1e-6]),
+)
+def test_at_e0_where_a_step_is_split_moves_balls_by_at_most_the_regulariser(seed, n, split, ratio):
+    """Slip at e = 0: a plastic impact leaves a pair at rest or, where round-off leaves it closing,
+    separating at ``u_min`` (the regulariser, ``response``), so where steps end can change a
+    ball's velocity by about ``u_min`` and its position by ``u_min`` times the time left. The bound
+    that holds: velocities within ``collapse_ratio * v`` and positions within
+    ``collapse_ratio * (v T + r)``, ``v`` the fastest any ball can move (all the kinetic energy in
+    the lightest ball), ``r`` the largest radius."""
+    scene, pos, vel, mass, radii = _slip_scene(seed, n, 0.0)
+    whole = Simulator(scene, pos, vel, mass, radii, collapse_ratio=ratio)
+    parts = Simulator(scene, pos, vel, mass, radii, collapse_ratio=ratio)
+    total = 0.6
+    whole.step(total)
+    parts.step(split * total)
+    parts.step(total - split * total)
+    v = math.sqrt((mass * (vel**2).sum(1)).sum() / mass.min())
+    assert np.abs(whole.velocities - parts.velocities).max() <= ratio * v
+    assert np.abs(whole.positions - parts.positions).max() <= ratio * (v * total + radii.max())
+
+
+@pytest.mark.parametrize("e", [0.3, 0.7, 1.0])
+def test_above_e0_where_a_step_is_split_changes_nothing_beyond_round_off(e):
+    for seed in range(10):
+        scene, pos, vel, mass, radii = _slip_scene(seed, 6, e)
+        whole = Simulator(scene, pos, vel, mass, radii)
+        parts = Simulator(scene, pos, vel, mass, radii)
+        whole.step(0.6)
+        parts.step(0.3)
+        parts.step(0.3)
+        np.testing.assert_allclose(parts.positions, whole.positions, rtol=0, atol=1e-13)

@@ -4,6 +4,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from collision_env.engine import BatchSimulator, Scene, Simulator
 
@@ -202,3 +204,105 @@ def test_property_snapshots_do_not_follow_the_state():
     moved[0, 0] -= 0.1
     sim.set_balls(positions=moved)
     assert sim.positions[0, 0] == moved[0, 0]
+
+
+def test_huge_python_integers_name_the_ball_and_field():
+    with pytest.raises(
+        ValueError, match="ball 1: masses must be within float64's range, got an integer of about 1e400"
+    ):
+        make(masses=[1, 10**400])
+    with pytest.raises(ValueError, match="ball 0: positions must be within float64's range"):
+        make(positions=[[-(10**309), 0], [1, 0]])
+    with pytest.raises(ValueError, match="dt: must be within float64's range"):
+        make().step(10**400)
+    with pytest.raises(ValueError, match="scene elasticity: must lie in"):
+        Scene(elasticity=10**400)
+    with pytest.raises(ValueError, match="scene bounds: expected numbers within float64's range"):
+        Scene(bounds=(0, 0, 10**400, 1))
+
+
+@pytest.mark.parametrize("mode", ["naive", "posteriori"])
+def test_substeps_are_bounded(mode):
+    from collision_env.engine import MAX_SUBSTEPS
+
+    make(mode=mode, substeps=MAX_SUBSTEPS)
+    with pytest.raises(ValueError, match=f"substeps: must be at most {MAX_SUBSTEPS:,}, got 1,000,000,000"):
+        make(mode=mode, substeps=10**9)
+
+
+#: A bad value of each field of a state (for ``make()``'s two balls), and what the error says.
+BAD_STATE_FIELDS = {
+    "negative mass": ("masses", [-1.0, 2.0], "ball 0: mass must be positive"),
+    "zero radius": ("radii", [0.0, 0.2], "ball 0: radius must be positive"),
+    "overlap": ("positions", [[0.0, 0.0], [0.1, 0.0]], "ball 0: position overlaps ball 1"),
+    "outside": ("positions", [[-5.0, 0.0], [1.0, 0.0]], "ball 0: position must keep the ball inside"),
+    "fast": ("velocities", [[1e200, 0.0], [0.0, 0.0]], "ball 0: velocity must be finite, speed within 1e\\+150"),
+    "cluster index": ("clusters", [0, 2], "state clusters: ball 1: expected 1"),
+    "negative cluster": ("clusters", [-1, 1], "state clusters: ball 0: expected 0"),
+    "time": ("time", 1e300, "state time: must be finite and at most 1e\\+150 s"),
+    "compensation": ("time_compensation", 1e-3, "state time_compensation: must be within an ulp"),
+    "spin": ("omega", [1e200, 0.0], "state omega: ball 0: expected within 1e\\+150 rad/s"),
+}
+
+
+@pytest.mark.parametrize("bad", BAD_STATE_FIELDS, ids=str)
+def test_set_state_refuses_what_the_constructor_refuses_and_changes_nothing(bad):
+    key, value, message = BAD_STATE_FIELDS[bad]
+    sim = make(radii=[0.2, 0.2])
+    sim.step(0.3)
+    before = sim.get_state()
+    with pytest.raises(ValueError, match=message):
+        sim.set_state({**before, key: np.asarray(value)})
+    for k, v in sim.get_state().items():
+        np.testing.assert_array_equal(v, before[k])
+    sim.set_state(before)  # the state itself is good
+
+
+def test_set_state_checks_stick_clusters_and_names_missing_keys():
+    stick = make(scene=Scene(elasticity=0.0, inelastic="stick"), positions=[[-1.0, 0.0], [-0.5, 0.0]], radii=[0.25] * 2)
+    stick.step(0.1)  # the two balls stick
+    state = stick.get_state()
+    assert state["clusters"].tolist() == [0, 0]
+    stick.set_state(state)
+    with pytest.raises(ValueError, match="state clusters: ball 0: expected a ball index whose cluster is its own"):
+        stick.set_state({**state, "clusters": np.array([1, 0])})
+    with pytest.raises(ValueError, match=r"state: missing \['omega'\]"):
+        stick.set_state({k: v for k, v in state.items() if k != "omega"})
+    with pytest.raises(TypeError, match="state: expected a dict"):
+        stick.set_state([1, 2])
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    n=st.integers(2, 6),
+    key=st.sampled_from(["masses", "radii", "velocities", "positions", "clusters", "time"]),
+    ball=st.integers(0, 5),
+    value=st.sampled_from([-1.0, 0.0, 1e151, 1e200, math.inf, -1e300]),
+    mode=st.sampled_from(["exact", "posteriori", "naive"]),
+)
+def test_set_state_refuses_any_bad_value_and_changes_nothing(n, key, ball, value, mode):
+    """A value out of its field's range at any ball, in any mode: a ValueError naming the field
+    (or the ball), the state exactly as before."""
+    ball %= n
+    x = np.linspace(-1.5, 1.5, n)
+    sim = Simulator(Scene(), np.stack([x, np.zeros(n)], 1), np.ones((n, 2)), np.ones(n), np.full(n, 0.1), mode=mode)
+    state = sim.get_state()
+    bad = {k: np.array(v, copy=True) for k, v in state.items()}
+    if key == "clusters":
+        bad[key][ball] = n + 1 if value > 0 else -1
+    elif key == "time":
+        if abs(value) <= 1e150:
+            return  # a good time
+        bad[key] = np.array(value)
+    elif key in ("masses", "radii"):
+        if key == "masses" and 0.0 < value < math.inf:
+            return  # a heavy ball is a good ball (its kinetic energy is finite)
+        bad[key][ball] = value
+    else:
+        if abs(value) <= 1e150:
+            return
+        bad[key][ball, 0] = value
+    with pytest.raises(ValueError, match=f"ball {ball}|state {key}|{key}"):
+        sim.set_state(bad)
+    for k, v in sim.get_state().items():
+        np.testing.assert_array_equal(v, state[k])

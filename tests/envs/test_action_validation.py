@@ -48,3 +48,23 @@ def test_real_actions_of_any_numeric_type_are_taken(action):
     env = gym.make("CollisionEnv/OneBallTarget-v0").unwrapped
     env.reset(seed=0)
     env.step(action)
+
+
+@pytest.mark.parametrize("values, accepted", [([0.5, -0.25], True), ([0.5, None], False), ([0.5, "x"], False)])
+def test_object_arrays_follow_one_rule_in_the_single_and_the_vector_env(values, accepted):
+    """An object array of real numbers is an action like any other; one holding anything else is
+    refused, by the single env and the vector env alike."""
+    env = gym.make("CollisionEnv/OneBallTarget-v0").unwrapped
+    env.reset(seed=0)
+    envs = gym.make_vec("CollisionEnv/OneBallTarget-v0", num_envs=2, vectorization_mode="vector_entry_point")
+    envs.reset(seed=0)
+    single = np.array(values, dtype=object)
+    batch = np.array([values, [0.0, 0.0]], dtype=object)
+    if accepted:
+        env.step(single)
+        envs.step(batch)
+    else:
+        with pytest.raises(ValueError, match="action: expected real numbers"):
+            env.step(single)
+        with pytest.raises(ValueError, match="actions: expected real numbers"):
+            envs.step(batch)

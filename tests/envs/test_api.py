@@ -3,6 +3,7 @@
 import copy
 import importlib.util
 import pickle
+import re
 import warnings
 
 import gymnasium as gym
@@ -119,6 +120,33 @@ def test_get_state_set_state_restores_exactly(env_id):
     env.set_state(copy.deepcopy(state))
     second = [env.step(a) for a in actions] + [env.reset()]
     assert data_equivalence(first, second, exact=True)
+
+
+def test_set_state_names_the_keys_it_expects_and_changes_nothing():
+    env = gym.make("CollisionEnv/Target-v0").unwrapped
+    env.reset(seed=3)
+    envs = gym.make_vec("CollisionEnv/Target-v0", num_envs=2, vectorization_mode="vector_entry_point")
+    envs.reset(seed=3)
+    for target, keys in ((env, "['core', 'rng']"), (envs, "['core', 'autoreset', 'rngs']")):
+        before = target.get_state()
+        with pytest.raises(ValueError, match=re.escape(f"expected a dict with the keys {keys}")):
+            target.set_state({"engine": before["core"]["engine"]})
+        with pytest.raises(TypeError, match="set_state: expected a dict"):
+            target.set_state(None)
+        bad = copy.deepcopy(before)
+        bad["core"]["engine"]["velocities"][0, 0] = (1e200, 0.0)
+        with pytest.raises(ValueError, match="ball 0: velocity must be finite"):
+            target.set_state(bad)
+        assert data_equivalence(before, target.get_state(), exact=True)
+
+
+def test_substeps_beyond_the_engine_bound_are_refused_at_make():
+    from collision_env.engine import MAX_SUBSTEPS
+
+    with pytest.raises(ValueError, match=f"substeps: must be <= {MAX_SUBSTEPS}"):
+        gym.make("CollisionEnv/Target-v0", mode="naive", substeps=10**9)
+    env = gym.make("CollisionEnv/Target-v0", mode="naive", substeps=1000, observe="predicted").unwrapped
+    assert env._core.ahead.substeps == MAX_SUBSTEPS  # the look-ahead's sub-steps, capped at the bound
 
 
 def test_generic_env_reaches_every_preset():
