@@ -9,6 +9,7 @@ See :class:`Simulator` (one scene) and :class:`BatchSimulator` (many scenes at o
 """
 
 from ._jit import BACKEND
+from .impacts import Impact, Impacts
 from .scene import (
     BALL_DENSITY,
     CONSTANT_RADIUS,
@@ -22,7 +23,7 @@ from .scene import (
     Scene,
     radius_from_mass,
 )
-from .simulator import IMPACT_DTYPE, MODES, BatchSimulator, EventCapWarning, Frames, Impact, Simulator, warm_up
+from .simulator import IMPACT_DTYPE, MODES, BatchSimulator, EventCapWarning, Frames, Simulator, warm_up
 
 __all__ = [
     "BACKEND",
@@ -41,6 +42,7 @@ __all__ = [
     "EventCapWarning",
     "Frames",
     "Impact",
+    "Impacts",
     "Scene",
     "Simulator",
     "radius_from_mass",

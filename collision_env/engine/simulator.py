@@ -22,6 +22,7 @@ from ._jit import BACKEND, compile_for
 from .argpack import pack_arrays
 from .broadphase import GRID_MIN_BALLS, grid_geometry
 from .frames import copy_impacts, record_frame
+from .impacts import Impacts
 from .layout import (
     B_INV_MASS,
     B_MASS,
@@ -51,7 +52,6 @@ from .layout import (
 )
 from .modes import MODES as MODE_REGISTRY
 from .physics.motion import apply_impulses
-from .physics.walls import WALL_NAMES
 from .scene import Scene
 from .state import RESUME, RUN_FRAMES, START_STEP, FramesOut, State, aligned_copy, aligned_zeros, pack, with_frames
 from .validation import (
@@ -68,6 +68,29 @@ from .validation import (
 
 #: The engine's mode names, cheapest first.
 MODES = tuple(MODE_REGISTRY)
+
+#: The default event cap's budget per ball and step, and its floor (see :func:`default_event_cap`).
+EVENTS_PER_BALL = 1_000
+MIN_EVENT_CAP = 10_000
+
+
+def default_event_cap(n: int) -> int:
+    """The default cap on events per scene and step for scenes of ``n`` balls:
+    ``max(MIN_EVENT_CAP, EVENTS_PER_BALL * n)`` (10^4, or 1,000 events per ball).
+
+    An ordinary scene never reaches it: a hard-disk gas's collision rate per disk is
+    ``omega = 2 sqrt(pi) rho sigma g(sigma) sqrt(kT/m)`` (Enskog; see :mod:`collision_env.observables`),
+    so the events per ball of a step of ``dt`` are ``omega dt / 2`` plus its wall impacts: about 6 in a
+    1/60 s frame of disks of diameter 0.02 m at unit mean square speed and area fraction 0.7 (a dense
+    fluid, Z = 10.3), 160 times below the budget, whatever the number of disks. What reaches it
+    is a cascade whose event count does not scale with the step: an inelastic collapse, a light
+    ball squeezed by a far heavier one (about ``pi sqrt(M/m)`` collisions, Galperin 2003), a jammed
+    network. Such a scene stops after at most ``EVENTS_PER_BALL`` events per ball (a millisecond or
+    so of work per ball, some hundred frames' worth of the dense gas) with an
+    :class:`EventCapWarning`, in a valid state. A scene whose steps really need more (long steps of
+    a dense gas, say) sets ``max_events``."""
+    return max(MIN_EVENT_CAP, EVENTS_PER_BALL * int(n))
+
 
 #: What a step without impacts returns: one shared array of no rows (read-only, as nothing can be
 #: written to it; a fresh empty structured array costs more than a small scene's step).
@@ -90,17 +113,6 @@ class LiveArrays(NamedTuple):
 
 class EventCapWarning(RuntimeWarning):
     """A scene reached the cap on events per step and stopped early (in a valid state)."""
-
-
-class Impact(NamedTuple):
-    """One collision inside a step (a named tuple: cheap to make, immutable)."""
-
-    time: float  #: absolute simulation time (s)
-    ball: int  #: index of the ball
-    other: int | None  #: index of the other ball, or None for a wall
-    wall: str | None  #: "left" | "right" | "bottom" | "top", or None for a ball-ball impact
-    point: tuple[float, float]  #: contact point (m)
-    speed: float  #: normal closing speed just before the impact (m/s)
 
 
 class Frames(NamedTuple):
@@ -163,7 +175,8 @@ class BatchSimulator:
     max_events:
         Cap on events per scene per step in exact mode. A scene that reaches it stops at its last
         event, in a valid state; :attr:`cap_reached` flags it and an :class:`EventCapWarning` is
-        issued.
+        issued. The default, ``None``, is :func:`default_event_cap` of the ball count: a budget per
+        ball, far above what a gas spends in a frame, so that only a cascade reaches it.
     collapse_ratio, collapse_floor:
         The inelastic-collapse regulariser: a collision whose normal closing speed is at most
         ``u_min = max(collapse_ratio * s, collapse_floor)`` leaves the pair separating at ``u_min``,
@@ -188,7 +201,7 @@ class BatchSimulator:
         *,
         mode: str = "exact",
         substeps: int = 1,
-        max_events: int = 10_000,
+        max_events: int | None = None,
         collapse_ratio: float = 1e-9,
         collapse_floor: float = 0.0,
     ) -> None:
@@ -200,7 +213,8 @@ class BatchSimulator:
         substeps = positive_integer(substeps, "substeps")
         if not spec.substeps and substeps != 1:
             raise ValueError(f"substeps: {mode} mode resolves every event at its exact time; substeps must be 1")
-        max_events = positive_integer(max_events, "max_events")
+        if max_events is not None:
+            max_events = positive_integer(max_events, "max_events")
         if not (is_real(collapse_ratio) and 0.0 <= float(collapse_ratio) < 1.0):
             raise ValueError(f"collapse_ratio: must be a number in [0, 1), got {collapse_ratio!r}")
         if not (is_real(collapse_floor) and 0.0 <= float(collapse_floor) < MAX_MAGNITUDE):
@@ -225,6 +239,8 @@ class BatchSimulator:
             raise ValueError(f"positions: need at least one scene and one ball, got shape {shape}")
         self._n_scenes = n_scenes
         self._n = n
+        if max_events is None:
+            self._max_events = default_event_cap(n)
         self._label = Labels(n_scenes)
         pos, vel, mass, radius = checked_balls(
             scene, self._label, np.arange(n_scenes), n, positions, velocities, masses, radii
@@ -337,16 +353,15 @@ class BatchSimulator:
         number of steps ``time`` is within an ulp of the exact sum of the ``dt`` taken (forward and
         back again returns it to exactly where it was).
         """
-        return self._step(dt, True)
+        return self._step(dt)
 
-    def _step(self, dt, copy, stacklevel=4):
-        """:meth:`step`; with ``copy`` False, exact mode's impacts may come as a view of the impact
-        buffer, valid until the next step (for :meth:`Simulator.step`, which converts them at once)."""
+    def _step(self, dt, stacklevel=4):
+        """:meth:`step`, with the ``stacklevel`` of its warning (see :meth:`_finish`)."""
         dt = real_number(dt, "dt")
         if self._forward and 0.0 < dt <= MAX_MAGNITUDE:  # the common case, checked in one test
             rows = self._kernel(self._pack, dt, START_STEP)
             if rows >= 0:  # no scene stalled or reached the event cap
-                return self._take_impacts(rows, copy) if rows else _NO_IMPACTS
+                return self._take_impacts(rows) if rows else _NO_IMPACTS
             return self._finish(self._run(dt, first_done=True), 1.0, stacklevel)
         check_seconds(dt, "dt")
         if self.scene.bounds is None:
@@ -422,7 +437,7 @@ class BatchSimulator:
             if not (self._forward and 0.0 < dt <= MAX_MAGNITUDE):
                 # backwards or without a border: a step as step takes it (which may make the next
                 # ones forward steps with a border)
-                pieces.append(self._step(dt, True, stacklevel=5))
+                pieces.append(self._step(dt, stacklevel=5))
                 record_frame(f, self._balls, self._time, times, *self._frame_rows(positions, velocities))
                 f += 1
                 continue
@@ -500,13 +515,11 @@ class BatchSimulator:
                 n_imp = self._n_imp
             kernel(self._pack, dt_abs, RESUME)
 
-    def _take_impacts(self, rows, copy=True):
-        """A copy of the first ``rows`` impact records (a view of them if not ``copy``, in exact
-        mode). Exact mode records each scene's impacts in the order they happen, scenes in order;
-        the cheap modes' reconstructed times need sorting within each scene."""
+    def _take_impacts(self, rows):
+        """A copy of the first ``rows`` impact records. Exact mode records each scene's impacts in
+        the order they happen, scenes in order; the cheap modes' reconstructed times need sorting
+        within each scene."""
         if self._spec.sorted_impacts:
-            if not copy:
-                return self._imp[:rows]
             # (numpy copies structured arrays slowly: a byte copy is several times cheaper)
             return np.frombuffer(bytearray(self._imp_bytes[: rows * IMPACT_DTYPE.itemsize]), IMPACT_DTYPE)
         out = np.empty(rows, dtype=IMPACT_DTYPE)
@@ -763,7 +776,7 @@ class Simulator:
     """One scene: the engine's public surface for a single simulation.
 
     ``Simulator(scene, positions (N,2), velocities (N,2), masses (N,), radii=None, mode="exact",
-    substeps=1)``; :meth:`step` returns a list of :class:`Impact` in time order. Everything is a
+    substeps=1)``; :meth:`step` returns the step's :class:`Impacts` in time order. Everything is a
     batch of one over :class:`BatchSimulator`; keyword arguments pass through to it.
     """
 
@@ -802,9 +815,10 @@ class Simulator:
     def mode(self) -> str:
         return self._batch.mode
 
-    def step(self, dt: float) -> list[Impact]:
-        """Advance by ``dt`` seconds (negative: backwards). Returns the step's impacts in time order."""
-        return _impact_list(self._batch._step(dt, False))  # (converted here, before the next step)
+    def step(self, dt: float) -> Impacts:
+        """Advance by ``dt`` seconds (negative: backwards). Returns the step's impacts in time order,
+        as :class:`Impacts` (a sequence of :class:`Impact` over their records)."""
+        return Impacts(self._batch._step(dt))
 
     def frames(self, dt: float, n: int, out: Frames | None = None) -> Frames:
         """``n`` steps of ``dt`` seconds in one call, recording the state after each:
@@ -817,7 +831,7 @@ class Simulator:
         ((120, 1, 2), 2.0, [('right', 0.75)])
         """
         rec = self._batch._frames(dt, n, out, _single_shapes)
-        return Frames(rec.time[:, 0], rec.positions[:, 0], rec.velocities[:, 0], _impact_list(rec.impacts))
+        return Frames(rec.time[:, 0], rec.positions[:, 0], rec.velocities[:, 0], Impacts(rec.impacts))
 
     positions = property(lambda self: self._batch._pos[0].copy(), doc="(N, 2) centres, m (a copy).")
     velocities = property(lambda self: self._batch._vel[0].copy(), doc="(N, 2) velocities, m/s (a copy).")
@@ -870,16 +884,6 @@ class Simulator:
 def _single_shapes(sim, n):
     """The shapes of ``n`` frames of a single simulator (a batch of one without its axis)."""
     return (n,), (n, sim._n, 2), (n, sim._n, 2)
-
-
-def _impact_list(rows: np.ndarray) -> list[Impact]:
-    """Impact records of one scene (:data:`IMPACT_DTYPE`) as :class:`Impact` tuples."""
-    if not len(rows):
-        return []
-    return [
-        Impact(t, ball, None if other < 0 else other, None if wall < 0 else WALL_NAMES[wall], (x, y), speed)
-        for _, t, ball, other, wall, x, y, speed in rows.tolist()
-    ]
 
 
 def warm_up() -> None:
