@@ -53,7 +53,18 @@ from .layout import (
 from .modes import MODES as MODE_REGISTRY
 from .physics.motion import apply_impulses
 from .scene import Scene
-from .state import RESUME, RUN_FRAMES, START_STEP, FramesOut, State, aligned_copy, aligned_zeros, pack, with_frames
+from .state import (
+    RESUME,
+    RUN_FRAMES,
+    START_NEXT,
+    START_STEP,
+    FramesOut,
+    State,
+    aligned_copy,
+    aligned_zeros,
+    pack,
+    with_frames,
+)
 from .validation import (
     MAX_MAGNITUDE,
     Labels,
@@ -96,6 +107,12 @@ def default_event_cap(n: int) -> int:
 #: written to it; a fresh empty structured array costs more than a small scene's step).
 _NO_IMPACTS = np.empty(0, dtype=IMPACT_DTYPE)
 _NO_IMPACTS.flags.writeable = False
+_NO_IMPACTS_SEQ = Impacts(_NO_IMPACTS)  # (Simulator.step's, as shared)
+
+#: The impact buffer grows to hold a step's impacts up to this many rows (72 MB): a step that fills
+#: it is run in calls that each fill it, whose impacts are then joined (a cost per row far below an
+#: event's).
+MAX_IMPACT_ROWS = 1 << 20
 
 
 class LiveArrays(NamedTuple):
@@ -284,6 +301,7 @@ class BatchSimulator:
         # space), and its kernel for this kind of scene
         self._mode_arrays = spec.arrays(scene, n_scenes, n)
         self._kernel = spec.kernel(scene, n)
+        self._after_step = START_NEXT  # (see _step)
         self._invalidate(np.arange(n_scenes))
         self._alloc_work()
 
@@ -306,6 +324,7 @@ class BatchSimulator:
         self._work_f[scenes, W_GRID_X0 : W_GRID_X0 + 4] = origin_and_cells
         self._work_i[scenes, W_GRID_NX : W_GRID_NX + 2] = counts
         self._work_i[scenes, W_CALENDAR_VALID] = 0
+        self._start = START_STEP
 
     def _uses_grid(self):
         """The broad phase pays only in large scenes with ball pairs (and no stick clusters)."""
@@ -356,13 +375,23 @@ class BatchSimulator:
         return self._step(dt)
 
     def _step(self, dt, stacklevel=4):
-        """:meth:`step`, with the ``stacklevel`` of its warning (see :meth:`_finish`)."""
+        """:meth:`step`, with the ``stacklevel`` of its warning (see :meth:`_finish`).
+
+        A step that follows a completed forward step, with nothing changed in between, starts with
+        ``START_NEXT``: the kernel then need not compare every ball with its calendar record, which
+        is most of a small scene's fixed cost. ``_start`` says which: every other way of changing the
+        state (a nudge, ``set_scenes``, ``set_state``, ``load``, a step of another kind, ``frames``)
+        sets it back to ``START_STEP``, and once :meth:`live_arrays` has handed the arrays out, where
+        anyone may write them, it stays there."""
         dt = real_number(dt, "dt")
         if self._forward and 0.0 < dt <= MAX_MAGNITUDE:  # the common case, checked in one test
-            rows = self._kernel(self._pack, dt, START_STEP)
+            rows = self._kernel(self._pack, dt, self._start)
             if rows >= 0:  # no scene stalled or reached the event cap
+                self._start = self._after_step
                 return self._take_impacts(rows) if rows else _NO_IMPACTS
+            self._start = START_STEP
             return self._finish(self._run(dt, first_done=True), 1.0, stacklevel)
+        self._start = START_STEP
         check_seconds(dt, "dt")
         if self.scene.bounds is None:
             check_reach(self._pos, self._vel, dt, self._label)
@@ -422,6 +451,7 @@ class BatchSimulator:
         each public ``frames``, so that a warning names their caller."""
         dt = real_number(dt, "dt")
         check_seconds(dt, "dt")
+        self._start = START_STEP
         if isinstance(n, (bool, np.bool_)) or not isinstance(n, numbers.Integral) or n < 0:
             raise ValueError(f"n: must be a whole number of steps (0 or more), got {n!r}")
         n = int(n)
@@ -433,6 +463,7 @@ class BatchSimulator:
         pieces = []
         f = 0
         buffer = None  # the compiled loop's copy of the impacts
+        size = len(self._imp)
         while f < n:
             if not (self._forward and 0.0 < dt <= MAX_MAGNITUDE):
                 # backwards or without a border: a step as step takes it (which may make the next
@@ -442,22 +473,26 @@ class BatchSimulator:
                 f += 1
                 continue
             if buffer is None:
-                buffer = np.empty(len(self._imp), dtype=IMPACT_DTYPE)
+                buffer = np.empty(size, dtype=IMPACT_DTYPE)
             f, stepped, rows = self._run_frames(dt, f, n, times, positions, velocities, buffer)
-            if rows:
-                pieces.append(buffer[:rows].copy())
+            if rows:  # (kept, if at least half full: the next run gets a buffer of its own)
+                pieces.append(buffer[:rows] if 2 * rows >= len(buffer) else buffer[:rows].copy())
+            buffer = None
             if f == n:
                 break
             # frame f's impacts did not fit (the next frames get a buffer twice the size), or
             # its step needs completing, as step completes it
             if stepped:
                 pieces.append(self._take_impacts(self._n_imp[0]))
-                buffer = np.empty(2 * len(buffer), dtype=IMPACT_DTYPE)
+                size *= 2
             else:
                 pieces.append(self._finish(self._run(dt, first_done=True), 1.0, stacklevel=4))
             record_frame(f, self._balls, self._time, times, *self._frame_rows(positions, velocities))
             f += 1
-        impacts = np.concatenate(pieces) if pieces else _NO_IMPACTS.copy()
+        if len(pieces) == 1:
+            impacts = pieces[0]
+        else:
+            impacts = np.concatenate(pieces) if pieces else _NO_IMPACTS.copy()
         return Frames(times, positions, velocities, impacts)
 
     @staticmethod
@@ -494,6 +529,8 @@ class BatchSimulator:
         if len(chunks) == 1:
             return chunks[0]
         out = np.concatenate(chunks)  # a stalled step: a scene's impacts may span chunks
+        if self._n_scenes == 1:  # (one scene's chunks come in its order: each resumes where the last stopped)
+            return out
         return out[np.lexsort((sign * out["time"], out["scene"]))]
 
     def _run(self, dt_abs, first_done=False):
@@ -509,6 +546,9 @@ class BatchSimulator:
             if rows:
                 chunks.append(self._take_impacts(rows))
             if not n_imp[2]:  # no scene stalled
+                if len(chunks) > 1:  # the next steps like this one fit the buffer, up to MAX_IMPACT_ROWS
+                    total = sum(len(chunk) for chunk in chunks)
+                    self._alloc_work(max(len(self._imp), min(MAX_IMPACT_ROWS, 1 << (total - 1).bit_length())))
                 return chunks
             if not rows:  # not even one sub-step's worst case fits: a bigger buffer
                 self._alloc_work(2 * len(self._imp))
@@ -521,7 +561,7 @@ class BatchSimulator:
         within each scene."""
         if self._spec.sorted_impacts:
             # (numpy copies structured arrays slowly: a byte copy is several times cheaper)
-            return np.frombuffer(bytearray(self._imp_bytes[: rows * IMPACT_DTYPE.itemsize]), IMPACT_DTYPE)
+            return np.ndarray(rows, IMPACT_DTYPE, bytearray(self._imp_bytes[: rows * IMPACT_DTYPE.itemsize]))
         out = np.empty(rows, dtype=IMPACT_DTYPE)
         copy_impacts(self._imp, out, self._sign)
         return out
@@ -576,7 +616,9 @@ class BatchSimulator:
     def live_arrays(self) -> LiveArrays:
         """The engine's own state arrays, not copies, for compiled kernels that read them every
         step (the envs' kernels). Every step updates them in place. Treat them as read-only, except
-        through the engine's own kernels (``motion.apply_impulses`` is how the envs nudge)."""
+        through the engine's own kernels (``motion.apply_impulses`` is how the envs nudge).
+        From then on every step compares each ball with the state the last step left it in."""
+        self._start = self._after_step = START_STEP
         return self._live
 
     @property
@@ -618,6 +660,7 @@ class BatchSimulator:
         """
         if check:
             dv = checked_nudge(dv, self.scene, self._vel, self._mass, self._label)
+        self._start = START_STEP
         apply_impulses(self._balls, self._body, dv, self.scene.sticky)
 
     def set_scenes(
@@ -735,11 +778,12 @@ class BatchSimulator:
                 np.copyto(mine, theirs)
         self._sign = other._sign
         self._forward = other._forward
+        self._start = START_STEP
 
     #: What a copy or a pickle rebuilds rather than carries: work space, and what is bound to it.
     _REBUILT = (
         "_imp", "_imp_bytes", "_n_imp", "_kernel", "_state", "_pack", "_sign", "_forward", "_live", "_pos", "_vel",
-        "_mass", "_inv_mass", "_radius", "_omega", "_label", "_spec",
+        "_mass", "_inv_mass", "_radius", "_omega", "_label", "_spec", "_start", "_after_step",
     )  # fmt: skip
 
     def __getstate__(self):
@@ -760,6 +804,8 @@ class BatchSimulator:
         self._mode_arrays = kept + fresh[len(kept) :]
         self._kernel = self._spec.kernel(self.scene, self._n)
         self._label = Labels(self._n_scenes)
+        self._start = START_STEP
+        self._after_step = START_NEXT
         self._bind_views()
         self._alloc_work()
 
@@ -818,7 +864,8 @@ class Simulator:
     def step(self, dt: float) -> Impacts:
         """Advance by ``dt`` seconds (negative: backwards). Returns the step's impacts in time order,
         as :class:`Impacts` (a sequence of :class:`Impact` over their records)."""
-        return Impacts(self._batch._step(dt))
+        rows = self._batch._step(dt)
+        return _NO_IMPACTS_SEQ if rows is _NO_IMPACTS else Impacts(rows)
 
     def frames(self, dt: float, n: int, out: Frames | None = None) -> Frames:
         """``n`` steps of ``dt`` seconds in one call, recording the state after each:
