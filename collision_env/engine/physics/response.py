@@ -112,7 +112,7 @@ def separation_speed(closing_speed, e, u_min):
     return e * closing_speed if closing_speed > u_min else u_min
 
 
-@njit(inline="always")
+@njit(refcount=False, forceinline=True)
 def normal_impulse(closing_speed, e, u_min, inv_mass_sum):
     """The normal impulse (N s) of an impact whose response :func:`ball_ball` or :func:`ball_wall`
     gave: the momentum change along the normal of either ball of a pair, ``(u + u') / (w_i + w_j)``
