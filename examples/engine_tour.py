@@ -12,6 +12,7 @@ import time
 import numpy as np
 
 from collision_env.engine import BACKEND, PLAY_AREA_1D, Scene, Simulator
+from collision_env.observables import reduced_pressure, wall_pressure
 
 
 def head_on():
@@ -80,11 +81,12 @@ def explore_1d():
 
 
 def gas_pressure(n=400, radius=0.01, packing=0.3, seed=0):
-    """A hard-disk gas sampled in frames: its pressure on the walls (the impulse of the wall impacts
-    over the wall length and the time) against Henderson's equation of state,
-    P A / (N kT) = (1 + eta^2 / 8) / (1 - eta)^2 (Henderson 1975, Mol. Phys. 30:971). The walls of a
-    box of a few hundred disks raise it by a few per cent; the excess shrinks as the perimeter over
-    the area, as 1 / sqrt(N) (try ``gas_pressure(n=10_000)``)."""
+    """A hard-disk gas sampled in frames: its pressure from the collision virial and on the walls
+    (the impulses of the wall impacts over the length the centres reach and the time, times the
+    area they reach, over the kinetic energy), see ``collision_env.observables``, against
+    Henderson's equation of state, P A / (N kT) = (1 + eta^2 / 8) / (1 - eta)^2 (Henderson 1975,
+    Mol. Phys. 30:971). The walls of a box of a few hundred disks shift it by a few per cent; the
+    difference shrinks as the perimeter over the area, as 1 / sqrt(N) (try ``gas_pressure(n=10_000)``)."""
     side = np.sqrt(n * np.pi * radius**2 / packing)
     per_row = int(np.ceil(np.sqrt(n)))
     grid = (np.arange(per_row) + 0.5) * side / per_row - side / 2
@@ -96,15 +98,14 @@ def gas_pressure(n=400, radius=0.01, packing=0.3, seed=0):
     start = time.perf_counter()
     rec = sim.frames(1 / 60, 600)  # ten seconds, sampled at 60 Hz
     seconds = time.perf_counter() - start
-    impulse = sum(2.0 * hit.speed for hit in rec.impacts if hit.wall is not None)  # m = 1, e = 1
-    pressure = impulse / (4.0 * side * 600 / 60)
-    kT = 0.5 * np.mean(np.sum(rec.velocities**2, axis=-1))  # 2D: kT is the mean kinetic energy per disk
-    z = pressure * side**2 / (n * kT)
+    duration, energy = 600 / 60, sim.kinetic_energy()
+    z_virial = reduced_pressure(rec.impacts, sim.radii, duration, energy)
+    z_walls = wall_pressure(rec.impacts, duration, box.bounds, radius) * (side - 2 * radius) ** 2 / energy
     henderson = (1 + packing**2 / 8) / (1 - packing) ** 2
     print(
         f"\n{n}-disk gas at area fraction {packing}, 600 frames of 1/60 s in one call ({len(rec.impacts)} "
-        f"impacts, {seconds * 1e3:.0f} ms): P A / (N kT) = {z:.3f} from the walls, {henderson:.3f} by "
-        "Henderson's equation of state"
+        f"impacts, {seconds * 1e3:.0f} ms): P A / (N kT) = {z_virial:.3f} from the collision virial, "
+        f"{z_walls:.3f} from the walls, {henderson:.3f} by Henderson's equation of state"
     )
 
 

@@ -38,7 +38,7 @@ def render_episode(env_id: str, seed: int, ppm: float, every: int):
     still, hit_at = None, None
     for t in range(env.config.n_steps):
         _, _, term, trunc, info = env.step(policy())
-        renderer.record(core, 0, info["impacts"].records)
+        renderer.record(core, 0, info["impacts"].array)
         frame = renderer.draw(core, 0)
         if hit_at is None and info["targets_hit"] > 0:
             hit_at = t

@@ -45,7 +45,7 @@ def _env_rollout(env_id, mode, options, out):
         obs, reward, terminated, truncated, info = env.step(rng.uniform(-1, 1, env.action_space.shape))
         rows.append(obs)
         rewards.append((reward, terminated, truncated))
-        impacts.append(_impacts(info["impacts"].records))
+        impacts.append(_impacts(info["impacts"].array))
         if terminated or truncated:
             obs, _ = env.reset()
             rows.append(obs)

@@ -11,8 +11,10 @@ tuples, into that form.
   the reference sees collide but the run never reports at all is *tunnelled*.
 - :func:`drift`, :func:`final_state_error`, :func:`escapes`, :func:`wall_penetration`,
   :func:`max_overlap`: conservation and validity of states.
-- :func:`ks_rayleigh`, :func:`henderson_g`, :func:`enskog_rate`: statistical checks for long runs of
-  an elastic gas (2D Maxwell-Boltzmann speeds, collision frequency).
+- :func:`ks_rayleigh`, and :func:`~collision_env.observables.henderson_g` and
+  :func:`~collision_env.observables.enskog_rate` (from :mod:`collision_env.observables`):
+  statistical checks for long runs of an elastic gas (2D Maxwell-Boltzmann speeds, collision
+  frequency).
 - :func:`kolafa_rottner_z`, :func:`henderson_z`: the hard-disk fluid's equation of state, the
   compressibility factor ``Z = P A / (N kT)`` at area fraction ``eta``.
 """
@@ -27,6 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from collision_env.engine import WALL_NAMES
+from collision_env.observables import enskog_rate, henderson_g  # noqa: F401  (the bench's statistical checks)
 
 IMPACTS = np.dtype(
     [
@@ -347,16 +350,6 @@ def ks_rayleigh(speeds: ArrayLike, masses: ArrayLike | None = None, kT: float | 
 def ks_critical(n_samples: int, alpha: float = 0.05) -> float:
     """Asymptotic critical KS distance for ``n_samples`` independent samples at level ``alpha``."""
     return math.sqrt(-0.5 * math.log(alpha / 2.0)) / math.sqrt(n_samples)
-
-
-def henderson_g(packing: float) -> float:
-    """Henderson's contact value of the hard-disk pair correlation: ``(1 - 7 eta / 16) / (1 - eta)^2``."""
-    return (1.0 - 7.0 * packing / 16.0) / (1.0 - packing) ** 2
-
-
-def enskog_rate(density: float, diameter: float, packing: float, kT: float, mass: float) -> float:
-    """Enskog collision frequency per disk in 2D: ``nu = 2 n sigma g(sigma) sqrt(pi kT / m)``."""
-    return 2.0 * density * diameter * henderson_g(packing) * math.sqrt(math.pi * kT / mass)
 
 
 #: Kolafa & Rottner's fit of the hard-disk compressibility factor, ``Z = sum_i C_i x^i`` with

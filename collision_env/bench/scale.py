@@ -23,7 +23,14 @@ lattice with Maxwell-Boltzmann velocities (unit mean square speed). For each siz
 It also times the 50-disk gas of the engine benchmark (r = 0.02 in [-1, 1]^2) as one long step
 and in frames: frames stepped from Python cost one call each (about a microsecond of argument
 passing before any physics), against one call for the long step; ``BatchSimulator.frames`` runs
-the same frames in one call and records each.
+the same frames in one call and records each; ``Simulator.step`` in a Python loop is the public
+API's cost of the same frames.
+
+The public API's cost per event (:func:`bench_public`): the 10^4-disk gas in frames of 1/60 s
+through ``Simulator.step`` and ``Simulator.frames`` (each frame's impacts as an ``Impacts`` over a
+copy of the records, no Python object per impact), against the kernel stepping the same frames
+(one compiled call per frame, its impacts left in the engine's buffer), the variants taking turns
+from the same start state.
 
 Times are wall-clock times on a shared machine: compare the figures of one run with each other
 (the cost per event across sizes), not across runs. Compiled kernels are warmed up first, and
@@ -42,8 +49,9 @@ from collections.abc import Callable, Iterable
 
 import numpy as np
 
-from collision_env.engine import BatchSimulator, Scene, warm_up
+from collision_env.engine import BatchSimulator, Scene, Simulator, warm_up
 from collision_env.engine.broadphase import first_overlap
+from collision_env.engine.state import RESUME, START_STEP
 
 from .machine import cpus, machine, timestamp, versions
 from .metrics import enskog_rate
@@ -212,10 +220,15 @@ def bench_frames(n: int = 50, horizon: float = 20.0, repeats: int = 5) -> dict:
             sim = BatchSimulator(
                 scene, pos[None], vel[None], np.ones(n), radii=np.full(n, GAS_RADIUS), max_events=10**7
             )
+            single = Simulator(scene, pos, vel, np.ones(n), radii=np.full(n, GAS_RADIUS))
             t0 = time.perf_counter()
             if how == "step loop":
                 for _ in range(n_frames):
                     sim.step(FRAME)
+            elif how == "Simulator.step loop":
+                for _ in range(n_frames):
+                    single.step(FRAME)
+                sim = single.batch
             elif how == "frames call":
                 sim.frames(FRAME, n_frames)
             elif how == "frames call, given arrays":
@@ -239,7 +252,7 @@ def bench_frames(n: int = 50, horizon: float = 20.0, repeats: int = 5) -> dict:
 
     warm = BatchSimulator(scene, pos[None], vel[None], np.ones(n), radii=np.full(n, GAS_RADIUS))
     reused = warm.frames(FRAME, n_frames)  # (the warm-up, and the arrays the last variant records into)
-    one_step, in_frames = run("one step"), run("step loop")
+    one_step, in_frames, public = run("one step"), run("step loop"), run("Simulator.step loop")
     in_one_call, into_given = run("frames call"), run("frames call, given arrays")
     return {
         "n": n,
@@ -248,12 +261,64 @@ def bench_frames(n: int = 50, horizon: float = 20.0, repeats: int = 5) -> dict:
         "one_step_events_per_s": one_step,
         "frames_events_per_s": in_frames,
         "frames_over_one_step": in_frames / one_step,
+        "public_frames_events_per_s": public,
+        "public_frames_over_one_step": public / one_step,
         "frames_call_events_per_s": in_one_call,
         "frames_call_over_one_step": in_one_call / one_step,
         "frames_given_events_per_s": into_given,
         "frames_given_over_one_step": into_given / one_step,
         "empty_frame_us": 1e6 * empty_frame(),
     }
+
+
+def bench_public(n: int = 10_000, frames: int = 60, rounds: int = 3) -> dict:
+    """Events per second on the ``n``-disk gas in ``frames`` frames of 1/60 s: through
+    ``Simulator.step`` (a Python loop), ``Simulator.frames`` (one call), and the kernel (one compiled
+    call per frame, what ``step`` costs before its impacts are handed over), each the fastest of
+    ``rounds`` rounds in which the variants take turns from the same melted start state."""
+    scene, pos, vel = lattice_gas(n)
+    sim = Simulator(scene, pos, vel, np.ones(n), radii=np.full(n, RADIUS))  # (the default event cap)
+    nu = enskog_rate(n / _area(scene), 2 * RADIUS, PACKING, sim.kinetic_energy() / n, 1.0)
+    sim.frames(FRAME, max(1, math.ceil(WARM_COLLISIONS / nu / FRAME)))
+    start = sim.get_state()
+    batch = sim.batch
+
+    def kernel():
+        for _ in range(frames):
+            if batch._kernel(batch._pack, FRAME, START_STEP) < 0:
+                while batch._n_imp[2]:  # (a full impact buffer stopped the step: go on, as step does)
+                    batch._kernel(batch._pack, FRAME, RESUME)
+
+    def step():
+        for _ in range(frames):
+            sim.step(FRAME)
+
+    variants = {"kernel": kernel, "Simulator.step": step, "Simulator.frames": lambda: sim.frames(FRAME, frames)}
+    best = dict.fromkeys(variants, 0.0)
+    for _ in range(rounds):
+        for name, fn in variants.items():
+            sim.set_state(start)
+            sim.step(FRAME)  # (the calendar predicted afresh after set_state: not timed)
+            events = sim.stats["events"]
+            t0 = time.perf_counter()
+            fn()
+            best[name] = max(best[name], (sim.stats["events"] - events) / (time.perf_counter() - t0))
+    return {
+        "n": n,
+        "frames": frames,
+        "kernel_events_per_s": best["kernel"],
+        "step_events_per_s": best["Simulator.step"],
+        "frames_events_per_s": best["Simulator.frames"],
+        "step_over_kernel": best["Simulator.step"] / best["kernel"],
+        "frames_over_kernel": best["Simulator.frames"] / best["kernel"],
+        "capped": bool(sim.cap_reached),
+    }
+
+
+def _area(scene: Scene) -> float:
+    assert scene.bounds is not None  # (the gas's box)
+    xmin, ymin, xmax, ymax = scene.bounds
+    return (xmax - xmin) * (ymax - ymin)
 
 
 def run(quick: bool = False, log: Callable[[str], None] = print) -> dict:
@@ -265,8 +330,15 @@ def run(quick: bool = False, log: Callable[[str], None] = print) -> dict:
     frames = bench_frames(repeats=3 if quick else 7)
     log(
         f"  50-disk gas: frames keep {100 * frames['frames_over_one_step']:.0f} % of the one-step event rate "
-        f"stepped from Python, {100 * frames['frames_call_over_one_step']:.0f} % in one frames call, "
+        f"stepped from Python, {100 * frames['public_frames_over_one_step']:.0f} % through Simulator.step, "
+        f"{100 * frames['frames_call_over_one_step']:.0f} % in one frames call, "
         f"{100 * frames['frames_given_over_one_step']:.0f} % recording into given arrays"
+    )
+    public = bench_public()
+    log(
+        f"  {public['n']:,}-disk gas: Simulator.step {public['step_events_per_s']:.3g} events/s "
+        f"({100 * public['step_over_kernel']:.0f} % of the kernel's {public['kernel_events_per_s']:.3g}), "
+        f"Simulator.frames {public['frames_events_per_s']:.3g} ({100 * public['frames_over_kernel']:.0f} %)"
     )
     return {
         "machine": machine(),
@@ -277,6 +349,7 @@ def run(quick: bool = False, log: Callable[[str], None] = print) -> dict:
         "min_slice_s": MIN_SLICE_S,
         "sizes": rows,
         "frames": frames,
+        "public": public,
         "seconds": time.perf_counter() - t0,
     }
 
@@ -307,6 +380,7 @@ def render_markdown(results: dict) -> str:
             f"| {r['energy_rel_change']:.1e} | {r['rate_ratio']:.3f} |"
         )
     f = results["frames"]
+    p = results["public"]
     lines += [
         "",
         f"The {f['n']}-disk gas of the engine benchmark over {f['horizon_s']:g} s: one step "
@@ -319,7 +393,16 @@ def render_markdown(results: dict) -> str:
         f"({1e6 / f['one_step_events_per_s']:.2f} µs in the long step); a frame stepped from Python costs "
         f"{f['empty_frame_us']:.2f} µs even without one (the call from Python and a pass over the balls that "
         "brings them to the frame's end); `frames` makes that call once for all its frames, and new arrays "
-        "cost the operating system's first touch of each of their pages.",
+        "cost the operating system's first touch of each of their pages. The public API, "
+        f"`Simulator.step` in a Python loop, keeps {f['public_frames_events_per_s']:.3g} events/s "
+        f"({100 * f['public_frames_over_one_step']:.0f} % of the one-step rate).",
+        "",
+        f"The public API on the {p['n']:,}-disk gas, {p['frames']} frames of 1/60 s from the same start state "
+        f"(the fastest of rounds that take turns): `Simulator.step` {p['step_events_per_s']:.3g} events/s "
+        f"({100 * p['step_over_kernel']:.0f} % of the kernel's {p['kernel_events_per_s']:.3g} events/s, stepping the "
+        f"same frames with its impacts left in its buffer), `Simulator.frames` {p['frames_events_per_s']:.3g} "
+        f"events/s ({100 * p['frames_over_kernel']:.0f} %). Each frame's impacts come as an `Impacts` over a copy "
+        "of their records: no Python object per impact.",
     ]
     return "\n".join(lines)
 

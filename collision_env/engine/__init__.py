@@ -10,6 +10,7 @@ See :class:`Simulator` (one scene) and :class:`BatchSimulator` (many scenes at o
 
 from ._jit import BACKEND
 from .gas import Gas, disk_gas
+from .impacts import Impact, Impacts
 from .keywords import UnknownKeywordError
 from .scene import (
     BALL_DENSITY,
@@ -31,7 +32,6 @@ from .simulator import (
     BatchSimulator,
     EventCapWarning,
     Frames,
-    Impact,
     Simulator,
     warm_up,
 )
@@ -55,6 +55,7 @@ __all__ = [
     "Frames",
     "Gas",
     "Impact",
+    "Impacts",
     "Scene",
     "Simulator",
     "UnknownKeywordError",

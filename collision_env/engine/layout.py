@@ -122,6 +122,7 @@ IMPACT_DTYPE = np.dtype(
         ("x", np.float64),
         ("y", np.float64),
         ("speed", np.float64),  # normal closing speed just before the impact
+        ("impulse", np.float64),  # normal impulse (N s): see collision_env.engine.impacts
     ]
 )
 

@@ -23,6 +23,7 @@ from ._jit import BACKEND, compile_for
 from .argpack import pack_arrays
 from .broadphase import GRID_MIN_BALLS, grid_geometry
 from .frames import copy_impacts, record_frame
+from .impacts import Impacts
 from .keywords import check_keywords
 from .layout import (
     B_INV_MASS,
@@ -53,9 +54,19 @@ from .layout import (
 )
 from .modes import MODES as MODE_REGISTRY
 from .physics.motion import apply_impulses
-from .physics.walls import WALL_NAMES
 from .scene import Scene
-from .state import RESUME, RUN_FRAMES, START_STEP, FramesOut, State, aligned_copy, aligned_zeros, pack, with_frames
+from .state import (
+    RESUME,
+    RUN_FRAMES,
+    START_NEXT,
+    START_STEP,
+    FramesOut,
+    State,
+    aligned_copy,
+    aligned_zeros,
+    pack,
+    with_frames,
+)
 from .validation import (
     MAX_MAGNITUDE,
     MAX_SUBSTEPS,
@@ -72,10 +83,39 @@ from .validation import (
 #: The engine's mode names, cheapest first.
 MODES = tuple(MODE_REGISTRY)
 
+#: The default event cap's budget per ball and step, and its floor (see :func:`default_event_cap`).
+EVENTS_PER_BALL = 1_000
+MIN_EVENT_CAP = 10_000
+
+
+def default_event_cap(n: int) -> int:
+    """The default cap on events per scene and step for scenes of ``n`` balls:
+    ``max(MIN_EVENT_CAP, EVENTS_PER_BALL * n)`` (10^4, or 1,000 events per ball).
+
+    An ordinary scene never reaches it: a hard-disk gas's collision rate per disk is
+    ``omega = 2 sqrt(pi) rho sigma g(sigma) sqrt(kT/m)`` (Enskog; see :mod:`collision_env.observables`),
+    so the events per ball of a step of ``dt`` are ``omega dt / 2`` plus its wall impacts: about 6 in a
+    1/60 s frame of disks of diameter 0.02 m at unit mean square speed and area fraction 0.7 (a dense
+    fluid, Z = 10.3), 160 times below the budget, whatever the number of disks. What reaches it
+    is a cascade whose event count does not scale with the step: an inelastic collapse, a light
+    ball squeezed by a far heavier one (about ``pi sqrt(M/m)`` collisions, Galperin 2003), a jammed
+    network. Such a scene stops after at most ``EVENTS_PER_BALL`` events per ball (a millisecond or
+    so of work per ball, some hundred frames' worth of the dense gas) with an
+    :class:`EventCapWarning`, in a valid state. A scene whose steps really need more (long steps of
+    a dense gas, say) sets ``max_events``."""
+    return max(MIN_EVENT_CAP, EVENTS_PER_BALL * int(n))
+
+
 #: What a step without impacts returns: one shared array of no rows (read-only, as nothing can be
 #: written to it; a fresh empty structured array costs more than a small scene's step).
 _NO_IMPACTS = np.empty(0, dtype=IMPACT_DTYPE)
 _NO_IMPACTS.flags.writeable = False
+_NO_IMPACTS_SEQ = Impacts(_NO_IMPACTS)  # (Simulator.step's, as shared)
+
+#: The impact buffer grows to hold a step's impacts up to this many rows (72 MB): a step that fills
+#: it is run in calls that each fill it, whose impacts are then joined (a cost per row far below an
+#: event's).
+MAX_IMPACT_ROWS = 1 << 20
 
 
 class LiveArrays(NamedTuple):
@@ -93,17 +133,6 @@ class LiveArrays(NamedTuple):
 
 class EventCapWarning(RuntimeWarning):
     """A scene reached the cap on events per step and stopped early (in a valid state)."""
-
-
-class Impact(NamedTuple):
-    """One collision inside a step (a named tuple: cheap to make, immutable)."""
-
-    time: float  #: absolute simulation time (s)
-    ball: int  #: index of the ball
-    other: int | None  #: index of the other ball, or None for a wall
-    wall: str | None  #: "left" | "right" | "bottom" | "top", or None for a ball-ball impact
-    point: tuple[float, float]  #: contact point (m)
-    speed: float  #: normal closing speed just before the impact (m/s)
 
 
 class Frames(NamedTuple):
@@ -167,7 +196,8 @@ class BatchSimulator:
     max_events:
         Cap on events per scene per step in exact mode. A scene that reaches it stops at its last
         event, in a valid state; :attr:`cap_reached` flags it and an :class:`EventCapWarning` is
-        issued.
+        issued. The default, ``None``, is :func:`default_event_cap` of the ball count: a budget per
+        ball, far above what a gas spends in a frame, so that only a cascade reaches it.
     collapse_ratio, collapse_floor:
         The inelastic-collapse regulariser: a collision whose normal closing speed is at most
         ``u_min = max(collapse_ratio * s, collapse_floor)`` leaves the pair separating at ``u_min``,
@@ -199,7 +229,7 @@ class BatchSimulator:
         *,
         mode: str = "exact",
         substeps: int = 1,
-        max_events: int = 10_000,
+        max_events: int | None = None,
         collapse_ratio: float = 1e-9,
         collapse_floor: float = 0.0,
     ) -> None:
@@ -211,7 +241,8 @@ class BatchSimulator:
         substeps = positive_integer(substeps, "substeps", MAX_SUBSTEPS)
         if not spec.substeps and substeps != 1:
             raise ValueError(f"substeps: {mode} mode resolves every event at its exact time; substeps must be 1")
-        max_events = positive_integer(max_events, "max_events")
+        if max_events is not None:
+            max_events = positive_integer(max_events, "max_events")
         if not (is_real(collapse_ratio) and 0.0 <= float(collapse_ratio) < 1.0):
             raise ValueError(f"collapse_ratio: must be a number in [0, 1), got {collapse_ratio!r}")
         if not (is_real(collapse_floor) and 0.0 <= float(collapse_floor) < MAX_MAGNITUDE):
@@ -236,6 +267,8 @@ class BatchSimulator:
             raise ValueError(f"positions: need at least one scene and one ball, got shape {shape}")
         self._n_scenes = n_scenes
         self._n = n
+        if max_events is None:
+            self._max_events = default_event_cap(n)
         self._label = Labels(n_scenes, self._single)
         pos, vel, mass, radius = checked_balls(
             scene, self._label, np.arange(n_scenes), n, positions, velocities, masses, radii
@@ -279,6 +312,7 @@ class BatchSimulator:
         # space), and its kernel for this kind of scene
         self._mode_arrays = spec.arrays(scene, n_scenes, n)
         self._kernel = spec.kernel(scene, n)
+        self._after_step = START_NEXT  # (see _step)
         self._invalidate(np.arange(n_scenes))
         self._alloc_work()
 
@@ -301,6 +335,7 @@ class BatchSimulator:
         self._work_f[scenes, W_GRID_X0 : W_GRID_X0 + 4] = origin_and_cells
         self._work_i[scenes, W_GRID_NX : W_GRID_NX + 2] = counts
         self._work_i[scenes, W_CALENDAR_VALID] = 0
+        self._start = START_STEP
 
     def _uses_grid(self):
         """The broad phase pays only in large scenes with ball pairs (and no stick clusters)."""
@@ -348,17 +383,26 @@ class BatchSimulator:
         number of steps ``time`` is within an ulp of the exact sum of the ``dt`` taken (forward and
         back again returns it to exactly where it was).
         """
-        return self._step(dt, True)
+        return self._step(dt)
 
-    def _step(self, dt, copy, stacklevel=4):
-        """:meth:`step`; with ``copy`` False, exact mode's impacts may come as a view of the impact
-        buffer, valid until the next step (for :meth:`Simulator.step`, which converts them at once)."""
+    def _step(self, dt, stacklevel=4):
+        """:meth:`step`, with the ``stacklevel`` of its warning (see :meth:`_finish`).
+
+        A step that follows a completed forward step, with nothing changed in between, starts with
+        ``START_NEXT``: the kernel then need not compare every ball with its calendar record, which
+        is most of a small scene's fixed cost. ``_start`` says which: every other way of changing the
+        state (a nudge, ``set_scenes``, ``set_state``, ``load``, a step of another kind, ``frames``)
+        sets it back to ``START_STEP``, and once :meth:`live_arrays` has handed the arrays out, where
+        anyone may write them, it stays there."""
         dt = real_number(dt, "dt")
         if self._forward and 0.0 < dt <= MAX_MAGNITUDE:  # the common case, checked in one test
-            rows = self._kernel(self._pack, dt, START_STEP)
+            rows = self._kernel(self._pack, dt, self._start)
             if rows >= 0:  # no scene stalled or reached the event cap
-                return self._take_impacts(rows, copy) if rows else _NO_IMPACTS
+                self._start = self._after_step
+                return self._take_impacts(rows) if rows else _NO_IMPACTS
+            self._start = START_STEP
             return self._finish(self._run(dt, first_done=True), 1.0, stacklevel)
+        self._start = START_STEP
         check_seconds(dt, "dt")
         if self.scene.bounds is None:
             check_reach(self._pos, self._vel, dt, self._label)
@@ -418,6 +462,7 @@ class BatchSimulator:
         each public ``frames``, so that a warning names their caller."""
         dt = real_number(dt, "dt")
         check_seconds(dt, "dt")
+        self._start = START_STEP
         if isinstance(n, (bool, np.bool_)) or not isinstance(n, numbers.Integral) or n < 0:
             raise ValueError(f"n: must be a whole number of steps (0 or more), got {n!r}")
         n = int(n)
@@ -429,31 +474,36 @@ class BatchSimulator:
         pieces = []
         f = 0
         buffer = None  # the compiled loop's copy of the impacts
+        size = len(self._imp)
         while f < n:
             if not (self._forward and 0.0 < dt <= MAX_MAGNITUDE):
                 # backwards or without a border: a step as step takes it (which may make the next
                 # ones forward steps with a border)
-                pieces.append(self._step(dt, True, stacklevel=5))
+                pieces.append(self._step(dt, stacklevel=5))
                 record_frame(f, self._balls, self._time, times, *self._frame_rows(positions, velocities))
                 f += 1
                 continue
             if buffer is None:
-                buffer = np.empty(len(self._imp), dtype=IMPACT_DTYPE)
+                buffer = np.empty(size, dtype=IMPACT_DTYPE)
             f, stepped, rows = self._run_frames(dt, f, n, times, positions, velocities, buffer)
-            if rows:
-                pieces.append(buffer[:rows].copy())
+            if rows:  # (kept, if at least half full: the next run gets a buffer of its own)
+                pieces.append(buffer[:rows] if 2 * rows >= len(buffer) else buffer[:rows].copy())
+            buffer = None
             if f == n:
                 break
             # frame f's impacts did not fit (the next frames get a buffer twice the size), or
             # its step needs completing, as step completes it
             if stepped:
                 pieces.append(self._take_impacts(self._n_imp[0]))
-                buffer = np.empty(2 * len(buffer), dtype=IMPACT_DTYPE)
+                size *= 2
             else:
                 pieces.append(self._finish(self._run(dt, first_done=True), 1.0, stacklevel=4))
             record_frame(f, self._balls, self._time, times, *self._frame_rows(positions, velocities))
             f += 1
-        impacts = np.concatenate(pieces) if pieces else _NO_IMPACTS.copy()
+        if len(pieces) == 1:
+            impacts = pieces[0]
+        else:
+            impacts = np.concatenate(pieces) if pieces else _NO_IMPACTS.copy()
         return Frames(times, positions, velocities, impacts)
 
     @staticmethod
@@ -490,6 +540,8 @@ class BatchSimulator:
         if len(chunks) == 1:
             return chunks[0]
         out = np.concatenate(chunks)  # a stalled step: a scene's impacts may span chunks
+        if self._n_scenes == 1:  # (one scene's chunks come in its order: each resumes where the last stopped)
+            return out
         return out[np.lexsort((sign * out["time"], out["scene"]))]
 
     def _run(self, dt_abs, first_done=False):
@@ -505,21 +557,22 @@ class BatchSimulator:
             if rows:
                 chunks.append(self._take_impacts(rows))
             if not n_imp[2]:  # no scene stalled
+                if len(chunks) > 1:  # the next steps like this one fit the buffer, up to MAX_IMPACT_ROWS
+                    total = sum(len(chunk) for chunk in chunks)
+                    self._alloc_work(max(len(self._imp), min(MAX_IMPACT_ROWS, 1 << (total - 1).bit_length())))
                 return chunks
             if not rows:  # not even one sub-step's worst case fits: a bigger buffer
                 self._alloc_work(2 * len(self._imp))
                 n_imp = self._n_imp
             kernel(self._pack, dt_abs, RESUME)
 
-    def _take_impacts(self, rows, copy=True):
-        """A copy of the first ``rows`` impact records (a view of them if not ``copy``, in exact
-        mode). Exact mode records each scene's impacts in the order they happen, scenes in order;
-        the cheap modes' reconstructed times need sorting within each scene."""
+    def _take_impacts(self, rows):
+        """A copy of the first ``rows`` impact records. Exact mode records each scene's impacts in
+        the order they happen, scenes in order; the cheap modes' reconstructed times need sorting
+        within each scene."""
         if self._spec.sorted_impacts:
-            if not copy:
-                return self._imp[:rows]
             # (numpy copies structured arrays slowly: a byte copy is several times cheaper)
-            return np.frombuffer(bytearray(self._imp_bytes[: rows * IMPACT_DTYPE.itemsize]), IMPACT_DTYPE)
+            return np.ndarray(rows, IMPACT_DTYPE, bytearray(self._imp_bytes[: rows * IMPACT_DTYPE.itemsize]))
         out = np.empty(rows, dtype=IMPACT_DTYPE)
         copy_impacts(self._imp, out, self._sign)
         return out
@@ -581,7 +634,9 @@ class BatchSimulator:
     def live_arrays(self) -> LiveArrays:
         """The engine's own state arrays, not copies, for compiled kernels that read them every
         step (the envs' kernels). Every step updates them in place. Treat them as read-only, except
-        through the engine's own kernels (``motion.apply_impulses`` is how the envs nudge)."""
+        through the engine's own kernels (``motion.apply_impulses`` is how the envs nudge).
+        From then on every step compares each ball with the state the last step left it in."""
+        self._start = self._after_step = START_STEP
         return self._live
 
     @property
@@ -623,6 +678,7 @@ class BatchSimulator:
         """
         if check:
             dv = checked_nudge(dv, self.scene, self._vel, self._mass, self._label)
+        self._start = START_STEP
         apply_impulses(self._balls, self._body, dv, self.scene.sticky)
 
     def set_scenes(
@@ -796,11 +852,12 @@ class BatchSimulator:
                 np.copyto(mine, theirs)
         self._sign = other._sign
         self._forward = other._forward
+        self._start = START_STEP
 
     #: What a copy or a pickle rebuilds rather than carries: work space, and what is bound to it.
     _REBUILT = (
         "_imp", "_imp_bytes", "_n_imp", "_kernel", "_state", "_pack", "_sign", "_forward", "_live", "_pos", "_vel",
-        "_mass", "_inv_mass", "_radius", "_omega", "_label", "_spec",
+        "_mass", "_inv_mass", "_radius", "_omega", "_label", "_spec", "_start", "_after_step",
     )  # fmt: skip
 
     def __getstate__(self):
@@ -821,6 +878,8 @@ class BatchSimulator:
         self._mode_arrays = kept + fresh[len(kept) :]
         self._kernel = self._spec.kernel(self.scene, self._n)
         self._label = Labels(self._n_scenes, self._single)
+        self._start = START_STEP
+        self._after_step = START_NEXT
         self._bind_views()
         self._alloc_work()
 
@@ -841,7 +900,7 @@ class Simulator:
     """One scene: the engine's public surface for a single simulation.
 
     ``Simulator(scene, positions (N,2), velocities (N,2), masses (N,), radii=None, mode="exact",
-    substeps=1)``; :meth:`step` returns a list of :class:`Impact` in time order. Everything is a
+    substeps=1)``; :meth:`step` returns the step's :class:`Impacts` in time order. Everything is a
     batch of one over :class:`BatchSimulator`; keyword arguments pass through to it.
     """
 
@@ -884,9 +943,11 @@ class Simulator:
     def mode(self) -> str:
         return self._batch.mode
 
-    def step(self, dt: float) -> list[Impact]:
-        """Advance by ``dt`` seconds (negative: backwards). Returns the step's impacts in time order."""
-        return _impact_list(self._batch._step(dt, False))  # (converted here, before the next step)
+    def step(self, dt: float) -> Impacts:
+        """Advance by ``dt`` seconds (negative: backwards). Returns the step's impacts in time order,
+        as :class:`Impacts` (a sequence of :class:`Impact` over their records)."""
+        rows = self._batch._step(dt)
+        return _NO_IMPACTS_SEQ if rows is _NO_IMPACTS else Impacts(rows)
 
     def frames(self, dt: float, n: int, out: Frames | None = None) -> Frames:
         """``n`` steps of ``dt`` seconds in one call, recording the state after each:
@@ -899,7 +960,7 @@ class Simulator:
         ((120, 1, 2), 2.0, [('right', 0.75)])
         """
         rec = self._batch._frames(dt, n, out, _single_shapes)
-        return Frames(rec.time[:, 0], rec.positions[:, 0], rec.velocities[:, 0], _impact_list(rec.impacts))
+        return Frames(rec.time[:, 0], rec.positions[:, 0], rec.velocities[:, 0], Impacts(rec.impacts))
 
     # read-only snapshots, as BatchSimulator's: set_balls, nudge and set_state change the state
     positions = property(lambda self: _snapshot(self._batch._pos[0]), doc="(N, 2) centres, m (read-only).")
@@ -963,16 +1024,6 @@ def _snapshot(array: np.ndarray) -> np.ndarray:
 def _single_shapes(sim, n):
     """The shapes of ``n`` frames of a single simulator (a batch of one without its axis)."""
     return (n,), (n, sim._n, 2), (n, sim._n, 2)
-
-
-def _impact_list(rows: np.ndarray) -> list[Impact]:
-    """Impact records of one scene (:data:`IMPACT_DTYPE`) as :class:`Impact` tuples."""
-    if not len(rows):
-        return []
-    return [
-        Impact(t, ball, None if other < 0 else other, None if wall < 0 else WALL_NAMES[wall], (x, y), speed)
-        for _, t, ball, other, wall, x, y, speed in rows.tolist()
-    ]
 
 
 def warm_up() -> None:

@@ -251,7 +251,7 @@ def shoot(
         for t in range(horizon):
             _, _, term, trunc, info = planner.step(as_env_action(planner, plan(t, planner)))
             if info["targets_hit"] > hits:
-                return plan, t, info["impacts"].records.copy()
+                return plan, t, info["impacts"].array.copy()
             if term or trunc:
                 break
     return None, None, None

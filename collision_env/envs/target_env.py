@@ -10,9 +10,9 @@ import numpy as np
 from gymnasium import spaces
 from numpy.typing import ArrayLike
 
-from collision_env.engine import BatchSimulator
+from collision_env.engine import BatchSimulator, Impacts
 from collision_env.envs._config import PRESETS, TaskConfig, keywords_of, make_config
-from collision_env.envs._core import Impacts, TaskCore, check_state_keys
+from collision_env.envs._core import TaskCore, check_state_keys
 from collision_env.envs.task.layout import ROW_RESET, ROW_STEPPED, SCENE_FLOATS, SCENE_INTS
 
 if TYPE_CHECKING:

@@ -23,8 +23,9 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 from numpy.typing import ArrayLike
 
+from collision_env.engine import Impacts
 from collision_env.envs._config import TaskConfig, keywords_of, make_config
-from collision_env.envs._core import Impacts, TaskCore, check_state_keys
+from collision_env.envs._core import TaskCore, check_state_keys
 from collision_env.envs.task.layout import ROW_OBSERVE, ROW_RESET, ROW_SKIP, ROW_STEPPED
 
 if TYPE_CHECKING:

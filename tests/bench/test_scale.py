@@ -34,11 +34,13 @@ def test_the_report_renders_every_size():
         "seconds": 3.0,
         "sizes": scale.bench_sizes((100, 200), log=lambda *_: None, min_slice_s=0.0),
         "frames": scale.bench_frames(n=20, horizon=1.0, repeats=1),
+        "public": scale.bench_public(n=200, frames=5, rounds=1),
     }
     text = scale.render_markdown(results)
     assert "| 100 |" in text and "| 200 |" in text
     assert all(row["frames"] >= scale.SLICES * 10 for row in results["sizes"])  # every size timed in every round
     assert "% of the one-step rate" in text and "into arrays it is given" in text
+    assert "`Simulator.step`" in text and results["public"]["step_over_kernel"] > 0
     frames = results["frames"]
     ratios = ("frames_over_one_step", "frames_call_over_one_step", "frames_given_over_one_step")
     assert all(frames[key] > 0 for key in ratios)

@@ -11,7 +11,7 @@ import pytest
 from collision_env.engine import BatchSimulator, EventCapWarning, Scene, Simulator
 from tests.engine.test_calendar import gas
 
-FIELDS = ["scene", "time", "ball", "other", "wall", "x", "y", "speed"]
+FIELDS = ["scene", "time", "ball", "other", "wall", "x", "y", "speed", "impulse"]
 
 
 @pytest.fixture
@@ -128,8 +128,11 @@ def test_frames_past_full_impact_buffers_and_the_event_cap(dt, n, max_events, ca
     assert all(w.filename == __file__ for w in capped)  # (each names the caller)
     if dt < 0.01:  # the loop's own copy fills up after a few frames: it hands over a stepped frame
         assert any(stepped for f, stepped in loop_exits if f < n) and loop_exits[-1] == (n, True)
-    else:  # the kernel's buffer fills up in every frame: Python completes each
+    elif capped_steps:  # every frame's step is capped: Python completes each
         assert loop_exits == [(f, False) for f in range(n)]
+    else:  # the kernel's buffer fills up (Python completes the frame), then grows to hold a step's impacts
+        assert loop_exits[0] == (0, False)
+        assert sum(not stepped for _, stepped in loop_exits) < n // 2
 
 
 @pytest.mark.parametrize("dt", [0.05, -0.05], ids=["compiled loop", "step by step"])
@@ -217,3 +220,30 @@ def test_frames_refuse_arrays_they_cannot_record_into():
     single = Simulator(scene, pos, vel, np.ones(10), radii=radii)
     with pytest.raises(ValueError, match=r"out: time must be .* of shape \(5,\), got float64 \(5, 1\)"):
         single.frames(0.1, 5, out=good)  # (a batch's arrays, not a single simulator's)
+
+
+@pytest.mark.parametrize("change", ["nudge", "set_balls", "set_state", "live arrays"])
+def test_a_step_sees_a_change_made_since_the_last_step(change):
+    # a step right after a step does not compare every ball with the calendar; every way of
+    # changing the state in between must bring that comparison back
+    scene, pos, vel, radii = gas(60, seed=4)
+    sim = Simulator(scene, pos, vel, np.ones(60), radii)
+    for _ in range(5):
+        sim.step(1 / 60)
+    dv = np.zeros((60, 2))
+    dv[:, 0] = 0.5
+    if change == "nudge":
+        sim.nudge(dv)
+    elif change == "set_balls":
+        sim.set_balls(velocities=sim.velocities + dv)
+    elif change == "set_state":
+        state = sim.get_state()
+        state["velocities"] = state["velocities"] + dv
+        sim.set_state(state)
+    else:
+        sim.batch.live_arrays().velocities[0] += dv
+    fresh = Simulator(scene, sim.positions, sim.velocities, np.ones(60), radii)
+    for _ in range(5):
+        a, b = sim.step(1 / 60), fresh.step(1 / 60)
+        assert [(i.ball, i.other, i.wall) for i in a] == [(i.ball, i.other, i.wall) for i in b] and len(a) > 0
+    np.testing.assert_allclose(sim.positions, fresh.positions, rtol=0, atol=1e-12)

@@ -281,10 +281,10 @@ def test_info_is_fresh_and_impacts_match_the_engine():
     for _ in range(200):
         _, _, term, trunc, info = env.step(np.zeros(2, np.float32))
         imp = info["impacts"]
-        for rec in imp.to_list():
+        for rec in imp:
             seen += 1
-            assert rec["wall"] in ("left", "right", "bottom", "top") and rec["ball"] == 0
-            x, y = rec["point"]
+            assert rec.wall in ("left", "right", "bottom", "top") and rec.ball == 0
+            x, y = rec.point
             assert x in (-2.0, 2.0) or y in (-1.0, 1.0)  # contact points lie exactly on the walls
         if term or trunc:
             break

@@ -52,7 +52,7 @@ def test_prediction_is_the_impact_that_happens_when_nothing_is_nudged(env_id):
         zero = np.zeros(env.action_space.shape, np.float32)
         while not (term or trunc) and len(first) < cfg.n_balls and env.core.time[0] - now <= lookahead:
             _, _, term, trunc, info = env.step(zero)
-            for r in info["impacts"].records:
+            for r in info["impacts"].array:
                 if r["wall"] >= 0 and r["ball"] not in first:
                     first[int(r["ball"])] = r
         for i in range(cfg.n_balls):
@@ -223,7 +223,7 @@ def test_scoring_prediction_looks_past_a_miss_for_the_impact_on_the_target():
         assert block[PREDICTED_OBS.hits] == 1.0
         for _ in range(400):  # coast: the miss, then the hit
             obs, _, term, _, info = env.step(zero)
-            walls = [r for r in info["impacts"].records if r["wall"] >= 0]
+            walls = [r for r in info["impacts"].array if r["wall"] >= 0]
             if walls and walls[-1]["wall"] == wall:
                 break
         else:

@@ -39,7 +39,7 @@ def test_aimer_hits_every_target(env_id, seed):
             hits = info["targets_hit"]
             assert any(
                 on_target(env.core, 0, k, r["wall"], r["x"], r["y"], r["time"])
-                for r in info["impacts"].records
+                for r in info["impacts"].array
                 if r["wall"] >= 0
                 for k in pending
             )
@@ -56,7 +56,7 @@ def replay_and_check(env, plan, hit_step, predicted, horizon):
         if t == hit_step:
             break
     assert t == hit_step and info["targets_hit"] >= 1
-    assert np.array_equal(info["impacts"].records, predicted)  # exactly the predicted impacts
+    assert np.array_equal(info["impacts"].array, predicted)  # exactly the predicted impacts
     newly = np.flatnonzero((before == 0) & (env.core.t_status[0] == 1))
     assert len(newly) >= 1
     assert any(

@@ -15,7 +15,7 @@ N_ENVS = 4
 
 def _records(imp):
     """Impact records without the scene column (sync sub-envs all say 0)."""
-    rec = imp.records
+    rec = imp.array
     return rec[[n for n in rec.dtype.names if n != "scene"]]
 
 

@@ -19,7 +19,7 @@ from .._jit import njit
 from ..layout import CLUSTER_TESTS, KINEMATICS, PAIR_TESTS, WALL_TESTS
 from ..physics.impacts import record
 from ..physics.motion import advance_all, body_kinematics
-from ..physics.response import merge_bodies, stop_body
+from ..physics.response import body_inverse_mass, merge_bodies, stop_body
 from ..physics.toi import INF, ca_pair, ca_wall, toi_pair, toi_wall
 from ..physics.tolerance import balls_touch
 from ..physics.walls import heads_into, snap_to_wall, wall_axis, wall_contact, wall_point
@@ -126,7 +126,8 @@ def resolve_wall(sc, t_abs, bi, wall, b, ph, wk):
     if b.omega[b.body[bi]] == 0.0:
         snap_to_wall(bi, wall, pos, radius, ph.bounds)
     x, y = wall_point(bi, wall, pos, ph.bounds)
-    record(wk.imp, wk.n_imp, sc, t_abs, bi, -1, wall, x, y, abs(vel[bi, axis]))
+    speed = abs(vel[bi, axis])
+    record(wk.imp, wk.n_imp, sc, t_abs, bi, -1, wall, x, y, speed, speed / body_inverse_mass(bi, b.mass, b.body, True))
     n_inv = _list_cluster(b.body[bi], b.body, wk.pending)
     stop_body(bi, vel, b.body, b.omega)
     return n_inv
@@ -147,6 +148,7 @@ def resolve_pair(sc, t_abs, bi, bj, b, wk):
         return 2
     x = pos[bi, 0] + radius[bi] * dx / dist
     y = pos[bi, 1] + radius[bi] * dy / dist
-    record(wk.imp, wk.n_imp, sc, t_abs, bi, bj, -1, x, y, -closing / dist)
+    w = body_inverse_mass(bi, b.mass, b.body, True) + body_inverse_mass(bj, b.mass, b.body, True)
+    record(wk.imp, wk.n_imp, sc, t_abs, bi, bj, -1, x, y, -closing / dist, -closing / dist / w)
     root = merge_bodies(bi, bj, pos, vel, b.mass, b.body, b.omega)
     return _list_cluster(root, b.body, wk.pending)

@@ -23,7 +23,7 @@ from .._jit import njit
 from ..layout import EVENTS
 from ..physics.impacts import record
 from ..physics.ldp import least_distance
-from ..physics.response import ball_ball, ball_wall, group_threshold
+from ..physics.response import ball_ball, ball_wall, group_threshold, normal_impulse
 from ..physics.tolerance import balls_touch
 from ..physics.walls import wall_contact, wall_count, wall_normal, wall_point
 
@@ -126,7 +126,8 @@ def _sweep(sc, t_abs, n_contacts, u_min, b, ph, wk):
             if speed > 0.0:
                 changed = True
                 wk.counters[EVENTS] += 1
-                _record_contact(sc, t_abs, c, speed, b, ph, wk)
+                w = _contact_inv_mass(c, wk.c_a, wk.c_b, b.inv_mass)
+                _record_contact(sc, t_abs, c, speed, normal_impulse(speed, ph.e, u_min, w), b, ph, wk)
         if not changed:
             return True
     return False
@@ -146,8 +147,16 @@ def _contact_normal(c, c_a, c_b, pos):
 
 
 @njit(inline="always")
-def _record_contact(sc, t_abs, c, speed, b, ph, wk):
-    """Report contact ``c`` of a group the first time it takes an impulse."""
+def _contact_inv_mass(c, c_a, c_b, inv_mass):
+    """``w_a + w_b`` of contact ``c`` (``w_a`` alone for a wall)."""
+    other = c_b[c]
+    return inv_mass[c_a[c]] + (inv_mass[other] if other >= 0 else 0.0)
+
+
+@njit(inline="always")
+def _record_contact(sc, t_abs, c, speed, impulse, b, ph, wk):
+    """Report contact ``c`` of a group the first time it takes an impulse, with that impulse's
+    closing speed and normal impulse (N s)."""
     if wk.c_hit[c]:
         return
     wk.c_hit[c] = True
@@ -156,10 +165,12 @@ def _record_contact(sc, t_abs, c, speed, b, ph, wk):
     pos, radius = b.pos, b.radius
     if other >= 0:
         nx, ny = _contact_normal(c, wk.c_a, wk.c_b, pos)
-        record(wk.imp, wk.n_imp, sc, t_abs, a, other, -1, pos[a, 0] + radius[a] * nx, pos[a, 1] + radius[a] * ny, speed)
+        x = pos[a, 0] + radius[a] * nx
+        y = pos[a, 1] + radius[a] * ny
+        record(wk.imp, wk.n_imp, sc, t_abs, a, other, -1, x, y, speed, impulse)
     else:
         x, y = wall_point(a, -1 - other, pos, ph.bounds)
-        record(wk.imp, wk.n_imp, sc, t_abs, a, -1, -1 - other, x, y, speed)
+        record(wk.imp, wk.n_imp, sc, t_abs, a, -1, -1 - other, x, y, speed, impulse)
 
 
 @njit(python=False)
@@ -222,20 +233,29 @@ def settle(sc, t_abs, size, n_contacts, u_min, b, ph, wk):
     for c in range(n_contacts):
         if closing[c] > 0.0:
             wk.counters[EVENTS] += 1
-            _record_contact(sc, t_abs, c, closing[c], b, ph, wk)
+            # (the two-body impulse from the contact's closing speed and its separation speed in the limit)
+            sep = _separation(c, c_a, c_b, pos, vel)
+            impulse = (closing[c] + sep) / _contact_inv_mass(c, c_a, c_b, b.inv_mass)
+            _record_contact(sc, t_abs, c, closing[c], impulse, b, ph, wk)
+
+
+@njit(inline="always")
+def _separation(c, c_a, c_b, pos, vel):
+    """The normal speed at which contact ``c`` separates (m/s; negative: it closes)."""
+    a = c_a[c]
+    other = c_b[c]
+    nx, ny = _contact_normal(c, c_a, c_b, pos)
+    sep = -(vel[a, 0] * nx + vel[a, 1] * ny)
+    if other >= 0:
+        sep += vel[other, 0] * nx + vel[other, 1] * ny
+    return sep
 
 
 @njit(inline="always")
 def _contacts_open(vel, pos, c_a, c_b, n_contacts, slack):
     """No contact of the group closes faster than ``slack`` (m/s)."""
     for c in range(n_contacts):
-        a = c_a[c]
-        other = c_b[c]
-        nx, ny = _contact_normal(c, c_a, c_b, pos)
-        sep = -(vel[a, 0] * nx + vel[a, 1] * ny)
-        if other >= 0:
-            sep += vel[other, 0] * nx + vel[other, 1] * ny
-        if sep < -slack:
+        if _separation(c, c_a, c_b, pos, vel) < -slack:
             return False
     return True
 

@@ -82,7 +82,7 @@ from ..layout import (
 )
 from ..physics.impacts import record
 from ..physics.motion import ball_views, has_rotation
-from ..physics.response import ball_ball, ball_wall, impact_threshold
+from ..physics.response import ball_ball, ball_wall, impact_threshold, normal_impulse
 from ..physics.toi import INF, toi_pair
 from ..physics.walls import snap_to_wall, wall_point
 from ..state import (
@@ -370,7 +370,8 @@ def resolve_wall(sc, t_abs, bi, li, wall, b, ph, wk):
     speed = ball_wall(li, wall, b.vel, ph.e, u_min)
     if speed > 0.0:
         x, y = wall_point(li, wall, b.pos, ph.bounds)
-        record(wk.imp, wk.n_imp, sc, t_abs, bi, -1, wall, x, y, speed)
+        impulse = normal_impulse(speed, ph.e, u_min, b.inv_mass[li])
+        record(wk.imp, wk.n_imp, sc, t_abs, bi, -1, wall, x, y, speed, impulse)
     wk.pending[0] = bi
     return speed
 
@@ -388,7 +389,8 @@ def resolve_pair(sc, t_abs, bi, bj, li, lj, b, ph, wk):
         dist = math.sqrt(dx * dx + dy * dy)
         x = pos[li, 0] + radius[li] * dx / dist
         y = pos[li, 1] + radius[li] * dy / dist
-        record(wk.imp, wk.n_imp, sc, t_abs, bi, bj, -1, x, y, speed)
+        impulse = normal_impulse(speed, ph.e, u_min, b.inv_mass[li] + b.inv_mass[lj])
+        record(wk.imp, wk.n_imp, sc, t_abs, bi, bj, -1, x, y, speed, impulse)
     wk.pending[0] = bi
     wk.pending[1] = bj
     return speed

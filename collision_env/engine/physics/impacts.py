@@ -6,7 +6,7 @@ from .._jit import njit
 
 
 @njit(refcount=False, forceinline=True)
-def record(imp, n_imp, scene, time, ball, other, wall, x, y, speed):
+def record(imp, n_imp, scene, time, ball, other, wall, x, y, speed, impulse):
     """Append an impact to the record buffer ``imp``; ``n_imp[0]`` counts the rows filled.
     ``other`` is -1 for a wall impact, ``wall`` -1 for a ball-ball one."""
     k = n_imp[0]
@@ -19,4 +19,5 @@ def record(imp, n_imp, scene, time, ball, other, wall, x, y, speed):
     r["x"] = x
     r["y"] = y
     r["speed"] = speed
+    r["impulse"] = impulse
     n_imp[0] = k + 1

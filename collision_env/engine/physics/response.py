@@ -113,6 +113,29 @@ def separation_speed(closing_speed, e, u_min):
 
 
 @njit(refcount=False, forceinline=True)
+def normal_impulse(closing_speed, e, u_min, inv_mass_sum):
+    """The normal impulse (N s) of an impact whose response :func:`ball_ball` or :func:`ball_wall`
+    gave: the momentum change along the normal of either ball of a pair, ``(u + u') / (w_i + w_j)``
+    with ``u'`` the separation speed, or of the ball at a wall, ``m (u + u')`` (``inv_mass_sum``
+    is ``w_i + w_j``, or ``w_i`` for a wall). A plastic impact (e = 0, ``u_min`` = 0) gives
+    ``u / (w_i + w_j)`` (``m u`` at a wall)."""
+    return (closing_speed + separation_speed(closing_speed, e, u_min)) / inv_mass_sum
+
+
+@njit(refcount=False, forceinline=True)
+def body_inverse_mass(i, mass, body, sticky):
+    """1 / the mass of ball ``i``'s cluster (of the ball alone unless the scene is a stick one)."""
+    if not sticky:
+        return 1.0 / mass[i]
+    root = body[i]
+    m_tot = 0.0
+    for k in range(mass.shape[0]):
+        if body[k] == root:
+            m_tot += mass[k]
+    return 1.0 / m_tot
+
+
+@njit(refcount=False, forceinline=True)
 def ball_ball(i, j, pos, vel, inv_mass, e, u_min):
     """Apply the impulse between balls ``i`` and ``j``. Returns the closing speed (0: no impulse)."""
     dx = pos[j, 0] - pos[i, 0]

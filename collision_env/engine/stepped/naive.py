@@ -20,22 +20,9 @@ import math
 from .._jit import njit
 from ..layout import EVENTS, PAIR_TESTS, WALL_TESTS
 from ..physics.impacts import record
-from ..physics.response import ball_ball, ball_wall, merge_bodies, stop_body
+from ..physics.response import ball_ball, ball_wall, body_inverse_mass, merge_bodies, normal_impulse, stop_body
 from ..physics.walls import heads_into, wall_of, wall_point
 from .cells import later_neighbours
-
-
-@njit(refcount=False, forceinline=True)
-def body_inverse_mass(i, mass, body, sticky):
-    """1 / the mass of ball ``i``'s cluster (of the ball alone unless the scene is a stick one)."""
-    if not sticky:
-        return 1.0 / mass[i]
-    root = body[i]
-    m_tot = 0.0
-    for k in range(mass.shape[0]):
-        if body[k] == root:
-            m_tot += mass[k]
-    return 1.0 / m_tot
 
 
 @njit(refcount=False, forceinline=True)
@@ -77,13 +64,16 @@ def contain(sc, t_abs, u_min, b, ph, state):
                 shift_body(i, 0.0, push, pos, b.body, ph.sticky)
             v = vel[i, axis]
             if heads_into(wall, v):
+                w = body_inverse_mass(i, b.mass, b.body, ph.sticky)
                 if ph.sticky:
                     stop_body(i, vel, b.body, b.omega)
                     speed = abs(v)
+                    impulse = speed / w
                 else:
                     speed = ball_wall(i, wall, vel, ph.e, u_min)
+                    impulse = normal_impulse(speed, ph.e, u_min, w)
                 cx, cy = wall_point(i, wall, pos, bounds)
-                record(state.imp, state.n_imp, sc, t_abs, i, -1, wall, cx, cy, speed)
+                record(state.imp, state.n_imp, sc, t_abs, i, -1, wall, cx, cy, speed, impulse)
                 state.counters[EVENTS] += 1
 
 
@@ -118,9 +108,11 @@ def _resolve_pair(sc, t_abs, i, j, u_min, b, ph, state):
         if sticky:
             merge_bodies(i, j, pos, vel, b.mass, body, b.omega)
             speed = -closing
+            impulse = speed / (wi + wj)
         else:
             speed = ball_ball(i, j, pos, vel, b.inv_mass, ph.e, u_min)
-        record(state.imp, state.n_imp, sc, t_abs, i, j, -1, x, y, speed)
+            impulse = normal_impulse(speed, ph.e, u_min, wi + wj)
+        record(state.imp, state.n_imp, sc, t_abs, i, j, -1, x, y, speed, impulse)
         state.counters[EVENTS] += 1
 
 

@@ -26,7 +26,7 @@ from .._jit import njit
 from ..layout import EVENTS, PAIR_TESTS, WALL_TESTS
 from ..physics.impacts import record
 from ..physics.motion import advance_body
-from ..physics.response import ball_ball, ball_wall, merge_bodies, stop_body
+from ..physics.response import ball_ball, ball_wall, body_inverse_mass, merge_bodies, normal_impulse, stop_body
 from ..physics.walls import wall_of, wall_point
 from .cells import later_neighbours
 from .naive import contain, shift_body
@@ -97,12 +97,15 @@ def _resolve_pair(sc, t_end, h, i, j, u_min, b, ph, state):
     if closing < 0.0 and dist > 0.0:
         x = pos[i, 0] + radius[i] * dx / dist
         y = pos[i, 1] + radius[i] * dy / dist
+        w = body_inverse_mass(i, mass, body, sticky) + body_inverse_mass(j, mass, body, sticky)
         if sticky:
             merge_bodies(i, j, pos, vel, mass, body, omega)
             speed = -closing / dist
+            impulse = speed / w
         else:
             speed = ball_ball(i, j, pos, vel, b.inv_mass, ph.e, u_min)
-        record(state.imp, state.n_imp, sc, t_end - ph.sign * t, i, j, -1, x, y, speed)
+            impulse = normal_impulse(speed, ph.e, u_min, w)
+        record(state.imp, state.n_imp, sc, t_end - ph.sign * t, i, j, -1, x, y, speed, impulse)
         state.counters[EVENTS] += 1
     _move(i, t, pos, vel, mass, body, omega, sticky)
     if body[j] != body[i]:
@@ -126,16 +129,19 @@ def _resolve_border(sc, t_end, h, i, u_min, b, ph, state):
             continue
         wall = wall_of(axis, ds > 0.0)
         v = vel[i, axis]
+        w = body_inverse_mass(i, b.mass, body, sticky)
         if sticky:
             if v == 0.0:
                 continue
             stop_body(i, vel, body, b.omega)
             speed = abs(v)
+            impulse = speed / w
         else:
             speed = ball_wall(i, wall, vel, ph.e, u_min)
+            impulse = normal_impulse(speed, ph.e, u_min, w)
         if speed > 0.0:
             x, y = wall_point(i, wall, pos, ph.bounds)
-            record(state.imp, state.n_imp, sc, t_abs, i, -1, wall, x, y, speed)
+            record(state.imp, state.n_imp, sc, t_abs, i, -1, wall, x, y, speed, impulse)
             state.counters[EVENTS] += 1
     shift_body(i, t * vel[i, 0], t * vel[i, 1], pos, body, sticky)
 

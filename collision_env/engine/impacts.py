@@ -1,0 +1,144 @@
+"""A step's impacts: :class:`Impacts`, a sequence of :class:`Impact` backed by one structured array.
+
+The kernels write every impact as a row of :data:`~collision_env.engine.IMPACT_DTYPE`;
+:meth:`Simulator.step <collision_env.engine.Simulator.step>`, :meth:`Simulator.frames
+<collision_env.engine.Simulator.frames>` and the envs' ``info["impacts"]`` hand that array over
+as an :class:`Impacts`, which makes an :class:`Impact` only for the rows asked for, so a step of
+10^5 disks costs no Python object per impact.
+
+**Impulse.** ``impulse`` is the normal impulse of the impact (N s): the magnitude of the momentum
+change along the normal (the line of centres, or the wall's normal), of either ball of a pair (the
+two are equal and opposite), or of the ball at a wall, ``m |Δv_n|``. With the balls' inverse
+masses ``w`` and the separation speed ``u'`` the response left (``e u``, or the collapse
+regulariser's ``u_min``, see :mod:`collision_env.engine.physics.response`):
+``J = (u + u') / (w_i + w_j)`` between balls, ``J = (u + u') / w_i`` at a wall.
+
+- In a contact group resolved at one instant (exact mode, e < 1), each contact is reported once,
+  with the closing speed and the impulse of the first impulse it takes; further impulses at the
+  same instant (the group's later sweeps) are not added. Where the group's cascade is replaced by
+  its limit (``exact.contacts.settle``), a contact first reported there carries the two-body
+  impulse ``(u + u') / (w_i + w_j)`` of its closing speed before and separation speed ``u'``
+  after the limit.
+- In stick scenes (``inelastic="stick"``) the impulse is the plastic one of the bodies as point
+  masses, at the recorded closing speed ``u`` of the contact: ``u / (1/M_i + 1/M_j)`` for two
+  bodies (clusters) of masses ``M_i``, ``M_j`` that stick, ``M u`` for a body that stops dead at a
+  wall; a spinning cluster's rotation and the tangential momentum a stop removes are not counted.
+
+The sum of ``impulse`` over a run's wall impacts, divided by the time and the wall length, is the
+mechanical pressure on the walls (see :mod:`collision_env.observables`).
+"""
+
+from __future__ import annotations
+
+import numbers
+from collections.abc import Iterator, Sequence
+from typing import NamedTuple, overload
+
+import numpy as np
+
+from .physics.walls import WALL_NAMES
+
+#: Rows converted to :class:`Impact` at a time while iterating (so a long run's iteration holds
+#: no list of every impact).
+_CHUNK = 4096
+
+
+class Impact(NamedTuple):
+    """One collision inside a step (a named tuple: cheap to make, immutable)."""
+
+    time: float  #: absolute simulation time (s)
+    ball: int  #: index of the ball
+    other: int | None  #: index of the other ball, or None for a wall
+    wall: str | None  #: "left" | "right" | "bottom" | "top", or None for a ball-ball impact
+    point: tuple[float, float]  #: contact point (m)
+    speed: float  #: normal closing speed just before the impact (m/s)
+    impulse: float  #: normal impulse (N s), see :mod:`collision_env.engine.impacts`
+
+
+def _impact(row: tuple) -> Impact:
+    """The :class:`Impact` of one record (a row of ``IMPACT_DTYPE`` as ``tolist`` gives it)."""
+    _, t, ball, other, wall, x, y, speed, impulse = row
+    return Impact(t, ball, None if other < 0 else other, None if wall < 0 else WALL_NAMES[wall], (x, y), speed, impulse)
+
+
+class Impacts(Sequence):
+    """The impacts of a step (or of a run of frames), in order: a read-only sequence of
+    :class:`Impact` over one structured array of :data:`~collision_env.engine.IMPACT_DTYPE`.
+
+    - ``len(impacts)``, ``impacts[k]`` (an :class:`Impact`, made on demand), iteration;
+    - ``impacts[a:b]``, ``impacts[mask]``, ``impacts[indices]``: an :class:`Impacts` of those rows;
+    - ``impacts["time"]`` (any field of the dtype): that column as an array, as is
+      ``impacts.point`` (``(n, 2)``), and ``impacts.wall_names`` the wall names (None for a
+      ball-ball impact);
+    - ``impacts.array``: the structured array itself (``scene``, ``time``, ``ball``, ``other``
+      (-1 for a wall), ``wall`` (index into ``WALL_NAMES``, -1 for a ball), ``x``, ``y``,
+      ``speed``, ``impulse``); ``impacts.to_list()``: every :class:`Impact` in a list;
+    - ``impacts.for_scene(i)``: the impacts of scene ``i`` of a batch (the sub-env of a vector env).
+
+    Equality: with another :class:`Impacts`, the records compare (so env infos compare with
+    Gymnasium's ``data_equivalence``); with a list or tuple, the :class:`Impact` tuples do
+    (``sim.step(dt) == []`` is a step without impacts).
+
+    >>> from collision_env.engine import Scene, Simulator
+    >>> sim = Simulator(Scene(bounds=(-1.0, -1.0, 1.0, 1.0)), [[0.0, 0.0]], [[1.0, 0.0]], [2.0], [0.25])
+    >>> imp = sim.step(1.0)
+    >>> len(imp), imp[0].wall, imp[0].time, imp[0].impulse, imp["impulse"].tolist()
+    (1, 'right', 0.75, 4.0, [4.0])
+    """
+
+    __slots__ = ("array",)
+
+    def __init__(self, array: np.ndarray) -> None:
+        self.array = array
+
+    def __len__(self) -> int:
+        return len(self.array)
+
+    @overload
+    def __getitem__(self, key: int) -> Impact: ...
+    @overload
+    def __getitem__(self, key: str) -> np.ndarray: ...
+    @overload
+    def __getitem__(self, key: slice | np.ndarray | Sequence[int]) -> Impacts: ...
+    def __getitem__(self, key):
+        if isinstance(key, str):
+            return self.array[key]
+        if isinstance(key, numbers.Integral) and not isinstance(key, (bool, np.bool_)):
+            return _impact(self.array[key].tolist())
+        return Impacts(self.array[key])
+
+    def __iter__(self) -> Iterator[Impact]:
+        a = self.array
+        for start in range(0, len(a), _CHUNK):
+            yield from map(_impact, a[start : start + _CHUNK].tolist())
+
+    def to_list(self) -> list[Impact]:
+        """Every impact as an :class:`Impact`, in order."""
+        return list(map(_impact, self.array.tolist()))
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, Impacts):
+            a, b = self.array, other.array
+            return a.dtype == b.dtype and a.shape == b.shape and bool(np.all(a == b))
+        if isinstance(other, (list, tuple)):
+            return len(self) == len(other) and self.to_list() == list(other)
+        return NotImplemented
+
+    __hash__ = None  # type: ignore[assignment]  # (mutable contents: not hashable, as a list)
+
+    @property
+    def point(self) -> np.ndarray:
+        """``(n, 2)`` contact points (m)."""
+        return np.stack([self.array["x"], self.array["y"]], axis=-1)
+
+    @property
+    def wall_names(self) -> list[str | None]:
+        """The wall of each impact by name, None for a ball-ball impact."""
+        return [WALL_NAMES[w] if w >= 0 else None for w in self.array["wall"].tolist()]
+
+    def for_scene(self, scene: int) -> Impacts:
+        """The impacts of scene ``scene`` of a batch."""
+        return Impacts(self.array[self.array["scene"] == scene])
+
+    def __repr__(self) -> str:
+        return f"Impacts({len(self.array)} impacts)"
