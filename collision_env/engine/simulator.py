@@ -51,6 +51,7 @@ from .layout import (
 )
 from .modes import MODES as MODE_REGISTRY
 from .physics.motion import apply_impulses
+from .physics.periodic import wrap_positions
 from .physics.walls import WALL_NAMES
 from .scene import Scene
 from .state import RESUME, RUN_FRAMES, START_STEP, FramesOut, State, aligned_copy, aligned_zeros, pack, with_frames
@@ -229,6 +230,7 @@ class BatchSimulator:
         pos, vel, mass, radius = checked_balls(
             scene, self._label, np.arange(n_scenes), n, positions, velocities, masses, radii
         )
+        pos, images = self._wrapped(pos)
         # Every per-ball float lives in one (B, N, 8) array, _pos, _vel, ... are views into it: each
         # array handed to a kernel costs ~0.1 us per call, which is most of a small scene's step.
         self._balls = aligned_zeros((n_scenes, n, len(BALL)), np.float64)
@@ -239,6 +241,7 @@ class BatchSimulator:
         self._inv_mass[...] = 1.0 / mass
         self._radius[...] = radius
         self._body = np.tile(np.arange(n, dtype=np.int64), (n_scenes, 1))
+        self._images = images  # (a periodic cell's lengths crossed by each ball; zeros otherwise)
         self._time = np.zeros(n_scenes)
         self._clock = np.zeros((n_scenes, 2))  # per scene: _time as the clock set it, its compensation
         self._capped = np.zeros(n_scenes, dtype=np.bool_)
@@ -253,7 +256,7 @@ class BatchSimulator:
             collapse_floor=self.collapse_floor,
         )
         scene_i = dict(
-            has_walls=scene.bounds is not None,
+            has_walls=scene.bounds is not None and not scene.periodic,
             pairs=scene.ball_collisions and n > 1,
             dim=scene.dimension,
             sticky=scene.sticky,
@@ -281,11 +284,24 @@ class BatchSimulator:
         self._radius = b[..., B_RADIUS]
         self._omega = b[..., B_OMEGA]
 
+    def _wrapped(self, pos):
+        """Positions ``(K, N, 2)`` wrapped into a periodic scene's cell, and the periods each was
+        moved by (zeros, and ``pos`` itself, in other scenes)."""
+        if not self.scene.periodic:
+            return pos, np.zeros(pos.shape, dtype=np.int64)
+        return wrap_positions(pos, self.scene.bounds, self.scene.dimension)
+
     def _invalidate(self, scenes):
         """Drop the calendar's predictions for ``scenes`` (they are made afresh at the next step)
         and lay out their grid for the balls they now hold."""
+        period = self.scene.period if self.scene.periodic else None
         origin_and_cells, counts = grid_geometry(
-            self.scene.bounds, self._pos[scenes], self._radius[scenes], self._uses_grid(), **self._spec.grid
+            self.scene.bounds,
+            self._pos[scenes],
+            self._radius[scenes],
+            self._uses_grid(),
+            **self._spec.grid,
+            period=period,
         )
         self._work_f[scenes, W_GRID_X0 : W_GRID_X0 + 4] = origin_and_cells
         self._work_i[scenes, W_GRID_NX : W_GRID_NX + 2] = counts
@@ -318,6 +334,7 @@ class BatchSimulator:
             self._work_f,
             self._work_i,
             self._clock,
+            self._images,
         )
         self._pack = pack(self._state, *self._mode_arrays, frames=True)
         self._sign = float(self._fparams[S_SIGN])  # the direction _fparams are set for (see step)
@@ -543,6 +560,19 @@ class BatchSimulator:
         return self._time.copy()
 
     @property
+    def images(self) -> np.ndarray:
+        """``(B, N, 2)`` int64: how many periodic cell lengths each ball has crossed along x and y
+        (zeros unless the scene is periodic); see :attr:`unwrapped_positions`."""
+        return self._images.copy()
+
+    @property
+    def unwrapped_positions(self) -> np.ndarray:
+        """``(B, N, 2)`` centres as if the periodic cell did not wrap them, m: ``positions + images *
+        (lx, ly)`` (``Scene.period``), which moves continuously (for mean squared displacements and
+        diffusion). The positions themselves outside a periodic scene."""
+        return self._pos + self._images * np.array(self.scene.period)
+
+    @property
     def clusters(self) -> np.ndarray:
         """``(B, N)``: the index of the ball rooting each ball's rigid cluster (itself if free)."""
         return self._body.copy()
@@ -573,7 +603,8 @@ class BatchSimulator:
             "mode": self.mode,
             "substeps": self.substeps,
             "dimension": self.scene.dimension,
-            "walls": self.scene.bounds is not None,
+            "walls": self.scene.bounds is not None and not self.scene.periodic,
+            "periodic": self.scene.periodic,
             "ball_pairs": bool(self._iparams[S_PAIRS]),
             "clusters": self.scene.sticky,
             "backend": BACKEND,
@@ -631,7 +662,9 @@ class BatchSimulator:
         if radii is None:
             radii = self._radius[idx]
         pos, vel, m, r = checked_balls(self.scene, self._label, idx, self._n, positions, velocities, masses, radii)
+        pos, images = self._wrapped(pos)
         self._pos[idx] = pos
+        self._images[idx] = images
         self._vel[idx] = vel
         self._mass[idx] = m
         self._inv_mass[idx] = 1.0 / m
@@ -653,11 +686,13 @@ class BatchSimulator:
             "omega": self._omega.copy(),
             "time": self._time.copy(),
             "time_compensation": self._clock[:, 1].copy(),
+            "images": self._images.copy(),
         }
 
     def set_state(self, state: Mapping[str, ArrayLike]) -> None:
         """Restore a state from :meth:`get_state` (shapes, number types and finiteness are checked;
-        the physics of the values is trusted)."""
+        the physics of the values is trusted). ``images`` may be left out (zeros); in a periodic
+        scene, positions outside the cell are wrapped into it, their images counted."""
         shapes = {
             "positions": self._pos.shape,
             "velocities": self._vel.shape,
@@ -669,21 +704,28 @@ class BatchSimulator:
             "time_compensation": self._time.shape,
         }
         arrays = {}
+        if "images" in state:
+            shapes["images"] = self._images.shape
         for key, shape in shapes.items():
             if key not in state:
                 raise ValueError(f"state: missing {key!r}")
             a = np.asarray(state[key])
             if a.shape != shape:
                 raise ValueError(f"state {key}: expected shape {shape}, got {a.shape}")
-            kinds = "iu" if key == "clusters" else "iuf"
+            whole = key in ("clusters", "images")
+            kinds = "iu" if whole else "iuf"
             if a.dtype.kind not in kinds:
                 raise ValueError(
-                    f"state {key}: expected {'integers' if key == 'clusters' else 'real numbers'}, got dtype {a.dtype}"
+                    f"state {key}: expected {'integers' if whole else 'real numbers'}, got dtype {a.dtype}"
                 )
             if not np.isfinite(a).all():
                 raise ValueError(f"state {key}: values must be finite")
             arrays[key] = a
-        np.copyto(self._pos, arrays["positions"])
+        pos, images = self._wrapped(np.asarray(arrays["positions"], dtype=np.float64))
+        if "images" in arrays:
+            images = images + arrays["images"]
+        np.copyto(self._pos, pos)
+        np.copyto(self._images, images)
         np.copyto(self._vel, arrays["velocities"])
         np.copyto(self._mass, arrays["masses"])
         np.copyto(self._inv_mass, 1.0 / arrays["masses"])
@@ -713,7 +755,7 @@ class BatchSimulator:
                 f"other: a simulator of the same scene, mode and shape, got mode {other.mode!r} and shape "
                 f"{other._balls.shape[:2]} (this one: {self.mode!r}, {self._balls.shape[:2]})"
             )
-        for name in ("_balls", "_body", "_time", "_clock", "_capped", "_work_f", "_work_i"):
+        for name in ("_balls", "_body", "_time", "_clock", "_capped", "_work_f", "_work_i", "_images"):
             np.copyto(getattr(self, name), getattr(other, name))
         for field in (S_ELASTICITY, S_SIGN):  # (the direction of time the state is kept for)
             self._fparams[field] = other._fparams[field]
@@ -820,6 +862,14 @@ class Simulator:
         return Frames(rec.time[:, 0], rec.positions[:, 0], rec.velocities[:, 0], _impact_list(rec.impacts))
 
     positions = property(lambda self: self._batch._pos[0].copy(), doc="(N, 2) centres, m (a copy).")
+    images = property(
+        lambda self: self._batch._images[0].copy(),
+        doc="(N, 2) periodic cell lengths each ball has crossed (zeros unless the scene is periodic).",
+    )
+    unwrapped_positions = property(
+        lambda self: self._batch.unwrapped_positions[0],
+        doc="(N, 2) centres as if the periodic cell did not wrap them, m (``positions + images * Scene.period``).",
+    )
     velocities = property(lambda self: self._batch._vel[0].copy(), doc="(N, 2) velocities, m/s (a copy).")
     masses = property(lambda self: self._batch._mass[0].copy(), doc="(N,) masses, kg.")
     radii = property(lambda self: self._batch._radius[0].copy(), doc="(N,) radii, m.")
@@ -843,6 +893,7 @@ class Simulator:
         """Replace positions and/or velocities (validated; on error nothing changes). Time is kept."""
         b = self._batch
         clock = b._clock[0].copy()
+        images = b._images[0].copy()
         b.set_scenes(
             [0],
             b._pos if positions is None else [positions],
@@ -850,6 +901,8 @@ class Simulator:
             time=b._time[0],
         )
         b._clock[0] = clock
+        if positions is None:  # (the balls stay where they are, images included)
+            b._images[0] = images
 
     def get_state(self) -> dict[str, np.ndarray]:
         """A dict of array copies (no batch axis) that :meth:`set_state` restores exactly."""

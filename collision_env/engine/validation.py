@@ -16,7 +16,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .broadphase import first_overlap
+from .broadphase import first_overlap, first_overlap_periodic
+from .physics.periodic import periods, wrap_positions
 from .physics.tolerance import CONTACT_RTOL, EPS, roundoff
 from .scene import CONSTANT_RADIUS, Scene, radius_from_mass
 
@@ -145,6 +146,9 @@ def checked_balls(scene: Scene, label: Labels, scenes, n: int, positions, veloci
             lambda s, i: f"velocity {tuple(vel[s, i])} gives mass {m[s, i]} a kinetic energy beyond float64",
         )
     fail(~(np.isfinite(r) & (r > 0) & (r <= big)), lambda s, i: f"radius must be positive and finite, got {r[s, i]}")
+    given = pos
+    if scene.periodic:  # (checked where they will be: wrapped into the cell)
+        pos, _ = wrap_positions(pos, scene.bounds, scene.dimension)
     # the coordinates' magnitude in each scene: the border, or the balls' own extent
     extent = np.max(np.abs(pos) + r[..., None], axis=(1, 2))
     if scene.bounds is not None:
@@ -161,7 +165,18 @@ def checked_balls(scene: Scene, label: Labels, scenes, n: int, positions, veloci
     if scene.dimension == 1:
         fail(pos[..., 1] != 0.0, lambda s, i: f"position y must be 0 in a 1D scene, got {pos[s, i, 1]}")
         fail(vel[..., 1] != 0.0, lambda s, i: f"velocity y must be 0 in a 1D scene, got {vel[s, i, 1]}")
-    if scene.bounds is not None:
+    if scene.periodic:
+        # minimum image: a ball touches at most one image of another (Allen & Tildesley 1.6.4)
+        for length, name in zip(scene.period, ("width", "height"), strict=True):
+            if length > 0.0:
+                fail(
+                    ~(4.0 * r < length),
+                    lambda s, i, length=length, name=name: (
+                        f"radius {r[s, i]:.6g} m is too large for the periodic cell: its diameter must be "
+                        f"less than half the cell {name} {length:.6g} m (minimum image)"
+                    ),
+                )
+    elif scene.bounds is not None:
         xmin, ymin, xmax, ymax = scene.bounds
         # a ball needs room to move across the box: more than the contact tolerance of the walls
         for lo, hi, name in ((xmin, xmax, "width"), (ymin, ymax, "height"))[: scene.dimension]:
@@ -186,14 +201,28 @@ def checked_balls(scene: Scene, label: Labels, scenes, n: int, positions, veloci
         )
     if scene.ball_collisions and n > 1:
         for s_ in range(k):
-            i, j = first_overlap(pos[s_], r[s_], START_CONTACT_RTOL)
+            if scene.periodic:
+                lx, ly = periods(scene.bounds, scene.dimension)
+                x0, y0 = scene.bounds[:2]
+                i, j = first_overlap_periodic(pos[s_], r[s_], START_CONTACT_RTOL, x0, y0, lx, ly)
+            else:
+                i, j = first_overlap(pos[s_], r[s_], START_CONTACT_RTOL)
             if i >= 0:
-                dist = float(np.hypot(*(pos[s_, i] - pos[s_, j])))
+                d = pos[s_, i] - pos[s_, j]
+                across = ""
+                if scene.periodic:
+                    near = d.copy()
+                    for axis, length in enumerate((lx, ly)):
+                        if length > 0.0:
+                            near[axis] -= length * np.floor(d[axis] / length + 0.5)
+                    across = " across the periodic boundary" if not np.array_equal(near, d) else ""
+                    d = near
+                dist = float(np.hypot(*d))
                 raise ValueError(
-                    f"{label(scenes[s_], i)}position overlaps ball {j} "
+                    f"{label(scenes[s_], i)}position overlaps ball {j}{across} "
                     f"(centres {dist:.6g} m apart, radii sum to {r[s_, i] + r[s_, j]:.6g} m)"
                 )
-    return pos, vel, m, r
+    return given, vel, m, r
 
 
 def check_reach(pos: np.ndarray, vel: np.ndarray, dt: float, label: Labels) -> None:
