@@ -58,6 +58,7 @@ from .state import RESUME, RUN_FRAMES, START_STEP, FramesOut, State, aligned_cop
 from .validation import (
     MAX_MAGNITUDE,
     Labels,
+    check_laps,
     check_reach,
     check_seconds,
     checked_balls,
@@ -338,7 +339,8 @@ class BatchSimulator:
         )
         self._pack = pack(self._state, *self._mode_arrays, frames=True)
         self._sign = float(self._fparams[S_SIGN])  # the direction _fparams are set for (see step)
-        self._forward = self._sign > 0.0 and self.scene.bounds is not None  # step's fast path applies
+        # step's fast path applies (not to periodic scenes: each step's laps are checked)
+        self._forward = self._sign > 0.0 and self.scene.bounds is not None and not self.scene.periodic
         self._live = LiveArrays(
             self._balls, self._pos, self._vel, self._mass, self._radius, self._time, self._body, self._capped
         )
@@ -368,6 +370,8 @@ class BatchSimulator:
         check_seconds(dt, "dt")
         if self.scene.bounds is None:
             check_reach(self._pos, self._vel, dt, self._label)
+        if self.scene.periodic:
+            check_laps(self.scene, self._mass, self._vel, dt, self._label)
         e = self.scene.elasticity
         if dt < 0.0 and e == 0.0:
             raise ValueError(
@@ -382,7 +386,7 @@ class BatchSimulator:
             fp[S_ELASTICITY] = e if sign > 0 else 1.0 / e
             fp[S_SIGN] = sign
             self._sign = sign
-            self._forward = sign > 0.0 and self.scene.bounds is not None
+            self._forward = sign > 0.0 and self.scene.bounds is not None and not self.scene.periodic
         if sign < 0:
             np.negative(self._vel, out=self._vel)
             np.negative(self._omega, out=self._omega)
@@ -435,8 +439,11 @@ class BatchSimulator:
         pieces = []
         f = 0
         buffer = None  # the compiled loop's copy of the impacts
+        if self.scene.periodic:  # (the run's laps, checked once: a periodic step has no fast path)
+            check_laps(self.scene, self._mass, self._vel, dt * n, self._label)
         while f < n:
-            if not (self._forward and 0.0 < dt <= MAX_MAGNITUDE):
+            forward = self._forward or (self.scene.periodic and self._sign > 0.0)
+            if not (forward and 0.0 < dt <= MAX_MAGNITUDE):
                 # backwards or without a border: a step as step takes it (which may make the next
                 # ones forward steps with a border)
                 pieces.append(self._step(dt, True, stacklevel=5))

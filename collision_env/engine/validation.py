@@ -236,6 +236,28 @@ def check_reach(pos: np.ndarray, vel: np.ndarray, dt: float, label: Labels) -> N
         )
 
 
+#: Most times a step may take a ball round a periodic cell: exact mode wraps a ball at each crossing
+#: of the cell (an event), so a step that laps the cell without bound would never end.
+MAX_LAPS = 2.0**20
+
+
+def check_laps(scene: Scene, mass: np.ndarray, vel: np.ndarray, dt: float, label: Labels) -> None:
+    """In a periodic cell, a step of ``dt`` must not take any ball round the cell more than
+    :data:`MAX_LAPS` times, at the fastest speed the energy of its scene allows any of its balls
+    (collisions never add energy)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        energy = (mass * (vel**2).sum(-1)).sum(-1)
+        fastest = np.sqrt(energy / mass.min(-1))
+        laps = fastest * abs(dt) / min(length for length in scene.period if length > 0.0)
+    if not (laps <= MAX_LAPS).all():
+        s = int(np.flatnonzero(~(laps <= MAX_LAPS))[0])
+        where = label(s).rstrip(": ")
+        raise ValueError(
+            f"dt: a step of {dt:g} s could take a ball{' of ' + where if where else ''} round the periodic "
+            f"cell {laps[s]:.3g} times (at most {MAX_LAPS:g}: each crossing is an event); take shorter steps"
+        )
+
+
 def checked_nudge(dv, scene: Scene, vel, mass, label: Labels) -> np.ndarray:
     """``dv`` as a float64 ``(B, N, 2)`` velocity change: finite, 0 along y in 1D, and giving speeds
     that stay representable (bounded through the clusters' spin by the largest change of any of

@@ -379,3 +379,21 @@ def test_periodic_invariants_at_the_extremes(case):
         energy = e_now
         scale = max(np.abs(momentum).max(), (sim.masses * np.linalg.norm(v, axis=1)).sum())
         assert np.all(np.abs(sim.momentum() - momentum) <= 1e-12 * scale), "momentum not conserved"
+
+
+@pytest.mark.parametrize("mode", MODES)
+def test_a_step_that_would_lap_the_cell_without_bound_is_refused(mode):
+    sim = Simulator(Scene(bounds=CELL, periodic=True), [[0.5, 0.5], [0.1, 0.1]], [[1e3, 0.0], [0.0, 0.0]], [1.0, 1.0],
+                    [0.1, 0.1], mode=mode)  # fmt: skip
+    before = sim.get_state()
+    with pytest.raises(
+        ValueError, match=r"dt: a step of 10000 s could take a ball round the periodic cell 1e\+07 times"
+    ):
+        sim.step(1e4)
+    with pytest.raises(
+        ValueError, match=r"dt: a step of 1e\+06 s could take a ball round the periodic cell 1e\+09 times"
+    ):
+        sim.frames(1e3, 1000)
+    for key, value in sim.get_state().items():
+        np.testing.assert_array_equal(value, before[key])
+    sim.step(100.0)  # (1e5 laps at most: allowed)
