@@ -48,6 +48,7 @@ def grid_geometry(
     reach: float = 1.0,
     balls_per_cell: float = 1.0,
     cells_per_ball: float = 1,
+    period: tuple[float, float] | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Per-scene grid ``(x0, y0, hx, hy)`` and ``(nx, ny)`` for ``(B, N, 2)`` positions and
     ``(B, N)`` radii; scenes with ``use_grid`` False get a single cell. The cells are at least
@@ -55,7 +56,11 @@ def grid_geometry(
     number at most ``cells_per_ball`` per ball. The cheap modes use ``reach = 2``: their grid is
     built before a sub-step's overlaps are pushed apart, and a pushed ball must still find the
     balls it now overlaps. Exact mode uses :data:`EXACT_BALLS_PER_CELL` and
-    :data:`EXACT_CELLS_PER_BALL`."""
+    :data:`EXACT_CELLS_PER_BALL`.
+
+    ``period``: a periodic scene's cell lengths ``(lx, ly)`` (``ly = 0`` in 1D). The grid then wraps:
+    its cells tile the periodic cell exactly, at least 3 along each repeating axis or else 1 (the
+    periodic cell's own length, so that a ball crossing it is seen), and one row along y in 1D."""
     n_scenes, n = radii.shape
     if bounds is not None:
         lo = np.broadcast_to(np.array(bounds[:2], dtype=np.float64), (n_scenes, 2))
@@ -79,6 +84,13 @@ def grid_geometry(
             over = counts[:, 0] * counts[:, 1] > most
             big = np.argmax(counts, axis=1)
             counts[over, big[over]] -= 1
+    if period is not None:
+        counts[counts < 3] = 1  # (the 3 x 3 cells around a ball are then distinct)
+        if period[1] == 0.0:
+            counts[:, 1] = 1
+        repeats = np.array(period) > 0.0
+        cell = np.where(repeats | (counts > 1), size / counts, np.inf)
+        return np.concatenate([lo, cell], axis=1), counts
     cell = np.where(counts > 1, size / counts, np.inf)  # one cell along an axis: no boundary there
     return np.concatenate([lo, cell], axis=1), counts
 
@@ -223,3 +235,55 @@ def wall_to_wall(pos, radius, bounds, dim, pairs):
             if walls[a] & both == both:
                 return a, axis, size[a]
     return -1, -1, 0
+
+
+@njit
+def first_overlap_periodic(pos, radius, rtol, x0, y0, lx, ly):
+    """:func:`first_overlap` in a periodic cell of lengths ``lx``, ``ly`` (``ly = 0``: y does not
+    repeat) starting at ``(x0, y0)``, for positions inside it: pairs are measured between nearest
+    images, on a grid that wraps (at least 3 cells along a repeating axis, or one)."""
+    n = pos.shape[0]
+    if n < 2:
+        return -1, -1
+    r_max = 0.0
+    for i in range(n):
+        r_max = max(r_max, radius[i])
+    h = 2.0 * r_max * CELL_MARGIN
+    nx = min(max(int(lx / h), 1), n)
+    ny = min(max(int(ly / h), 1), max(n // nx, 1)) if ly > 0.0 else 1
+    nx = nx if nx >= 3 else 1
+    ny = ny if ny >= 3 else 1
+    hx = lx / nx
+    hy = ly / ny if ly > 0.0 else math.inf
+    head = np.full(nx * ny, -1, dtype=np.int64)
+    nxt = np.empty(n, dtype=np.int64)
+    cell = np.empty(n, dtype=np.int64)
+    for i in range(n - 1, -1, -1):
+        c = cell_of(pos[i, 0], pos[i, 1], x0, y0, hx, hy, nx, ny)
+        cell[i] = c
+        nxt[i] = head[c]
+        head[c] = i
+    reach_x = 1 if nx >= 3 else 0
+    reach_y = 1 if ny >= 3 else 0
+    best_j = -1
+    for i in range(n):
+        cx = cell[i] % nx
+        cy = cell[i] // nx
+        for oy in range(-reach_y, reach_y + 1):
+            for ox in range(-reach_x, reach_x + 1):
+                j = head[((cy + oy) % ny) * nx + (cx + ox) % nx]
+                while j >= 0:
+                    if j > i:
+                        dx = pos[j, 0] - pos[i, 0]
+                        dx -= lx * math.floor(dx / lx + 0.5)
+                        dy = pos[j, 1] - pos[i, 1]
+                        if ly > 0.0:
+                            dy -= ly * math.floor(dy / ly + 0.5)
+                        sigma = radius[i] + radius[j]
+                        if math.sqrt(dx * dx + dy * dy) < sigma * (1.0 - rtol):
+                            if best_j < 0 or j < best_j:
+                                best_j = j
+                    j = nxt[j]
+        if best_j >= 0:
+            return i, best_j
+    return -1, -1

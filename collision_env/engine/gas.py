@@ -131,8 +131,7 @@ def disk_gas(
     else:
         width = height = math.sqrt(area)
         positions = _random(radii, width, height, periodic, rng)
-    scene_options = {"periodic": True} if periodic else {}
-    scene = Scene(bounds=(0.0, 0.0, width, height), **scene_options)
+    scene = Scene(bounds=(0.0, 0.0, width, height), periodic=periodic)
     masses = np.full(n, float(mass))
     velocities = rng.normal(0.0, math.sqrt(temperature / mass), (n, 2))
     velocities -= velocities.mean(axis=0)  # equal masses: the centre of mass at rest

@@ -36,11 +36,11 @@ class Mode(NamedTuple):
     impact_rows: Callable  #: ``impact_rows(scene, n, uses_grid)``: rows of the impact buffer
     sorted_impacts: bool  #: its impacts come in time order within each scene
     leaves_overlaps: bool  #: its steps may end with balls overlapping (which its ``set_state`` accepts)
-    kernels: Callable  #: ``kernels()``: every kernel it can build (for scenes of any kind)
+    kernels: Callable  #: ``kernels()``: every kernel it can build (for scenes of any kind but periodic)
 
 
 def _exact_kind(scene: Scene, n: int) -> scheduler.Kind:
-    return scheduler.scene_kind(scene.sticky, scene.elasticity)
+    return scheduler.scene_kind(scene.sticky, scene.elasticity, scene.periodic)
 
 
 def _exact_arrays(scene: Scene, n_scenes: int, n: int) -> tuple:
@@ -66,7 +66,7 @@ def _cheap(name: str, summary: str) -> Mode:
         name=name,
         summary=summary,
         substeps=True,
-        kernel=lambda scene, n: substep.step_kernel(name),
+        kernel=lambda scene, n: substep.step_kernel(name, scene.periodic),
         arrays=_substep_arrays,
         persistent=False,
         frames_slot=SUBSTEP_FRAMES_SLOT,

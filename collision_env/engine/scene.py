@@ -73,8 +73,8 @@ class Scene:
     Parameters
     ----------
     bounds:
-        ``(xmin, ymin, xmax, ymax)`` of the reflecting border in metres, or ``None`` for no border
-        (balls leave the area and fly on).
+        ``(xmin, ymin, xmax, ymax)`` of the reflecting border in metres (of the periodic cell with
+        ``periodic=True``), or ``None`` for no border (balls leave the area and fly on).
     elasticity:
         Coefficient of restitution ``e`` in [0, 1], for ball-ball and ball-wall collisions alike.
     dimension:
@@ -85,6 +85,21 @@ class Scene:
         that touches a wall stops dead (PhET's Inelastic screen).
     ball_collisions:
         ``False`` lets balls pass through each other (no pair work at all).
+    periodic:
+        ``True`` makes ``bounds`` a periodic cell in both axes (x only in 1D) instead of a
+        reflecting border: there are no walls and no wall impacts; a ball that leaves the cell
+        through one side comes back through the opposite one, and two balls meet through the
+        boundary by the minimum-image convention (Allen & Tildesley, *Computer Simulation of
+        Liquids*, 2nd ed., 2017, section 1.6.4): a pair interacts through its nearest periodic
+        images. Positions are reported wrapped into the cell, ``[xmin, xmax) x [ymin, ymax)`` up to
+        round-off; each ball's count of cell lengths crossed is kept (``images``), so that
+        ``positions + images * (xmax - xmin, ymax - ymin)`` are the unwrapped positions
+        (``Simulator.unwrapped_positions``), for diffusion. Every ball's diameter must be less than
+        half the cell's width (and height, in 2D), so that a ball never touches two images of
+        another at once; positions outside the cell are wrapped into it (their images counted).
+        Stick clusters (``inelastic="stick"`` at elasticity 0) are not supported in a periodic
+        cell, and at elasticity below 1 the balls of a touching group collide pairwise, one event
+        after another, rather than as one contact group. Works in every mode.
     """
 
     bounds: tuple[float, float, float, float] | None = PLAY_AREA_2D
@@ -92,6 +107,7 @@ class Scene:
     dimension: int = 2
     inelastic: str = "slip"
     ball_collisions: bool = True
+    periodic: bool = False
 
     def __new__(cls, *args: Any, **kwargs: Any) -> Scene:
         # before the generated __init__, whose TypeError names no close match
@@ -125,8 +141,27 @@ class Scene:
         if not isinstance(self.ball_collisions, (bool, np.bool_)):
             raise ValueError(f"scene ball_collisions: expected True or False, got {self.ball_collisions!r}")
         object.__setattr__(self, "ball_collisions", bool(self.ball_collisions))
+        if not isinstance(self.periodic, (bool, np.bool_)):
+            raise ValueError(f"scene periodic: expected True or False, got {self.periodic!r}")
+        object.__setattr__(self, "periodic", bool(self.periodic))
+        if self.periodic and self.bounds is None:
+            raise ValueError("scene periodic: a periodic scene needs bounds (the periodic cell), got bounds=None")
+        if self.periodic and self.sticky:
+            raise ValueError(
+                "scene periodic: stick clusters (inelastic='stick' at elasticity 0) are not supported in a "
+                "periodic cell; use inelastic='slip' or periodic=False"
+            )
 
     @property
     def sticky(self) -> bool:
         """True when colliding balls form rigid clusters (stick flavour at elasticity 0)."""
         return self.inelastic == "stick" and self.elasticity == 0.0 and self.ball_collisions
+
+    @property
+    def period(self) -> tuple[float, float]:
+        """The periodic cell's lengths along x and y (m); 0 along an axis that is not periodic
+        (both without ``periodic``, y in 1D)."""
+        if not self.periodic or self.bounds is None:  # (a periodic scene always has bounds)
+            return (0.0, 0.0)
+        xmin, ymin, xmax, ymax = self.bounds
+        return (xmax - xmin, ymax - ymin if self.dimension == 2 else 0.0)

@@ -54,6 +54,7 @@ from .layout import (
 )
 from .modes import MODES as MODE_REGISTRY
 from .physics.motion import apply_impulses
+from .physics.periodic import wrap_positions
 from .scene import Scene
 from .state import (
     RESUME,
@@ -71,6 +72,7 @@ from .validation import (
     MAX_MAGNITUDE,
     MAX_SUBSTEPS,
     Labels,
+    check_laps,
     check_reach,
     check_seconds,
     checked_balls,
@@ -273,6 +275,7 @@ class BatchSimulator:
         pos, vel, mass, radius = checked_balls(
             scene, self._label, np.arange(n_scenes), n, positions, velocities, masses, radii
         )
+        pos, images = self._wrapped(pos)
         # Every per-ball float lives in one (B, N, 8) array, _pos, _vel, ... are views into it: each
         # array handed to a kernel costs ~0.1 us per call, which is most of a small scene's step.
         self._balls = aligned_zeros((n_scenes, n, len(BALL)), np.float64)
@@ -283,6 +286,7 @@ class BatchSimulator:
         self._inv_mass[...] = 1.0 / mass
         self._radius[...] = radius
         self._body = np.tile(np.arange(n, dtype=np.int64), (n_scenes, 1))
+        self._images = images  # (a periodic cell's lengths crossed by each ball; zeros otherwise)
         self._time = np.zeros(n_scenes)
         self._clock = np.zeros((n_scenes, 2))  # per scene: _time as the clock set it, its compensation
         self._capped = np.zeros(n_scenes, dtype=np.bool_)
@@ -297,7 +301,7 @@ class BatchSimulator:
             collapse_floor=self.collapse_floor,
         )
         scene_i = dict(
-            has_walls=scene.bounds is not None,
+            has_walls=scene.bounds is not None and not scene.periodic,
             pairs=scene.ball_collisions and n > 1,
             dim=scene.dimension,
             sticky=scene.sticky,
@@ -326,11 +330,24 @@ class BatchSimulator:
         self._radius = b[..., B_RADIUS]
         self._omega = b[..., B_OMEGA]
 
+    def _wrapped(self, pos):
+        """Positions ``(K, N, 2)`` wrapped into a periodic scene's cell, and the periods each was
+        moved by (zeros, and ``pos`` itself, in other scenes)."""
+        if not self.scene.periodic:
+            return pos, np.zeros(pos.shape, dtype=np.int64)
+        return wrap_positions(pos, self.scene.bounds, self.scene.dimension)
+
     def _invalidate(self, scenes):
         """Drop the calendar's predictions for ``scenes`` (they are made afresh at the next step)
         and lay out their grid for the balls they now hold."""
+        period = self.scene.period if self.scene.periodic else None
         origin_and_cells, counts = grid_geometry(
-            self.scene.bounds, self._pos[scenes], self._radius[scenes], self._uses_grid(), **self._spec.grid
+            self.scene.bounds,
+            self._pos[scenes],
+            self._radius[scenes],
+            self._uses_grid(),
+            **self._spec.grid,
+            period=period,
         )
         self._work_f[scenes, W_GRID_X0 : W_GRID_X0 + 4] = origin_and_cells
         self._work_i[scenes, W_GRID_NX : W_GRID_NX + 2] = counts
@@ -364,10 +381,12 @@ class BatchSimulator:
             self._work_f,
             self._work_i,
             self._clock,
+            self._images,
         )
         self._pack = pack(self._state, *self._mode_arrays, frames=True)
         self._sign = float(self._fparams[S_SIGN])  # the direction _fparams are set for (see step)
-        self._forward = self._sign > 0.0 and self.scene.bounds is not None  # step's fast path applies
+        # step's fast path applies (not to periodic scenes: each step's laps are checked)
+        self._forward = self._sign > 0.0 and self.scene.bounds is not None and not self.scene.periodic
         self._live = LiveArrays(
             self._balls, self._pos, self._vel, self._mass, self._radius, self._time, self._body, self._capped
         )
@@ -406,6 +425,8 @@ class BatchSimulator:
         check_seconds(dt, "dt")
         if self.scene.bounds is None:
             check_reach(self._pos, self._vel, dt, self._label)
+        if self.scene.periodic:
+            check_laps(self.scene, self._mass, self._vel, dt, self._label)
         e = self.scene.elasticity
         if dt < 0.0 and e == 0.0:
             raise ValueError(
@@ -420,7 +441,7 @@ class BatchSimulator:
             fp[S_ELASTICITY] = e if sign > 0 else 1.0 / e
             fp[S_SIGN] = sign
             self._sign = sign
-            self._forward = sign > 0.0 and self.scene.bounds is not None
+            self._forward = sign > 0.0 and self.scene.bounds is not None and not self.scene.periodic
         if sign < 0:
             np.negative(self._vel, out=self._vel)
             np.negative(self._omega, out=self._omega)
@@ -475,8 +496,11 @@ class BatchSimulator:
         f = 0
         buffer = None  # the compiled loop's copy of the impacts
         size = len(self._imp)
+        if self.scene.periodic:  # (the run's laps, checked once: a periodic step has no fast path)
+            check_laps(self.scene, self._mass, self._vel, dt * n, self._label)
         while f < n:
-            if not (self._forward and 0.0 < dt <= MAX_MAGNITUDE):
+            forward = self._forward or (self.scene.periodic and self._sign > 0.0)
+            if not (forward and 0.0 < dt <= MAX_MAGNITUDE):
                 # backwards or without a border: a step as step takes it (which may make the next
                 # ones forward steps with a border)
                 pieces.append(self._step(dt, stacklevel=5))
@@ -614,6 +638,19 @@ class BatchSimulator:
         return _snapshot(self._time)
 
     @property
+    def images(self) -> np.ndarray:
+        """``(B, N, 2)`` int64: how many periodic cell lengths each ball has crossed along x and y
+        (zeros unless the scene is periodic); see :attr:`unwrapped_positions`."""
+        return self._images.copy()
+
+    @property
+    def unwrapped_positions(self) -> np.ndarray:
+        """``(B, N, 2)`` centres as if the periodic cell did not wrap them, m: ``positions + images *
+        (lx, ly)`` (``Scene.period``), which moves continuously (for mean squared displacements and
+        diffusion). The positions themselves outside a periodic scene."""
+        return self._pos + self._images * np.array(self.scene.period)
+
+    @property
     def clusters(self) -> np.ndarray:
         """``(B, N)``: the index of the ball rooting each ball's rigid cluster (itself if free)."""
         return _snapshot(self._body)
@@ -646,7 +683,8 @@ class BatchSimulator:
             "mode": self.mode,
             "substeps": self.substeps,
             "dimension": self.scene.dimension,
-            "walls": self.scene.bounds is not None,
+            "walls": self.scene.bounds is not None and not self.scene.periodic,
+            "periodic": self.scene.periodic,
             "ball_pairs": bool(self._iparams[S_PAIRS]),
             "clusters": self.scene.sticky,
             "backend": BACKEND,
@@ -705,7 +743,9 @@ class BatchSimulator:
         if radii is None:
             radii = self._radius[idx]
         pos, vel, m, r = checked_balls(self.scene, self._label, idx, self._n, positions, velocities, masses, radii)
+        pos, images = self._wrapped(pos)
         self._pos[idx] = pos
+        self._images[idx] = images
         self._vel[idx] = vel
         self._mass[idx] = m
         self._inv_mass[idx] = 1.0 / m
@@ -727,6 +767,7 @@ class BatchSimulator:
             "omega": self._omega.copy(),
             "time": self._time.copy(),
             "time_compensation": self._clock[:, 1].copy(),
+            "images": self._images.copy(),
         }
 
     def set_state(self, state: Mapping[str, ArrayLike]) -> None:
@@ -739,7 +780,8 @@ class BatchSimulator:
         with a compensation below an ulp of it. In naive and posteriori modes, whose steps may end
         with balls overlapping, overlaps (and touching balls from wall to wall, which these modes
         step like any others) are accepted. Bad input raises a ``ValueError`` naming
-        the scene, ball and field, and changes nothing.
+        the scene, ball and field, and changes nothing. ``images`` may be left out (zeros); in a
+        periodic scene, positions outside the cell are wrapped into it, their images counted.
         """
         shapes = {
             "positions": self._pos.shape,
@@ -757,16 +799,19 @@ class BatchSimulator:
         if missing:
             raise ValueError(f"state: missing {missing} (a state has the keys {list(shapes)}, as get_state gives)")
         arrays = {}
+        if "images" in state:
+            shapes["images"] = self._images.shape
         for key, shape in shapes.items():
             a = np.asarray(state[key])
             if a.shape != shape:
                 raise ValueError(
                     f"state {key}: expected shape {self._label.shape(shape)}, got {self._label.shape(a.shape)}"
                 )
-            kinds = "iu" if key == "clusters" else "iuf"
+            whole = key in ("clusters", "images")
+            kinds = "iu" if whole else "iuf"
             if a.dtype.kind not in kinds:
                 raise ValueError(
-                    f"state {key}: expected {'integers' if key == 'clusters' else 'real numbers'}, got dtype {a.dtype}"
+                    f"state {key}: expected {'integers' if whole else 'real numbers'}, got dtype {a.dtype}"
                 )
             if not np.isfinite(a).all():
                 raise ValueError(f"state {key}: values must be finite")
@@ -792,7 +837,11 @@ class BatchSimulator:
                     f"state time_compensation: {self._label(sc)}must be within an ulp of the time "
                     f"({np.spacing(abs(time)):.3g} s at {time:g} s), got {compensation:g}"
                 )
+        pos, images = self._wrapped(pos)
+        if "images" in arrays:
+            images = images + arrays["images"]
         np.copyto(self._pos, pos)
+        np.copyto(self._images, images)
         np.copyto(self._vel, vel)
         np.copyto(self._mass, mass)
         np.copyto(self._inv_mass, 1.0 / mass)
@@ -843,7 +892,7 @@ class BatchSimulator:
                 f"other: a simulator of the same scene, mode and shape, got mode {other.mode!r} and shape "
                 f"{other._balls.shape[:2]} (this one: {self.mode!r}, {self._balls.shape[:2]})"
             )
-        for name in ("_balls", "_body", "_time", "_clock", "_capped", "_work_f", "_work_i"):
+        for name in ("_balls", "_body", "_time", "_clock", "_capped", "_work_f", "_work_i", "_images"):
             np.copyto(getattr(self, name), getattr(other, name))
         for field in (S_ELASTICITY, S_SIGN):  # (the direction of time the state is kept for)
             self._fparams[field] = other._fparams[field]
@@ -967,6 +1016,14 @@ class Simulator:
     velocities = property(lambda self: _snapshot(self._batch._vel[0]), doc="(N, 2) velocities, m/s (read-only).")
     masses = property(lambda self: _snapshot(self._batch._mass[0]), doc="(N,) masses, kg (read-only).")
     radii = property(lambda self: _snapshot(self._batch._radius[0]), doc="(N,) radii, m (read-only).")
+    images = property(
+        lambda self: _snapshot(self._batch._images[0]),
+        doc="(N, 2) periodic cell lengths each ball has crossed (zeros unless the scene is periodic).",
+    )
+    unwrapped_positions = property(
+        lambda self: self._batch.unwrapped_positions[0],
+        doc="(N, 2) centres as if the periodic cell did not wrap them, m (``positions + images * Scene.period``).",
+    )
     time = property(lambda self: float(self._batch._time[0]), doc="Simulation time, s.")
     clusters = property(lambda self: _snapshot(self._batch._body[0]), doc="(N,) root ball of each ball's cluster.")
     cap_reached = property(lambda self: bool(self._batch._capped[0]), doc="The last step stopped at the event cap.")
@@ -987,6 +1044,7 @@ class Simulator:
         """Replace positions and/or velocities (validated; on error nothing changes). Time is kept."""
         b = self._batch
         clock = b._clock[0].copy()
+        images = b._images[0].copy()
         b.set_scenes(
             [0],
             b._pos if positions is None else [positions],
@@ -994,6 +1052,8 @@ class Simulator:
             time=b._time[0],
         )
         b._clock[0] = clock
+        if positions is None:  # (the balls stay where they are, images included)
+            b._images[0] = images
 
     def get_state(self) -> dict[str, np.ndarray]:
         """A dict of array copies (no batch axis) that :meth:`set_state` restores exactly."""

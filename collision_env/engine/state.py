@@ -62,6 +62,7 @@ class State(NamedTuple):
     work_f: np.ndarray  #: (B, len(WORK_F)) float64
     work_i: np.ndarray  #: (B, len(WORK_I)) int64
     clock: np.ndarray  #: (B, 2) float64 compensated clocks (:mod:`~collision_env.engine.clock`)
+    images: np.ndarray  #: (B, N, 2) int64: periodic cell lengths each ball has crossed (0 unless periodic)
 
 
 class Calendar(NamedTuple):
@@ -227,6 +228,7 @@ if HAVE_NUMBA:
             view(h, s + 9, np.float64, 2),
             view(h, s + 10, np.int64, 2),
             view(h, s + 11, np.float64, 2),
+            view(h, s + 12, np.int64, 3),
         )
 
     @njit(inline="always")

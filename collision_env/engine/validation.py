@@ -17,7 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from .broadphase import first_overlap, wall_to_wall
+from .broadphase import first_overlap, first_overlap_periodic, wall_to_wall
+from .physics.periodic import periods, wrap_positions
 from .physics.tolerance import CONTACT_RTOL, EPS, roundoff
 from .scene import CONSTANT_RADIUS, Scene, radius_from_mass
 
@@ -187,6 +188,9 @@ def checked_balls(
             lambda s, i: f"velocity {tuple(vel[s, i])} gives mass {m[s, i]} a kinetic energy beyond float64",
         )
     fail(~(np.isfinite(r) & (r > 0) & (r <= big)), lambda s, i: f"radius must be positive and finite, got {r[s, i]}")
+    given = pos
+    if scene.periodic:  # (checked where they will be: wrapped into the cell)
+        pos, _ = wrap_positions(pos, scene.bounds, scene.dimension)
     # the coordinates' magnitude in each scene: the border, or the balls' own extent
     extent = np.max(np.abs(pos) + r[..., None], axis=(1, 2))
     if scene.bounds is not None:
@@ -203,7 +207,18 @@ def checked_balls(
     if scene.dimension == 1:
         fail(pos[..., 1] != 0.0, lambda s, i: f"position y must be 0 in a 1D scene, got {pos[s, i, 1]}")
         fail(vel[..., 1] != 0.0, lambda s, i: f"velocity y must be 0 in a 1D scene, got {vel[s, i, 1]}")
-    if scene.bounds is not None:
+    if scene.periodic:
+        # minimum image: a ball touches at most one image of another (Allen & Tildesley 1.6.4)
+        for length, name in zip(scene.period, ("width", "height"), strict=True):
+            if length > 0.0:
+                fail(
+                    ~(4.0 * r < length),
+                    lambda s, i, length=length, name=name: (
+                        f"radius {r[s, i]:.6g} m is too large for the periodic cell: its diameter must be "
+                        f"less than half the cell {name} {length:.6g} m (minimum image)"
+                    ),
+                )
+    elif scene.bounds is not None:
         xmin, ymin, xmax, ymax = scene.bounds
         # a ball needs room to move across the box: more than the contact tolerance of the walls
         for lo, hi, name in ((xmin, xmax, "width"), (ymin, ymax, "height"))[: scene.dimension]:
@@ -228,14 +243,28 @@ def checked_balls(
         )
     if scene.ball_collisions and n > 1 and not overlaps:
         for s_ in range(k):
-            i, j = first_overlap(pos[s_], r[s_], START_CONTACT_RTOL)
+            if scene.periodic and scene.bounds is not None:
+                lx, ly = periods(scene.bounds, scene.dimension)
+                x0, y0 = scene.bounds[:2]
+                i, j = first_overlap_periodic(pos[s_], r[s_], START_CONTACT_RTOL, x0, y0, lx, ly)
+            else:
+                i, j = first_overlap(pos[s_], r[s_], START_CONTACT_RTOL)
             if i >= 0:
-                dist = float(np.hypot(*(pos[s_, i] - pos[s_, j])))
+                d = pos[s_, i] - pos[s_, j]
+                across = ""
+                if scene.periodic:
+                    near = d.copy()
+                    for axis, length in enumerate((lx, ly)):
+                        if length > 0.0:
+                            near[axis] -= length * np.floor(d[axis] / length + 0.5)
+                    across = " across the periodic boundary" if not np.array_equal(near, d) else ""
+                    d = near
+                dist = float(np.hypot(*d))
                 raise ValueError(
-                    f"{label(scenes[s_], i)}position overlaps ball {j} "
+                    f"{label(scenes[s_], i)}position overlaps ball {j}{across} "
                     f"(centres {dist:.6g} m apart, radii sum to {r[s_, i] + r[s_, j]:.6g} m)"
                 )
-    if scene.bounds is not None and not overlaps:
+    if scene.bounds is not None and not scene.periodic and not overlaps:
         bounds = np.array(scene.bounds)
         # only a scene with balls at two opposite walls can have a network between them (this test
         # is looser than the kernel's contact test, so it never skips one)
@@ -252,7 +281,7 @@ def checked_balls(
                     f"{label(scenes[sc], i)}position leaves no room to move along {'xy'[axis]}: the ball is one "
                     f"of {size} touching balls that reach from wall to wall ({walls}), jammed between them"
                 )
-    return pos, vel, m, r
+    return given, vel, m, r
 
 
 def check_reach(pos: np.ndarray, vel: np.ndarray, dt: float, label: Labels) -> None:
@@ -263,6 +292,28 @@ def check_reach(pos: np.ndarray, vel: np.ndarray, dt: float, label: Labels) -> N
         raise ValueError(
             f"dt: a step of {dt:g} s would take {label(s, i).rstrip(': ')} beyond "
             f"{MAX_MAGNITUDE:g} m (no border), where positions are no longer representable"
+        )
+
+
+#: Most times a step may take a ball round a periodic cell: exact mode wraps a ball at each crossing
+#: of the cell (an event), so a step that laps the cell without bound would never end.
+MAX_LAPS = 2.0**20
+
+
+def check_laps(scene: Scene, mass: np.ndarray, vel: np.ndarray, dt: float, label: Labels) -> None:
+    """In a periodic cell, a step of ``dt`` must not take any ball round the cell more than
+    :data:`MAX_LAPS` times, at the fastest speed the energy of its scene allows any of its balls
+    (collisions never add energy)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        energy = (mass * (vel**2).sum(-1)).sum(-1)
+        fastest = np.sqrt(energy / mass.min(-1))
+        laps = fastest * abs(dt) / min(length for length in scene.period if length > 0.0)
+    if not (laps <= MAX_LAPS).all():
+        s = int(np.flatnonzero(~(laps <= MAX_LAPS))[0])
+        where = label(s).rstrip(": ")
+        raise ValueError(
+            f"dt: a step of {dt:g} s could take a ball{' of ' + where if where else ''} round the periodic "
+            f"cell {laps[s]:.3g} times (at most {MAX_LAPS:g}: each crossing is an event); take shorter steps"
         )
 
 

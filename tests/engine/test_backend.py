@@ -53,6 +53,7 @@ def test_models_report_what_the_scene_needs():
         "substeps": 1,
         "dimension": 2,
         "walls": False,
+        "periodic": False,
         "ball_pairs": False,
         "clusters": False,
         "backend": None,

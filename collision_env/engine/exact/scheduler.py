@@ -100,6 +100,7 @@ from ..state import (
 )
 from . import calendar as cal
 from . import clusters, contacts, grid
+from . import periodic as cyclic
 from .bundles import SceneCalendar, work
 from .trajectories import load, not_before, pair_gap, pair_time, store, sync_all, take, wall_time
 
@@ -109,19 +110,26 @@ class Kind(NamedTuple):
 
     sticky: bool  #: form stick clusters (``inelastic="stick"`` at e = 0)
     cascades: bool  #: resolve contact groups at one instant (e < 1, slip)
+    periodic: bool = False  #: a periodic cell (:mod:`~.periodic`): no walls, pairs through images
 
     @property
     def label(self) -> str:
         """What the compile notice calls the kernel of this kind."""
+        if self.periodic:
+            return "exact mode for periodic scenes"
         return f"exact mode for {'stick' if self.sticky else 'inelastic' if self.cascades else 'elastic'} scenes"
 
 
-def scene_kind(sticky: bool, elasticity: float) -> Kind:
-    """The :class:`Kind` of a scene (``sticky``: ``Scene.sticky``)."""
+def scene_kind(sticky: bool, elasticity: float, periodic: bool = False) -> Kind:
+    """The :class:`Kind` of a scene (``sticky``: ``Scene.sticky``). Periodic scenes are one kind
+    whatever their elasticity (they have neither stick clusters nor contact groups)."""
+    if periodic:
+        return Kind(False, False, True)
     return Kind(bool(sticky), not sticky and elasticity < 1.0)
 
 
-#: Every kind a scene can be (stick scenes have no contact groups).
+#: Every kind a scene can be (stick scenes have no contact groups), but periodic scenes: their
+#: kernel is compiled only when a periodic scene is first stepped (``precompile`` leaves it out).
 KINDS = (Kind(False, False), Kind(False, True), Kind(True, False))
 
 
@@ -492,7 +500,7 @@ def _step(kind: Kind):
     The whole batch is one call with the scene loop inside: a call from Python checks every
     argument, which would cost as much as a small scene's events.
     """
-    sticky, cascades = kind.sticky, kind.cascades
+    sticky, cascades, periodic = kind.sticky, kind.cascades, kind.periodic
     whole_state = sticky or cascades  # (events may be resolved on the whole ball state)
     # (the two-level queue works as a heap of every ball when a scene has no buckets; stick scenes never do)
     build, schedule, first, rebase, walk_ahead = cal.HEAP_QUEUE if kind.sticky else cal.BUCKET_QUEUE
@@ -502,6 +510,8 @@ def _step(kind: Kind):
         """Find ball ``i``'s next event and queue it (``rebuild``: see ``next_event``)."""
         if sticky and rot:
             t, code, stamp = clusters.next_event(i, now, horizon, rebuild, b, cl, ph, wk)
+        elif periodic:
+            t, code, stamp = cyclic.next_event(i, rebuild, cl, ph, geo, wk)
         else:
             t, code, stamp = next_event(i, rebuild, b, cl, ph, geo, wk)
         cal.set_event(i, t, code, stamp, cl.rec, cl.ci)
@@ -567,7 +577,10 @@ def _step(kind: Kind):
             t = cl.rec[bi]["event_time"]
             if not t <= horizon_end:
                 break
-            verdict, t, now = screen(bi, t, now, ph, cl, geo, wk)
+            if periodic:
+                verdict, t, now = cyclic.screen(bi, t, now, ph, cl, geo, wk, state.images[sc])
+            else:
+                verdict, t, now = screen(bi, t, now, ph, cl, geo, wk)
             if verdict != RUN:
                 n_pending = 1 if verdict == PREDICT else 0
                 if verdict == RESCHEDULE:
@@ -594,10 +607,15 @@ def _step(kind: Kind):
                 take(bi, 0, now, cl, wk.event)
                 if bj >= 0:
                     take(bj, 1, now, cl, wk.event)
+                    if periodic:
+                        cyclic.nearest_partner(wk.event, ph.bounds, ph.dim)
             state.work_i[sc, W_EVENTS] += 1
             wk.counters[EVENTS] += 1
             # resolve, then invalidate (the changed balls are predicted afresh at the top of the loop)
+            rows_before = state.n_imp[0] if periodic else 0
             n_pending = resolve(sc, t0 + ph.sign * now, bi, bj, code, in_place, b, ev, ph, wk)
+            if periodic and bj >= 0:
+                cyclic.after_pair(bj, rows_before, cl, wk.event, wk, ph.bounds, ph.dim)
             if sticky:
                 rot = has_rotation(b.body, b.omega)
             invalidate(n_pending, now, ev, in_place, cl, wk)

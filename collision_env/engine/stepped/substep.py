@@ -25,6 +25,7 @@ from ..state import (
     unpack_substep_scratch,
 )
 from . import naive, posteriori
+from . import periodic as cyclic
 from .cells import cell_lists, worst_case_impacts
 
 #: The resolver of each cheap mode.
@@ -44,9 +45,10 @@ def open_step(state, start):
     state.n_imp[2] = 0
 
 
-def _step(resolve):
+def _step(resolve, periodic=False):
     """The sub-steps of every active scene of a batch, resolved by ``resolve`` (a mode's, with
-    the signature of ``naive.resolve``): a function ``step(h, dt_abs, start)`` of a pack of a
+    the signature of ``naive.resolve``; ``periodic``: in a periodic cell, :mod:`~.periodic`): a
+    function ``step(h, dt_abs, start)`` of a pack of a
     ``State`` and a ``SubstepScratch``, inlined into its kernel (:func:`step_kernel`). ``start``
     and the return value are as for exact mode's step (the cheap modes have no event cap, so
     ``capped`` stays False); a scene stops between sub-steps when the impact buffer could not
@@ -70,9 +72,16 @@ def _step(resolve):
             geo = scene_geometry(state.work_f, state.work_i, sc)
             u_min = elastic_threshold(b.vel, ph.ratio, ph.floor)
             while state.work_i[sc, W_SUBSTEPS_DONE] < k_total:
-                cells = cell_lists(n, b.pos, b.vel, h, scratch, geo)
+                if periodic:
+                    cells = cyclic.cell_lists(n, b.pos, b.vel, h, scratch, geo, ph.bounds, ph.dim)
+                else:
+                    cells = cell_lists(n, b.pos, b.vel, h, scratch, geo)
                 room = state.imp.shape[0] - state.n_imp[0]
-                if room < worst_case_impacts(n, cells, room):
+                if periodic:
+                    worst = cyclic.worst_case_impacts(n, cells, room)
+                else:
+                    worst = worst_case_impacts(n, cells, room)
+                if room < worst:
                     state.work_i[sc, W_STALLED] = True
                     break
                 k = state.work_i[sc, W_SUBSTEPS_DONE] + 1
@@ -95,10 +104,16 @@ def _step(resolve):
 _KERNELS: dict = {}
 
 
-def step_kernel(mode: str) -> Any:
+def step_kernel(mode: str, periodic: bool = False) -> Any:
     """The compiled stepping kernel of cheap ``mode`` ("naive" or "posteriori", built on first
     use): ``kernel(h, dt_abs, start)`` on a pack of a ``State``, a ``SubstepScratch`` and room for
-    frames (see :func:`~collision_env.engine.frames.frames_kernel`)."""
-    if mode not in _KERNELS:
-        _KERNELS[mode] = frames_kernel(_step(RESOLVERS[mode]), f"{mode} mode", SUBSTEP_FRAMES_SLOT)
-    return _KERNELS[mode]
+    frames (see :func:`~collision_env.engine.frames.frames_kernel`). ``periodic``: the kernel for
+    periodic scenes (compiled only when one is first stepped)."""
+    key = (mode, periodic)
+    if key not in _KERNELS:
+        if periodic:
+            step = _step(cyclic.RESOLVERS[mode], True)
+            _KERNELS[key] = frames_kernel(step, f"{mode} mode for periodic scenes", SUBSTEP_FRAMES_SLOT)
+        else:
+            _KERNELS[key] = frames_kernel(_step(RESOLVERS[mode]), f"{mode} mode", SUBSTEP_FRAMES_SLOT)
+    return _KERNELS[key]
