@@ -31,6 +31,8 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
+from collision_env.engine.impacts import Impacts
+
 __all__ = [
     "collision_rate",
     "collision_virial",
@@ -59,7 +61,7 @@ def _positive(value, name: str) -> float:
     return value
 
 
-def collision_virial(impacts, radii: ArrayLike) -> float:
+def collision_virial(impacts: Impacts | np.ndarray, radii: ArrayLike) -> float:
     """``W = sum over ball-ball impacts of sigma_ij J_ij`` (J m): the collision virial, with
     ``sigma_ij = r_i + r_j`` the contact distance and ``J_ij`` the normal impulse (the record's
     ``impulse``). At contact ``r_ij . Δp_i = sigma_ij J_ij`` (the impulse lies along the line of
@@ -71,7 +73,7 @@ def collision_virial(impacts, radii: ArrayLike) -> float:
     return float(np.sum((r[pairs["ball"]] + r[pairs["other"]]) * pairs["impulse"]))
 
 
-def reduced_pressure(impacts, radii: ArrayLike, duration: float, kinetic_energy: float) -> float:
+def reduced_pressure(impacts: Impacts | np.ndarray, radii: ArrayLike, duration: float, kinetic_energy: float) -> float:
     """The compressibility factor ``Z = P A / (N kT)`` from the collision virial over a run of
     ``duration`` seconds (Alder & Wainwright, *J. Chem. Phys.* 33, 1439 (1960); Allen & Tildesley
     2017, §3.7):
@@ -91,7 +93,9 @@ def reduced_pressure(impacts, radii: ArrayLike, duration: float, kinetic_energy:
     return 1.0 + collision_virial(impacts, radii) / (2.0 * k * t)
 
 
-def wall_pressure(impacts, duration: float, bounds: tuple[float, float, float, float], radius: float) -> float:
+def wall_pressure(
+    impacts: Impacts | np.ndarray, duration: float, bounds: tuple[float, float, float, float], radius: float
+) -> float:
     """The mechanical pressure on the walls of a 2D box, N/m: the wall impacts' impulses per unit
     time and per unit of the length the centres can reach,
 
@@ -112,7 +116,7 @@ def wall_pressure(impacts, duration: float, bounds: tuple[float, float, float, f
     return float(np.sum(rows["impulse"][rows["wall"] >= 0])) / (t * length)
 
 
-def collision_rate(impacts, n: int, duration: float) -> float:
+def collision_rate(impacts: Impacts | np.ndarray, n: int, duration: float) -> float:
     """Collisions per disk per second, ``omega = 2 N_coll / (N t)``: each ball-ball impact
     involves two disks (wall impacts are not counted). Its inverse is :func:`mean_free_time`."""
     rows = _records(impacts)
@@ -120,7 +124,7 @@ def collision_rate(impacts, n: int, duration: float) -> float:
     return 2.0 * float(np.count_nonzero(rows["other"] >= 0)) / (_positive(n, "n") * t)
 
 
-def mean_free_time(impacts, n: int, duration: float) -> float:
+def mean_free_time(impacts: Impacts | np.ndarray, n: int, duration: float) -> float:
     """The mean time between a disk's collisions, ``tau = 1 / omega`` (:func:`collision_rate`), s;
     infinite if no disk collided."""
     omega = collision_rate(impacts, n, duration)

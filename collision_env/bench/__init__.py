@@ -15,6 +15,8 @@ Every section is a module with a ``main(argv)``, runnable on its own
   memory per disk, and the validity of each run.
 - :mod:`.misses`: the cache lines an event of that gas misses, by array, counted on the Python path
   through a model of one cache (where the cost per event of a large gas comes from).
+- :mod:`.physics`: a periodic hard-disk fluid against the published equation of state and
+  Enskog's collision rate; events per second through the public API.
 - :mod:`.compile`: the CPU seconds numba takes with empty caches: a first step, a first env step,
   every kernel.
 
@@ -36,4 +38,5 @@ SECTIONS: dict[str, tuple[str, str]] = {
     "scale": ("collision_env.bench.scale", "exact mode on gases of 10^2 to 10^5 disks: events/s, memory, validity"),
     "misses": ("collision_env.bench.misses", "cache lines missed per event of a gas, by array (a cache model)"),
     "compile": ("collision_env.bench.compile", "CPU seconds numba takes with empty caches, per kernel family"),
+    "physics": ("collision_env.bench.physics", "a periodic hard-disk fluid against the published equation of state"),
 }

@@ -333,7 +333,7 @@ class BatchSimulator:
     def _wrapped(self, pos):
         """Positions ``(K, N, 2)`` wrapped into a periodic scene's cell, and the periods each was
         moved by (zeros, and ``pos`` itself, in other scenes)."""
-        if not self.scene.periodic:
+        if not self.scene.periodic or self.scene.bounds is None:
             return pos, np.zeros(pos.shape, dtype=np.int64)
         return wrap_positions(pos, self.scene.bounds, self.scene.dimension)
 

@@ -189,7 +189,7 @@ def checked_balls(
         )
     fail(~(np.isfinite(r) & (r > 0) & (r <= big)), lambda s, i: f"radius must be positive and finite, got {r[s, i]}")
     given = pos
-    if scene.periodic:  # (checked where they will be: wrapped into the cell)
+    if scene.periodic and scene.bounds is not None:  # (checked where they will be: wrapped into the cell)
         pos, _ = wrap_positions(pos, scene.bounds, scene.dimension)
     # the coordinates' magnitude in each scene: the border, or the balls' own extent
     extent = np.max(np.abs(pos) + r[..., None], axis=(1, 2))

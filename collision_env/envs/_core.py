@@ -187,7 +187,7 @@ def sample_episode(cfg: TaskConfig, rng: np.random.Generator) -> Episodes:
 # --------------------------------------------------------------------------------------------- #
 
 
-def check_state_keys(state, keys: tuple, source: str) -> None:
+def check_state_keys(state: Any, keys: tuple, source: str) -> None:
     """Raise unless ``state`` is a dict holding ``keys`` (the state ``source`` gives): a
     ``TypeError`` for anything but a mapping, a ``ValueError`` naming the missing keys."""
     if not isinstance(state, dict):

@@ -89,3 +89,44 @@ def test_the_same_seed_gives_the_same_gas():
 def test_bad_input_is_refused(kwargs, message):
     with pytest.raises(ValueError, match=message):
         disk_gas(**kwargs)
+
+
+def smallest_periodic_gap(gas):
+    """The smallest surface-to-surface distance between two disks, through the nearest images."""
+    x0, y0, x1, y1 = gas.scene.bounds
+    size = np.array([x1 - x0, y1 - y0])
+    d = gas.positions[:, None] - gas.positions[None]
+    d -= size * np.round(d / size)
+    dist = np.sqrt((d**2).sum(-1))
+    np.fill_diagonal(dist, np.inf)
+    return float((dist - (gas.radii[:, None] + gas.radii[None])).min())
+
+
+@given(
+    n=st.integers(8, 300),
+    fraction=st.floats(0.01, 1.0),
+    arrangement=st.sampled_from(["lattice", "random"]),
+    seed=st.integers(0, 2**32 - 1),
+)
+@settings(max_examples=40, deadline=None)
+def test_a_periodic_gas_fills_its_cell_without_overlap_across_the_edges(n, fraction, arrangement, seed):
+    limit = RANDOM_MAX if arrangement == "random" else CLOSE_PACKED
+    try:
+        gas = disk_gas(n, fraction * limit, arrangement=arrangement, periodic=True, seed=seed)
+    except ValueError as error:
+        assert "packing_fraction" in str(error)
+        return
+    x0, y0, x1, y1 = gas.scene.bounds
+    assert gas.scene.periodic
+    assert gas.packing_fraction == pytest.approx(fraction * limit, rel=1e-12)
+    assert ((gas.positions >= (x0, y0)) & (gas.positions < (x1, y1))).all()
+    assert smallest_periodic_gap(gas) >= 0.0
+
+
+def test_a_dense_periodic_lattice_runs_and_conserves_momentum():
+    gas = disk_gas(256, 0.7, periodic=True, seed=4)
+    sim = gas.simulator()
+    sim.step(1.0)
+    assert sim.time == pytest.approx(1.0)
+    assert np.abs(sim.momentum()).max() <= 1e-12 * 256
+    assert sim.kinetic_energy() == pytest.approx(gas.kinetic_energy(), rel=1e-12)

@@ -26,7 +26,7 @@ from .._jit import njit
 from .toi import INF, toi_pair
 
 
-def periods(bounds, dim) -> tuple[float, float]:
+def periods(bounds: tuple[float, float, float, float], dim: int) -> tuple[float, float]:
     """The cell lengths ``(lx, ly)`` of a periodic scene's ``bounds`` (``ly = 0`` in 1D), computed as
     the kernels compute them (:func:`cell_lengths`)."""
     return bounds[2] - bounds[0], (bounds[3] - bounds[1]) if dim == 2 else 0.0
@@ -110,7 +110,9 @@ def toi_images(dx, dy, dvx, dvy, sigma, lx, ly):
     return best
 
 
-def wrap_positions(positions: np.ndarray, bounds, dim: int) -> tuple[np.ndarray, np.ndarray]:
+def wrap_positions(
+    positions: np.ndarray, bounds: tuple[float, float, float, float], dim: int
+) -> tuple[np.ndarray, np.ndarray]:
     """``(..., 2)`` positions wrapped into a periodic cell by floor division, and the periods each
     was moved by (int64, ``(..., 2)``): ``positions = wrapped + images * (lx, ly)`` up to round-off."""
     lx, ly = periods(bounds, dim)
