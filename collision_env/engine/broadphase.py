@@ -119,6 +119,21 @@ def block(c, nx, ny):
     return max(cx - 1, 0), min(cx + 1, nx - 1), max(cy - 1, 0), min(cy + 1, ny - 1)
 
 
+@njit(inline="always")
+def _link_cells(pos, x0, y0, hx, hy, nx, ny):
+    """Each ball's cell, and per cell a linked list of its balls in index order (``head``, ``nxt``)."""
+    n = pos.shape[0]
+    head = np.full(nx * ny, -1, dtype=np.int64)
+    nxt = np.empty(n, dtype=np.int64)
+    cell = np.empty(n, dtype=np.int64)
+    for i in range(n - 1, -1, -1):
+        c = cell_of(pos[i, 0], pos[i, 1], x0, y0, hx, hy, nx, ny)
+        cell[i] = c
+        nxt[i] = head[c]
+        head[c] = i
+    return head, nxt, cell
+
+
 @njit
 def _ball_cells(pos, radius):
     """Cell lists of the balls on a grid of their box, cells one largest diameter wide (with the
@@ -142,14 +157,7 @@ def _ball_cells(pos, radius):
     hy = (y1 - y0) / ny if ny > 1 else math.inf
     hx = max(hx, h)
     hy = max(hy, h)
-    head = np.full(nx * ny, -1, dtype=np.int64)
-    nxt = np.empty(n, dtype=np.int64)
-    cell = np.empty(n, dtype=np.int64)
-    for i in range(n - 1, -1, -1):
-        c = cell_of(pos[i, 0], pos[i, 1], x0, y0, hx, hy, nx, ny)
-        cell[i] = c
-        nxt[i] = head[c]
-        head[c] = i
+    head, nxt, cell = _link_cells(pos, x0, y0, hx, hy, nx, ny)
     return head, nxt, cell, nx, ny
 
 
@@ -255,14 +263,7 @@ def first_overlap_periodic(pos, radius, rtol, x0, y0, lx, ly):
     ny = ny if ny >= 3 else 1
     hx = lx / nx
     hy = ly / ny if ly > 0.0 else math.inf
-    head = np.full(nx * ny, -1, dtype=np.int64)
-    nxt = np.empty(n, dtype=np.int64)
-    cell = np.empty(n, dtype=np.int64)
-    for i in range(n - 1, -1, -1):
-        c = cell_of(pos[i, 0], pos[i, 1], x0, y0, hx, hy, nx, ny)
-        cell[i] = c
-        nxt[i] = head[c]
-        head[c] = i
+    head, nxt, cell = _link_cells(pos, x0, y0, hx, hy, nx, ny)
     reach_x = 1 if nx >= 3 else 0
     reach_y = 1 if ny >= 3 else 0
     best_j = -1

@@ -80,6 +80,17 @@ def worst_case_impacts(n, cells, room):
     return worst
 
 
+@njit(inline="always")
+def insert_sorted(out, m, j):
+    """Insert ``j`` into the sorted prefix ``out[:m]`` (a handful of neighbours); returns ``m + 1``."""
+    q = m
+    while q > 0 and out[q - 1] > j:
+        out[q] = out[q - 1]
+        q -= 1
+    out[q] = j
+    return m + 1
+
+
 @njit(refcount=False, forceinline=True)
 def later_neighbours(i, n, cells):
     """The balls ``j > i`` in the 3 x 3 cells around ball ``i``, ascending, into ``cells.near``;
@@ -98,12 +109,6 @@ def later_neighbours(i, n, cells):
             j = cells.head[cy * cells.nx + cx]
             while j >= 0:
                 if j > i:
-                    # insertion into the sorted prefix (a handful of neighbours)
-                    q = m
-                    while q > 0 and out[q - 1] > j:
-                        out[q] = out[q - 1]
-                        q -= 1
-                    out[q] = j
-                    m += 1
+                    m = insert_sorted(out, m, j)
                 j = cells.nxt[j]
     return m

@@ -17,7 +17,7 @@ from ..broadphase import cell_of
 from ..layout import PAIR_TESTS
 from ..physics.periodic import cell_lengths, nearest, wrap_all, wrap_coordinate, wrap_point
 from . import naive, posteriori
-from .cells import CHEAP_CELLS_PER_BALL, CellLists
+from .cells import CHEAP_CELLS_PER_BALL, CellLists, insert_sorted
 
 
 @njit(inline="always")
@@ -99,12 +99,7 @@ def later_neighbours(i, n, cells):
             j = cells.head[((cy + oy) % cells.ny) * cells.nx + (cx + ox) % cells.nx]
             while j >= 0:
                 if j > i:
-                    q = m
-                    while q > 0 and out[q - 1] > j:
-                        out[q] = out[q - 1]
-                        q -= 1
-                    out[q] = j
-                    m += 1
+                    m = insert_sorted(out, m, j)
                 j = cells.nxt[j]
     return m
 
