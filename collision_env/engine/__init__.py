@@ -9,6 +9,7 @@ See :class:`Simulator` (one scene) and :class:`BatchSimulator` (many scenes at o
 """
 
 from ._jit import BACKEND
+from .compression import CompressionWarning, Packing, compress
 from .gas import Gas, disk_gas
 from .impacts import Impact, Impacts
 from .keywords import UnknownKeywordError
@@ -51,14 +52,17 @@ __all__ = [
     "WALL_RIGHT",
     "WALL_TOP",
     "BatchSimulator",
+    "CompressionWarning",
     "EventCapWarning",
     "Frames",
     "Gas",
     "Impact",
     "Impacts",
+    "Packing",
     "Scene",
     "Simulator",
     "UnknownKeywordError",
+    "compress",
     "disk_gas",
     "radius_from_mass",
     "warm_up",
