@@ -1,5 +1,6 @@
 """Hard disks with collision_env: a periodic fluid at a given area fraction, its pressure against the
-published equation of state, its radial distribution function g(r) and its mean squared displacement.
+published equation of state, its radial distribution function g(r) and its mean squared displacement;
+then a bidisperse mixture compressed to jamming.
 
     python examples/hard_disks.py                      # 1024 disks at area fraction 0.5
     python examples/hard_disks.py --n 4096 --packing 0.65 --plot hard_disks.png
@@ -14,7 +15,8 @@ import argparse
 import numpy as np
 
 from collision_env.bench.metrics import henderson_z, kolafa_rottner_z
-from collision_env.engine import disk_gas
+from collision_env.engine import compress, disk_gas
+from collision_env.engine.compression import DEFAULT_RATE
 from collision_env.observables import (
     collision_rate,
     mean_free_time,
@@ -28,7 +30,9 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--n", type=int, default=1024, help="disks")
     parser.add_argument("--packing", type=float, default=0.5, help="area fraction, up to 0.70")
-    parser.add_argument("--plot", help="save g(r) and the MSD here (a .png)")
+    parser.add_argument("--jam-n", type=int, default=1024, help="disks of the packing compressed to jamming")
+    parser.add_argument("--rate", type=float, default=DEFAULT_RATE, help="the compression's growth rate")
+    parser.add_argument("--plot", help="save g(r), the MSD and the jammed packing here (a .png)")
     args = parser.parse_args(argv)
 
     # 1. a gas: a triangular lattice in a periodic cell, Maxwell-Boltzmann velocities at kT = 1
@@ -70,13 +74,23 @@ def main(argv: list[str] | None = None) -> None:
         f"(at one frame {msd[1]:.2e}, ballistic 2 t^2 = {2 * dt**2:.2e})"
     )
 
+    # 4. jamming: a 50:50 mixture of diameters 1 and 1.4 (O'Hern et al. 2003), placed at random at
+    # area fraction 0.3, its disks grown (Lubachevsky-Stillinger) until the pressure diverges
+    mixture = disk_gas(args.jam_n, 0.3, arrangement="random", periodic=True, diameters=(1.0, 1.4), seed=2)
+    packing = compress(mixture.scene, mixture.positions, mixture.radii, rate=args.rate, seed=3)
+    print(
+        f"jammed at area fraction {packing.packing_fraction:.4f} (O'Hern et al.: 0.842) after "
+        f"{packing.events:,} collisions, Z = {packing.reduced_pressure:.3g}"
+    )
+
     if args.plot:
         import matplotlib
 
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
+        from matplotlib.collections import EllipseCollection
 
-        fig, (left, right) = plt.subplots(1, 2, figsize=(10, 4))
+        fig, (left, right, packed) = plt.subplots(1, 3, figsize=(15, 4))
         left.plot(r, g)
         left.axhline(1.0, color="k", lw=0.8)
         left.set(xlabel="r / sigma", ylabel="g(r)", title=f"Radial distribution, eta = {args.packing}")
@@ -84,6 +98,21 @@ def main(argv: list[str] | None = None) -> None:
         right.loglog(lags[1:] * dt, 2 * (lags[1:] * dt) ** 2, "k--", lw=0.8, label="ballistic 2 (kT/m) t^2")
         right.set(xlabel="t", ylabel="MSD", title="Mean squared displacement")
         right.legend()
+        size = 2 * packing.radii
+        packed.add_collection(
+            EllipseCollection(
+                size,
+                size,
+                0.0,
+                units="xy",
+                offsets=packing.positions,
+                offset_transform=packed.transData,
+                array=packing.radii,
+                cmap="coolwarm",
+            )
+        )
+        x0, y0, x1, y1 = packing.scene.bounds
+        packed.set(xlim=(x0, x1), ylim=(y0, y1), aspect="equal", title=f"Jammed, phi = {packing.packing_fraction:.3f}")
         fig.tight_layout()
         fig.savefig(args.plot, dpi=110)
         print(f"plot: {args.plot}")

@@ -9,8 +9,13 @@ EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
 def test_the_hard_disk_tutorial_runs(tmp_path, capsys, monkeypatch):
     plot = tmp_path / "hard_disks.png"
-    monkeypatch.setattr(sys, "argv", ["hard_disks.py", "--n", "256", "--packing", "0.3", "--plot", str(plot)])
+    monkeypatch.setattr(
+        sys,
+        "argv",
+        ["hard_disks.py", "--n", "256", "--packing", "0.3", "--jam-n", "128", "--rate", "0.1", "--plot", str(plot)],
+    )
     runpy.run_path(str(EXAMPLES / "hard_disks.py"), run_name="__main__")
     out = capsys.readouterr().out
     assert "Z = PA/NkT" in out and "g(r) peaks at r = 1.0" in out
+    assert "jammed at area fraction 0.8" in out
     assert plot.stat().st_size > 0

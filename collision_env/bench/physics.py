@@ -2,8 +2,8 @@
 
 Run it as::
 
-    python -m collision_env.bench.physics                 # N = 4096 (a few minutes)
-    python -m collision_env.bench.physics --quick         # N = 1024
+    python -m collision_env.bench.physics                 # N = 4096, jamming at N = 1024 and 4096
+    python -m collision_env.bench.physics --quick         # N = 1024, fewer jamming runs
     python -m collision_env.bench.physics --markdown docs/bench/physics.md --readme README.md --plot docs/img
 
 **Equation of state.** A periodic monodisperse fluid of ``N`` disks (diameter ``sigma = 1``, mass 1,
@@ -16,8 +16,16 @@ disk against Enskog's ``omega = 2 sqrt(pi) rho sigma g(sigma+) sqrt(kT / m)``, t
 taken from the reference ``Z`` through the contact theorem ``Z = 1 + 2 eta g(sigma+)``, which makes
 it exact in equilibrium. The error is the standard error of the block means.
 
+**Jamming.** A 50:50 bidisperse mixture, diameters 1 and 1.4 (O'Hern, Silbert, Liu & Nagel, Phys. Rev.
+E 68, 011306 (2003)), placed at random at ``eta = 0.3`` in a periodic cell and compressed by
+:func:`~collision_env.engine.compress` (Lubachevsky–Stillinger) until ``Z`` reaches ``10^6``, at several
+growth rates and seeds: the jamming density ``phi_J`` against O'Hern et al.'s ``0.842``, and its rate
+dependence (slower compressions jam denser: Skoge, Donev, Stillinger & Torquato, Phys. Rev. E 74,
+041127 (2006)).
+
 **Speed.** Events (collisions) per second of wall time through the public API (``Simulator.step``
-in steps of five mean free times, the impacts returned as arrays) at ``eta = 0.3, 0.5, 0.7``.
+in steps of five mean free times, the impacts returned as arrays) at ``eta = 0.3, 0.5, 0.7``, and
+collisions per second of each compression.
 """
 
 from __future__ import annotations
@@ -31,7 +39,8 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from collision_env.engine import Simulator, disk_gas, warm_up
+from collision_env.engine import Simulator, compress, disk_gas, warm_up
+from collision_env.engine.compression import DEFAULT_RATE, DEFAULT_UNTIL_PRESSURE
 from collision_env.observables import collision_rate, reduced_pressure
 
 from .machine import cpus, machine, timestamp, versions
@@ -45,6 +54,23 @@ MELT_COLLISIONS = 2000.0
 BLOCK_COLLISIONS = 300.0
 BLOCKS = 10
 SPEED_PACKINGS = (0.3, 0.5, 0.7)
+#: The jamming runs: (N, growth rate, seeds), and the quick subset.
+JAMMING_RUNS = (
+    (1024, 1e-1, 3),
+    (1024, 1e-2, 3),
+    (1024, 1e-3, 3),
+    (1024, 1e-4, 1),
+    (4096, 1e-1, 2),
+    (4096, 1e-2, 2),
+    (4096, 1e-3, 2),
+)
+QUICK_JAMMING_RUNS = ((1024, 1e-1, 2), (1024, 1e-2, 2), (1024, 1e-3, 1))
+#: The bidisperse mixture (diameters), its starting area fraction, and O'Hern et al.'s phi_J.
+JAMMING_DIAMETERS = (1.0, 1.4)
+JAMMING_START = 0.3
+PHI_J_OHERN = 0.842
+#: Collisions per disk a jamming run may spend (the slowest rates need more than compress's default).
+JAMMING_EVENTS_PER_DISK = 1_000_000
 #: The speed rows' timed stretch, collisions per disk.
 SPEED_COLLISIONS = 50.0
 
@@ -124,6 +150,71 @@ def speed(
     return rows
 
 
+def jamming(runs: Sequence[tuple[int, float, int]] = JAMMING_RUNS, log: Callable[[str], None] = print) -> list[dict]:
+    """Compress the bidisperse mixture from ``JAMMING_START`` to ``Z = 10^6`` for each ``(N, rate,
+    seeds)``; one row per run."""
+    rows = []
+    for n, rate, seeds in runs:
+        for seed in range(seeds):
+            gas = disk_gas(
+                n, JAMMING_START, arrangement="random", periodic=True, diameters=JAMMING_DIAMETERS, seed=seed
+            )
+            started = time.perf_counter()
+            packing = compress(
+                gas.scene,
+                gas.positions,
+                gas.radii,
+                rate=rate,
+                until_pressure=DEFAULT_UNTIL_PRESSURE,
+                max_events=JAMMING_EVENTS_PER_DISK * n,
+                seed=seed,
+                progress=False,
+            )
+            wall = time.perf_counter() - started
+            rows.append(
+                {
+                    "n": n,
+                    "rate": rate,
+                    "seed": seed,
+                    "phi_j": packing.packing_fraction,
+                    "z": packing.reduced_pressure,
+                    "jammed": packing.jammed,
+                    "collisions": packing.events,
+                    "seconds": wall,
+                    "collisions_per_s": packing.events / wall,
+                }
+            )
+            log(
+                f"  N {n}, rate {rate:g}, seed {seed}: phi_J {packing.packing_fraction:.4f} at "
+                f"Z {packing.reduced_pressure:.3g}, {packing.events:,} collisions in {wall:.0f} s "
+                f"({packing.events / wall:.3g}/s)"
+            )
+    return rows
+
+
+def jamming_summary(rows: Sequence[dict]) -> list[dict]:
+    """Per ``(N, rate)``: the mean ``phi_J``, its spread over seeds (sample standard deviation, 0 for
+    one seed), the mean seconds and collisions per second."""
+    out = []
+    for key in dict.fromkeys((r["n"], r["rate"]) for r in rows):
+        group = [r for r in rows if (r["n"], r["rate"]) == key]
+        phi = np.array([r["phi_j"] for r in group])
+        out.append(
+            {
+                "n": key[0],
+                "rate": key[1],
+                "seeds": len(group),
+                "phi_j": float(phi.mean()),
+                "phi_j_sd": float(phi.std(ddof=1)) if len(group) > 1 else 0.0,
+                "seconds": float(np.mean([r["seconds"] for r in group])),
+                "collisions_per_disk": float(np.mean([r["collisions"] for r in group])) / key[0],
+                "collisions_per_s": float(np.mean([r["collisions_per_s"] for r in group])),
+                "all_jammed": all(r["jammed"] for r in group),
+            }
+        )
+    return out
+
+
 def run(quick: bool, log: Callable[[str], None] = print) -> dict:
     n = QUICK_SIZE if quick else SIZE
     started = time.perf_counter()
@@ -132,6 +223,8 @@ def run(quick: bool, log: Callable[[str], None] = print) -> dict:
     eos = equation_of_state(n, log=log)
     log(f"speed, N = {n}:")
     fast = speed(n, log=log)
+    log("jamming:")
+    jams = jamming(QUICK_JAMMING_RUNS if quick else JAMMING_RUNS, log=log)
     return {
         "machine": machine(),
         "cpus": cpus(),
@@ -141,6 +234,7 @@ def run(quick: bool, log: Callable[[str], None] = print) -> dict:
         "n": n,
         "equation_of_state": eos,
         "speed": fast,
+        "jamming": jams,
     }
 
 
@@ -166,6 +260,23 @@ def render_markdown(results: dict) -> str:
     lines += ["", "| η | events/s (public API) |", "|---:|---:|"]
     for r in results["speed"]:
         lines.append(f"| {r['packing']:.2f} | {r['events_per_s']:.3g} |")
+    lines += [
+        "",
+        f"Jamming: a 50:50 mixture of diameters {JAMMING_DIAMETERS[0]:g} and {JAMMING_DIAMETERS[1]:g} placed at random "
+        f"at φ = {JAMMING_START:g} in a periodic cell, compressed by `compress` (Lubachevsky–Stillinger; the default "
+        f"rate is {DEFAULT_RATE:g}) until Z = {DEFAULT_UNTIL_PRESSURE:.0e}; φ_J is the mean over seeds (± their "
+        f"standard deviation), against O'Hern et al. (2003), {PHI_J_OHERN}.",
+        "",
+        "| N | rate | seeds | φ_J | collisions per disk | seconds per run | collisions/s |",
+        "|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for r in jamming_summary(results["jamming"]):
+        spread = f" ± {r['phi_j_sd']:.4f}" if r["seeds"] > 1 else ""
+        flag = "" if r["all_jammed"] else " (not all reached Z)"
+        lines.append(
+            f"| {r['n']:,} | {r['rate']:g} | {r['seeds']} | {r['phi_j']:.4f}{spread}{flag} | "
+            f"{r['collisions_per_disk']:,.0f} | {r['seconds']:.1f} | {r['collisions_per_s']:.3g} |"
+        )
     return "\n".join(lines)
 
 
@@ -200,13 +311,47 @@ def plot(results: dict, folder: str) -> str:
     return path
 
 
+def plot_jamming(results: dict, folder: str) -> str:
+    """φ_J against the growth rate, each run a point, per N, with O'Hern et al.'s value."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(5.5, 4))
+    ax.axhline(PHI_J_OHERN, color="k", lw=0.8, ls="--", label=f"O'Hern et al. (2003), {PHI_J_OHERN}")
+    for k, n in enumerate(sorted({r["n"] for r in results["jamming"]})):
+        rows = [r for r in results["jamming"] if r["n"] == n]
+        shift = 1.0 + 0.08 * k  # (side by side)
+        ax.plot(
+            [r["rate"] * shift for r in rows],
+            [r["phi_j"] for r in rows],
+            "o",
+            color=f"C{k}",
+            alpha=0.7,
+            label=f"N = {n:,}",
+        )
+    ax.set(
+        xscale="log",
+        xlabel="growth rate (diameters per thermal time)",
+        ylabel="φ_J at Z = 10⁶",
+        title="Jamming of a 50:50 bidisperse mixture",
+    )
+    ax.legend()
+    fig.tight_layout()
+    path = f"{folder}/physics_jamming.png"
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m collision_env.bench.physics", description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help=f"N = {QUICK_SIZE} rather than {SIZE}")
     parser.add_argument("--json", help="write the raw figures here")
     parser.add_argument("--markdown", help="write the tables here")
     parser.add_argument("--readme", help="rewrite this README's bench:physics block")
-    parser.add_argument("--plot", help="write physics_eos.png into this folder")
+    parser.add_argument("--plot", help="write physics_eos.png and physics_jamming.png into this folder")
     args = parser.parse_args(argv)
     results = run(args.quick)
     text = render_markdown(results)
@@ -221,6 +366,7 @@ def main(argv: list[str] | None = None) -> int:
         write_block(args.readme, "bench:physics", text)
     if args.plot:
         print(plot(results, args.plot))
+        print(plot_jamming(results, args.plot))
     return 0
 
 

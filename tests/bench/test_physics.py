@@ -1,4 +1,5 @@
-"""The hard-disk benchmark: a small periodic fluid against the reference equation of state."""
+"""The hard-disk benchmark: a small periodic fluid against the reference equation of state, small
+packings compressed to jamming."""
 
 import math
 
@@ -33,6 +34,12 @@ def test_a_small_fluid_meets_the_equation_of_state(monkeypatch):
         "n": 400,
         "equation_of_state": [row],
         "speed": [{"packing": 0.3, "events": 10, "events_per_s": 1e6}],
+        "jamming": P.jamming(((128, 0.1, 2),), log=lambda *a: None),
     }
     text = P.render_markdown(results)
     assert "| 0.30 |" in text and "Kolafa" in text
+    # two small packings jammed near O'Hern et al.'s density, summarised in one row
+    (summary,) = P.jamming_summary(results["jamming"])
+    assert summary["seeds"] == 2 and summary["all_jammed"]
+    assert 0.80 < summary["phi_j"] < 0.87 and summary["phi_j_sd"] > 0.0
+    assert f"| 128 | 0.1 | 2 | {summary['phi_j']:.4f}" in text
