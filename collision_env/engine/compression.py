@@ -4,11 +4,11 @@ The disks' radii grow in proportion while they move and collide (Lubachevsky & S
 Stat. Phys.* 60, 561 (1990); Donev, Torquato & Stillinger, *J. Comput. Phys.* 202, 737 (2005)): the
 time of impact of growing disks is still a quadratic, and a colliding pair bounces about the growth
 speed, so that it separates (:mod:`~collision_env.engine.physics.growth`; the event loop is
-:mod:`~collision_env.engine.exact.growth`). Collisions feed energy in; after every ``N`` collisions
+:mod:`~collision_env.engine.exact.growth`). Collisions feed energy in; after every ``4 N`` collisions
 the velocities are rescaled to the starting temperature. As the packing approaches jamming, the
 collision rate and the pressure diverge; the compression stops when the reduced pressure ``Z = P A
 / (N kT)`` passes ``until_pressure``, measured from the collision virial (walls included, see
-:func:`compress`) over the last ``N`` collisions or more.
+:func:`compress`) over the last ``4 N`` collisions or more (:data:`WINDOW_PER_DISK`).
 
 >>> from collision_env.engine import compress, disk_gas
 >>> gas = disk_gas(64, 0.3, arrangement="random", periodic=True, diameters=(1.0, 1.4), seed=2)
@@ -40,8 +40,9 @@ from .validation import Labels, checked_balls, is_real
 #: :func:`compress`): slow enough that the disks stay near equilibrium until close to jamming.
 DEFAULT_RATE = 1e-3
 #: The reduced pressure at which a packing is taken as jammed: the gaps between the disks of its
-#: rigid network are then about ``2 / Z`` of a diameter (the free-volume estimate ``Z ~ 2 phi_J /
-#: (phi_J - phi)`` in two dimensions; Donev, Torquato & Stillinger 2005).
+#: rigid network are then about ``1 / Z`` of a diameter (the free-volume equation of state near
+#: jamming, ``Z ~ d / (1 - phi / phi_J)`` in ``d`` dimensions, Salsburg & Wood, *J. Chem. Phys.* 37,
+#: 798 (1962), with ``1 - phi / phi_J ~ d gap / sigma``).
 DEFAULT_UNTIL_PRESSURE = 1e6
 #: Events per disk the compression may spend by default: it stops there with a warning.
 DEFAULT_EVENTS_PER_DISK = 100_000
@@ -72,7 +73,7 @@ class Packing(NamedTuple):
     masses: np.ndarray  #: (N,)
     radii: np.ndarray  #: (N,) the final radii
     packing_fraction: float  #: ``sum(pi r_i^2) / A``
-    reduced_pressure: float  #: ``Z = P A / (N kT)`` over the last ``N`` collisions or more
+    reduced_pressure: float  #: ``Z = P A / (N kT)`` over the last ``4 N`` collisions or more
     events: int  #: collisions (of pairs and with walls)
     time: float  #: how long the disks grew (s)
     jammed: bool  #: ``reduced_pressure`` reached ``until_pressure``
@@ -116,7 +117,7 @@ def compress(
         Slower compressions jam denser (the rate dependence is measured by ``python -m
         collision_env.bench.physics``); 0 runs the gas without growth.
     until_pressure:
-        Stop once ``Z = 1 + W / (2 K t)`` reaches it, over a window of at least ``N`` collisions:
+        Stop once ``Z = 1 + W / (2 K t)`` reaches it, over a window of at least ``4 N`` collisions:
         ``W`` sums ``sigma_ij J_ij`` over the collisions and, in a box, ``r_i J_i`` over the wall
         impacts (the virial theorem then gives the walls' pressure on the box area), ``J`` the
         normal impulses (see :func:`~collision_env.observables.reduced_pressure`).

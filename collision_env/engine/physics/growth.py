@@ -8,7 +8,7 @@ v_j - v_i``, the pair touches when ``|dr + dv t| = sigma + sigma_dot t``, a quad
     a t^2 + 2 b t + c = 0,   a = dv^2 - sigma_dot^2,   b = dr . dv - sigma sigma_dot,
                              c = dr^2 - sigma^2
 
-(Donev, Torquato & Stillinger, *J. Comput. Phys.* 202, 737 (2005), eq. 5). ``c >= 0`` apart; the
+(Donev, Torquato & Stillinger, *J. Comput. Phys.* 202, 737 (2005)). ``c >= 0`` apart; the
 earliest root is ``t = c / (-b + sqrt(b^2 - a c))``, the stable form (no cancellation near contact),
 whenever the pair closes in (``b < 0``) or the growth outruns the relative speed (``a < 0``: then
 they always meet, and the root is real). ``sigma_dot = 0`` gives back ``toi.toi_pair``.
