@@ -146,7 +146,7 @@ def _resolve_border(sc, t_end, h, i, u_min, b, ph, state):
     shift_body(i, t * vel[i, 0], t * vel[i, 1], pos, body, sticky)
 
 
-@njit(inline="always")
+@njit(refcount=False, forceinline=True)
 def resolve(sc, t_end, h, u_min, b, ph, state, cells):
     """Reconstruct and resolve the collisions of a sub-step of ``h`` seconds ending at ``t_end``;
     ``cells`` is the sub-step's broad phase (``cells.cell_lists``): pairs come from it in index
