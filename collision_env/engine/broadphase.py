@@ -22,7 +22,7 @@ import math
 import numpy as np
 
 from ._jit import njit
-from .physics.tolerance import balls_touch
+from .physics.tolerance import CONTACT_RTOL, balls_touch, roundoff
 from .physics.walls import wall_contact, wall_count, wall_of
 
 #: Scenes with fewer balls keep one cell (every ball is every other's neighbour): below this size
@@ -197,6 +197,25 @@ def _root(parent, i):
         parent[i] = parent[parent[i]]  # (path halving)
         i = parent[i]
     return i
+
+
+@njit
+def spans_walls(pos, radius, extent, bounds, dim):
+    """Which of the ``(K, N, 2)`` scenes have balls near both walls along an axis, within twice the
+    contact tolerance of the radii and of ``extent`` (``(K,)``, each scene's coordinate magnitude):
+    the only scenes :func:`wall_to_wall` can find a network in (this test is looser than its contact
+    test, so it never skips one). One compiled pass, as it runs at every start-state check."""
+    k, n = radius.shape
+    out = np.zeros(k, dtype=np.bool_)
+    for sc in range(k):
+        for axis in range(dim):
+            low = high = False
+            for i in range(n):
+                near = CONTACT_RTOL * 2.0 * radius[sc, i] + 2.0 * roundoff(extent[sc])
+                low |= pos[sc, i, axis] - radius[sc, i] - bounds[axis] <= near
+                high |= bounds[axis + 2] - radius[sc, i] - pos[sc, i, axis] <= near
+            out[sc] |= low and high
+    return out
 
 
 @njit

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from .broadphase import first_overlap, first_overlap_periodic, wall_to_wall
+from .broadphase import first_overlap, first_overlap_periodic, spans_walls, wall_to_wall
 from .physics.periodic import periods, wrap_positions
 from .physics.tolerance import CONTACT_RTOL, EPS, roundoff
 from .scene import CONSTANT_RADIUS, Scene, radius_from_mass
@@ -266,14 +266,8 @@ def checked_balls(
                 )
     if scene.bounds is not None and not scene.periodic and not overlaps:
         bounds = np.array(scene.bounds)
-        # only a scene with balls at two opposite walls can have a network between them (this test
-        # is looser than the kernel's contact test, so it never skips one)
-        near = CONTACT_RTOL * 2.0 * r[..., None] + 2.0 * roundoff(extent[:, None])[..., None]
-        gaps = np.stack([pos[..., 0] - r - bounds[0], bounds[2] - r - pos[..., 0]], -1)
-        if scene.dimension == 2:
-            gaps = np.concatenate([gaps, np.stack([pos[..., 1] - r - bounds[1], bounds[3] - r - pos[..., 1]], -1)], -1)
-        at = (gaps <= near).any(axis=1)  # (k, walls): some ball of the scene touches the wall
-        for sc in np.flatnonzero((at[:, 0::2] & at[:, 1::2]).any(-1)):
+        # only a scene with balls at two opposite walls can have a network between them
+        for sc in np.flatnonzero(spans_walls(pos, r, extent, bounds, scene.dimension)):
             i, axis, size = wall_to_wall(pos[sc], r[sc], bounds, scene.dimension, scene.ball_collisions)
             if i >= 0:
                 walls = ("left and right walls", "bottom and top walls")[axis]

@@ -63,7 +63,7 @@ from .walls import heads_into, wall_axis
 _ROUNDOFF_SPEED = 8.0 * 2.0**-52
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def elastic_threshold(vel, collapse_ratio, collapse_floor):
     """``u_min`` for one scene of the cheap modes: ``collapse_ratio`` times the speed of the scene's
     slowest moving ball (a pair that collides has at least one ball that fast, so the rule adds at

@@ -55,7 +55,7 @@ def cell_lists(n, p, v, h, scratch, geo):
     return cells
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def worst_case_impacts(n, cells, room):
     """Most impacts a sub-step can record: a pair per neighbour, and border and containment
     impacts; counted cell by cell only when a cruder bound (every ball's 3 x 3 block as full as
@@ -91,7 +91,7 @@ def insert_sorted(out, m, j):
     return m + 1
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def later_neighbours(i, n, cells):
     """The balls ``j > i`` in the 3 x 3 cells around ball ``i``, ascending, into ``cells.near``;
     returns how many. With one cell that is every ``j > i``, so the cheap modes visit pairs in the

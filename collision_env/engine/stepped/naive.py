@@ -39,7 +39,7 @@ def shift_body(i, dx, dy, pos, body, sticky):
             pos[k, 1] += dy
 
 
-@njit(refcount=False, forceinline=True)
+@njit(inline="always")
 def contain(sc, t_abs, u_min, b, ph, state):
     """Put every ball that ended up past a wall back on it; reflect it if it still moves outward."""
     pos, vel, radius, bounds = b.pos, b.vel, b.radius, ph.bounds
