@@ -24,7 +24,7 @@ import math
 import sys
 import time
 import warnings
-from typing import Any, NamedTuple
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -34,7 +34,7 @@ from .exact import growth
 from .gas import Gas
 from .physics.periodic import wrap_positions
 from .scene import Scene
-from .validation import Labels, checked_balls, is_real
+from .validation import Labels, checked_balls, is_real, positive_integer
 
 #: The growth rate of the diameters, in mean diameters per unit of the thermal time (see
 #: :func:`compress`): slow enough that the disks stay near equilibrium until close to jamming.
@@ -148,7 +148,7 @@ def compress(
     if shape is None or len(shape) != 2 or shape[0] < 2:
         raise ValueError(f"positions: expected shape (N, 2) with N >= 2, got {shape or 'a ragged sequence'}")
     n = shape[0]
-    budget = DEFAULT_EVENTS_PER_DISK * n if max_events is None else _budget(max_events)
+    budget = DEFAULT_EVENTS_PER_DISK * n if max_events is None else positive_integer(max_events, "max_events")
     if masses is None:
         masses = np.ones(n)
     if velocities is None:
@@ -160,12 +160,6 @@ def compress(
     if not kinetic > 0.0:
         raise ValueError("velocities: the disks must move (the kinetic energy is 0, so no temperature to hold)")
     return _Compression(scene, pos[0], vel[0], mass[0], r[0], rate, kinetic).run(until_pressure, budget, progress)
-
-
-def _budget(value: Any) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-        raise ValueError(f"max_events: must be an integer >= 1, got {value!r}")
-    return int(value)
 
 
 def _maxwell(masses: ArrayLike, seed: int | np.random.Generator | None, n: int) -> np.ndarray:
@@ -334,7 +328,7 @@ class _Window:
     """The collision virial and the kinetic energy's time integral since a window began."""
 
     def __init__(self, t: float, tally: np.ndarray, kinetic: float) -> None:
-        self.t0 = self.t = t
+        self.t = t
         self.virial0 = tally[growth.TALLY_PAIR_VIRIAL] + tally[growth.TALLY_WALL_VIRIAL]
         self.collisions0 = tally[growth.TALLY_COLLISIONS]
         self.kinetic = kinetic  # at the window's (or the last rescale's) start
