@@ -69,6 +69,8 @@ def grid_geometry(
         r = radii[..., None]
         lo = (positions - r).min(axis=1)
         hi = (positions + r).max(axis=1)
+    if not use_grid and period is None:  # one cell, with no boundary (a small scene: the common reset)
+        return np.concatenate([lo, np.full((n_scenes, 2), np.inf)], axis=1), np.ones((n_scenes, 2), dtype=np.int64)
     size = hi - lo
     sigma = 2.0 * reach * radii.max(axis=1) * CELL_MARGIN
     # about one ball per cell, but never narrower than a diameter

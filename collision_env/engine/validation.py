@@ -163,10 +163,10 @@ def checked_balls(
         r = np.broadcast_to(real_array(radii, [(n,), (k, n)], "radii", where, label), (k, n)).copy()
 
     def fail(mask, message):
-        bad = np.argwhere(mask)
-        if len(bad):
-            s, i = bad[0][0], bad[0][1]
-            raise ValueError(label(scenes[s], i) + message(s, i))
+        if not mask.any():  # (the common case: several times cheaper than argwhere)
+            return
+        s, i = np.argwhere(mask)[0]
+        raise ValueError(label(scenes[s], i) + message(s, i))
 
     big = MAX_MAGNITUDE
     with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
