@@ -62,15 +62,18 @@ def grid_geometry(
     its cells tile the periodic cell exactly, at least 3 along each repeating axis or else 1 (the
     periodic cell's own length, so that a ball crossing it is seen), and one row along y in 1D."""
     n_scenes, n = radii.shape
-    if bounds is not None:
-        lo = np.broadcast_to(np.array(bounds[:2], dtype=np.float64), (n_scenes, 2))
-        hi = np.broadcast_to(np.array(bounds[2:], dtype=np.float64), (n_scenes, 2))
+    if bounds is not None:  # (the same for every scene: broadcast)
+        lo = np.array(bounds[:2], dtype=np.float64)
+        hi = np.array(bounds[2:], dtype=np.float64)
     else:
         r = radii[..., None]
         lo = (positions - r).min(axis=1)
         hi = (positions + r).max(axis=1)
     if not use_grid and period is None:  # one cell, with no boundary (a small scene: the common reset)
-        return np.concatenate([lo, np.full((n_scenes, 2), np.inf)], axis=1), np.ones((n_scenes, 2), dtype=np.int64)
+        cells = np.full((n_scenes, 4), np.inf)
+        cells[:, :2] = lo
+        return cells, np.ones((n_scenes, 2), dtype=np.int64)
+    lo = np.broadcast_to(lo, (n_scenes, 2))
     size = hi - lo
     sigma = 2.0 * reach * radii.max(axis=1) * CELL_MARGIN
     # about one ball per cell, but never narrower than a diameter

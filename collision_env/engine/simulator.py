@@ -813,7 +813,7 @@ class BatchSimulator:
                 raise ValueError(
                     f"state {key}: expected {'integers' if whole else 'real numbers'}, got dtype {a.dtype}"
                 )
-            if not np.isfinite(a).all():
+            if a.dtype.kind == "f" and not np.isfinite(a).all():  # (integers always are)
                 raise ValueError(f"state {key}: values must be finite")
             arrays[key] = a
         scenes = np.arange(self._n_scenes)
@@ -857,12 +857,12 @@ class BatchSimulator:
         """``set_state``'s clusters and spins: each ball's root is a ball index and its own root (every
         ball its own without stick clusters), and spins are representable (raises ValueError)."""
         n = self._n
-        bad = (clusters < 0) | (clusters >= n)
-        if not bad.any():
-            roots = np.take_along_axis(clusters, clusters, axis=1)
-            bad = roots != clusters
-            if not self.scene.sticky:
-                bad |= clusters != np.arange(n)
+        if not self.scene.sticky:  # (every ball its own cluster: its own root too)
+            bad = clusters != np.arange(n)
+        else:
+            bad = (clusters < 0) | (clusters >= n)
+            if not bad.any():
+                bad = np.take_along_axis(clusters, clusters, axis=1) != clusters
         if bad.any():
             s, i = np.argwhere(bad)[0]
             expected = "a ball index whose cluster is its own" if self.scene.sticky else f"{i} (no stick clusters)"

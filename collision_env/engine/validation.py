@@ -129,6 +129,11 @@ class Labels:
         return f"{where}ball {ball}: " if ball is not None else (f"scene {sc}: " if self.n_scenes > 1 else "")
 
 
+def _per_scene(values: np.ndarray, k: int) -> np.ndarray:
+    """``(N,)`` or ``(K, N)`` values, a fresh copy from ``real_array``, as ``(K, N)``."""
+    return values if values.ndim == 2 else np.tile(values, (k, 1))
+
+
 def checked_balls(
     scene: Scene,
     label: Labels,
@@ -152,7 +157,7 @@ def checked_balls(
     vel = real_array(velocities, [(k, n, 2)], "velocities", where, label)
     if masses is None:
         raise ValueError(f"masses: expected shape ({n},) or ({k}, {n}), got None")
-    m = np.broadcast_to(real_array(masses, [(n,), (k, n)], "masses", where, label), (k, n)).copy()
+    m = _per_scene(real_array(masses, [(n,), (k, n)], "masses", where, label), k)
     if radii is None:
         r = radius_from_mass(m)
     elif isinstance(radii, str):
@@ -160,7 +165,7 @@ def checked_balls(
             raise ValueError(f"radii: expected None, 'constant' or an array, got {radii!r}")
         r = np.full((k, n), CONSTANT_RADIUS)
     else:
-        r = np.broadcast_to(real_array(radii, [(n,), (k, n)], "radii", where, label), (k, n)).copy()
+        r = _per_scene(real_array(radii, [(n,), (k, n)], "radii", where, label), k)
 
     def fail(mask, message):
         if not mask.any():  # (the common case: several times cheaper than argwhere)
@@ -175,8 +180,8 @@ def checked_balls(
             ~(np.abs(pos) <= big).all(-1),
             lambda s, i: f"position must be finite, within {big:g} m, got {tuple(pos[s, i])}",
         )
-        fail(
-            ~(np.abs(vel) <= big).all(-1) | ~(speed <= big),
+        fail(  # (a speed within range bounds both components: hypot is at least either)
+            ~(speed <= big),
             lambda s, i: f"velocity must be finite, speed within {big:g} m/s, got {tuple(vel[s, i])}",
         )
         fail(
@@ -192,7 +197,8 @@ def checked_balls(
     if scene.periodic and scene.bounds is not None:  # (checked where they will be: wrapped into the cell)
         pos, _ = wrap_positions(pos, scene.bounds, scene.dimension)
     # the coordinates' magnitude in each scene: the border, or the balls' own extent
-    extent = np.max(np.abs(pos) + r[..., None], axis=(1, 2))
+    coordinate = np.abs(pos).max(-1)
+    extent = (coordinate + r).max(-1)
     if scene.bounds is not None:
         extent = np.maximum(extent, max(abs(v) for v in scene.bounds))
     smallest = MIN_RADIUS_ULPS * EPS * extent
@@ -230,7 +236,7 @@ def checked_balls(
                     f"diameter is the box {name} {size:.6g} m or more"
                 ),
             )
-        tol = START_CONTACT_RTOL * r + roundoff(np.abs(pos).max(-1))
+        tol = START_CONTACT_RTOL * r + roundoff(coordinate)
         out = (pos[..., 0] - r < xmin - tol) | (pos[..., 0] + r > xmax + tol)
         if scene.dimension == 2:
             out |= (pos[..., 1] - r < ymin - tol) | (pos[..., 1] + r > ymax + tol)
