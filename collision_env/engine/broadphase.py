@@ -22,7 +22,7 @@ import math
 import numpy as np
 
 from ._jit import njit
-from .physics.tolerance import CONTACT_RTOL, balls_touch, roundoff
+from .physics.tolerance import CONTACT_RTOL, balls_touch, coordinate_size, roundoff
 from .physics.walls import wall_contact, wall_count, wall_of
 
 #: Scenes with fewer balls keep one cell (every ball is every other's neighbour): below this size
@@ -166,10 +166,21 @@ def _ball_cells(pos, radius):
     return head, nxt, cell, nx, ny
 
 
+@njit(inline="always")
+def _overlap(i, j, dx, dy, pos, radius, rtol):
+    """Balls ``i`` and ``j``, ``(dx, dy)`` apart, overlap by more than ``rtol`` of their radii sum and
+    the round-off of their coordinates (the engine leaves touching balls a few ulps apart either way:
+    far from the origin an ulp can be more than ``rtol`` of the radii)."""
+    coord = max(coordinate_size(i, pos), coordinate_size(j, pos))
+    sigma = radius[i] + radius[j]
+    return math.sqrt(dx * dx + dy * dy) < sigma * (1.0 - rtol) - roundoff(coord)
+
+
 @njit
 def first_overlap(pos, radius, rtol):
     """The first pair ``(i, j)``, ``i < j`` in lexicographic order, whose disks overlap by more than
-    ``rtol`` of their radii sum, or ``(-1, -1)``; O(N) expected time on a grid of the balls' box."""
+    ``rtol`` of their radii sum and the round-off of their coordinates, or ``(-1, -1)``; O(N)
+    expected time on a grid of the balls' box."""
     n = pos.shape[0]
     if n < 2:
         return -1, -1
@@ -185,8 +196,7 @@ def first_overlap(pos, radius, rtol):
                     if j > i:
                         dx = pos[j, 0] - pos[i, 0]
                         dy = pos[j, 1] - pos[i, 1]
-                        sigma = radius[i] + radius[j]
-                        if math.sqrt(dx * dx + dy * dy) < sigma * (1.0 - rtol):
+                        if _overlap(i, j, dx, dy, pos, radius, rtol):
                             if best_i < 0 or j < best_j:
                                 best_i = i
                                 best_j = j
@@ -304,8 +314,7 @@ def first_overlap_periodic(pos, radius, rtol, x0, y0, lx, ly):
                         dy = pos[j, 1] - pos[i, 1]
                         if ly > 0.0:
                             dy -= ly * math.floor(dy / ly + 0.5)
-                        sigma = radius[i] + radius[j]
-                        if math.sqrt(dx * dx + dy * dy) < sigma * (1.0 - rtol):
+                        if _overlap(i, j, dx, dy, pos, radius, rtol):
                             if best_j < 0 or j < best_j:
                                 best_j = j
                     j = nxt[j]

@@ -159,6 +159,34 @@ def test_a_scene_translated_far_away_has_the_same_impacts(seed, e, offset):
     np.testing.assert_allclose(t1, t0, rtol=0, atol=1e-8)
 
 
+@SLOW
+@given(
+    offset=st.sampled_from([1e3, 1e5, 1e6, -1e7]),
+    e=st.sampled_from([0.0, 0.5]),
+    speed=st.floats(0.1, 10.0),
+    dt=st.floats(0.01, 1.0),
+)
+def test_a_state_the_engine_leaves_far_from_the_origin_is_accepted_again(offset, e, speed, dt):
+    # the balls come to rest touching, a few ulps of the coordinates apart either way: at 1e6 m an
+    # ulp is 1e-10 m, more than any tolerance relative to the radii alone would allow
+    case = (
+        Scene(bounds=PLAY_AREA_1D, elasticity=e, dimension=1),
+        [[-1.5, 0.0], [-0.8, 0.0]],
+        [[-speed, 0.0], [-speed, 0.0]],
+        [1.0, 1.0],
+        [0.1, 0.1],
+    )
+    sim = _shifted(case, offset)
+    twin = sim.copy()
+    for _ in range(10):
+        sim.step(dt)
+        twin.step(dt)
+        twin.set_state(twin.get_state())
+    assert sim.time == twin.time
+    np.testing.assert_array_equal(twin.positions, sim.positions)
+    np.testing.assert_array_equal(twin.velocities, sim.velocities)
+
+
 # --------------------------------------------------------------------------- 4. the clock
 def test_the_clock_is_the_correctly_rounded_sum_after_a_million_steps():
     dt = 1 / 60
