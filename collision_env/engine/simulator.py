@@ -400,7 +400,9 @@ class BatchSimulator:
         ``dt`` is a real number (numpy scalars included) of at most 1e150 s; without a border, the
         step must also keep every ball within 1e150 m. The clocks are compensated sums: after any
         number of steps ``time`` is within an ulp of the exact sum of the ``dt`` taken (forward and
-        back again returns it to exactly where it was).
+        back again returns it to exactly where it was). Backwards, a bounce at elasticity e < 1
+        multiplies a speed by 1/e, and the bounces come ever faster: a past that reaches infinite
+        speed within the step raises a ``ValueError`` naming the ball, and changes nothing.
         """
         return self._step(dt)
 
@@ -442,6 +444,9 @@ class BatchSimulator:
             fp[S_SIGN] = sign
             self._sign = sign
             self._forward = sign > 0.0 and self.scene.bounds is not None and not self.scene.periodic
+        # reversed, a bounce at e < 1 multiplies the speed by 1/e, and the bounces come ever faster:
+        # a past may diverge within finite time. Such a step is refused, from a copy kept here.
+        before = self._saved() if sign < 0 and e < 1.0 else None
         if sign < 0:
             np.negative(self._vel, out=self._vel)
             np.negative(self._omega, out=self._omega)
@@ -451,7 +456,24 @@ class BatchSimulator:
             if sign < 0:
                 np.negative(self._vel, out=self._vel)
                 np.negative(self._omega, out=self._omega)
+        if before is not None:
+            self._refuse_divergent_past(before, dt)
         return self._finish(chunks, sign, stacklevel)
+
+    def _refuse_divergent_past(self, before: list[np.ndarray], dt: float) -> None:
+        """After a backward step at e < 1: if a ball's speed or position overflowed, restore
+        ``before`` (:meth:`_saved` before the step) and raise a ValueError naming the ball."""
+        lost = ~(np.isfinite(self._pos).all(-1) & np.isfinite(self._vel).all(-1))
+        if lost.any():
+            s, i = np.argwhere(lost)[0]
+            for mine, saved in zip(self._stepped_arrays(), before, strict=True):
+                np.copyto(mine, saved)
+            e = self.scene.elasticity
+            raise ValueError(
+                f"dt: the past of {self._label(s, i).rstrip(': ')} diverges within this step of {dt:g} s: "
+                f"reversed, each bounce at elasticity {e:g} multiplies its speed by {1.0 / e:.6g}, and the "
+                "bounces come ever faster, until the speed overflows (the state is unchanged)"
+            )
 
     def frames(self, dt: float, n: int, out: Frames | None = None) -> Frames:
         """Take ``n`` steps of ``dt`` seconds, recording every scene after each one.
@@ -892,16 +914,32 @@ class BatchSimulator:
                 f"other: a simulator of the same scene, mode and shape, got mode {other.mode!r} and shape "
                 f"{other._balls.shape[:2]} (this one: {self.mode!r}, {self._balls.shape[:2]})"
             )
-        for name in ("_balls", "_body", "_time", "_clock", "_capped", "_work_f", "_work_i", "_images"):
-            np.copyto(getattr(self, name), getattr(other, name))
+        for mine, theirs in zip(self._stepped_arrays(), other._stepped_arrays(), strict=True):
+            np.copyto(mine, theirs)
         for field in (S_ELASTICITY, S_SIGN):  # (the direction of time the state is kept for)
             self._fparams[field] = other._fparams[field]
-        if self._spec.persistent:
-            for mine, theirs in zip(self._mode_arrays[0], other._mode_arrays[0], strict=True):
-                np.copyto(mine, theirs)
         self._sign = other._sign
         self._forward = other._forward
         self._start = START_STEP
+
+    def _stepped_arrays(self) -> list[np.ndarray]:
+        """The arrays a step changes: balls, clusters, clocks and, in exact mode, the event
+        calendar (what :meth:`load` takes from another simulator)."""
+        arrays = [
+            self._balls,
+            self._body,
+            self._time,
+            self._clock,
+            self._capped,
+            self._work_f,
+            self._work_i,
+            self._images,
+        ]
+        return arrays + list(self._mode_arrays[0]) if self._spec.persistent else arrays
+
+    def _saved(self) -> list[np.ndarray]:
+        """Copies of :meth:`_stepped_arrays`, to restore a step's start from."""
+        return [a.copy() for a in self._stepped_arrays()]
 
     #: What a copy or a pickle rebuilds rather than carries: work space, and what is bound to it.
     _REBUILT = (

@@ -313,6 +313,32 @@ def test_a_step_that_overflows_the_position_is_rejected(dt, speed):
         np.testing.assert_array_equal(value, before[key])
 
 
+@SLOW
+@given(e=st.floats(0.05, 0.8), dt=st.floats(20.0, 1e3), n_scenes=st.integers(1, 3))
+def test_a_backward_step_into_a_divergent_past_is_rejected(e, dt, n_scenes):
+    # reversed, a ball bouncing between walls at e < 1 gains 1/e of its speed per bounce, and the
+    # bounces come ever faster: its past reaches infinite speed within a finite time (along y,
+    # 1.8 m / 0.8 m/s * e / (1 - e) after the first bounce: under 11 s for e <= 0.8)
+    pos = [[[0.0, 0.0]]] * n_scenes
+    vel = [[[0.0, 0.0]]] * (n_scenes - 1) + [[[0.6, 0.8]]]  # (only the last scene's ball moves)
+    sim = BatchSimulator(Scene(elasticity=e), pos, vel, [1.0], [0.1])
+    twin = sim.copy()
+    sim.step(0.25)
+    twin.step(0.25)
+    before = sim.get_state()
+    ball = "ball 0" if n_scenes == 1 else f"scene {n_scenes - 1}, ball 0"
+    with pytest.raises(ValueError, match=f"dt: the past of {ball} diverges within this step"):
+        sim.step(-dt)
+    for key, value in sim.get_state().items():
+        np.testing.assert_array_equal(value, before[key])
+    for s in (sim, twin):  # and what follows is as if the step was never asked for
+        s.step(-0.5)
+        s.step(1.0)
+    np.testing.assert_array_equal(sim.positions, twin.positions)
+    np.testing.assert_array_equal(sim.velocities, twin.velocities)
+    assert np.isfinite(sim.velocities).all()
+
+
 def test_a_long_step_without_a_border_that_stays_representable_is_taken():
     sim = _make(scene=Scene(bounds=None), velocities=[[-1.0, 0.0], [1.0, 0.0]])
     sim.step(1e140)
