@@ -21,6 +21,10 @@ from .physics.walls import WALL_BOTTOM, WALL_LEFT, WALL_NAMES, WALL_RIGHT, WALL_
 PLAY_AREA_2D = (-2.0, -1.0, 2.0, 1.0)
 #: PhET's 1D play area: 4 m by 1.1 m; balls stay on y = 0.
 PLAY_AREA_1D = (-2.0, -0.55, 2.0, 0.55)
+#: Largest coordinate of a border or a ball (m), speed (m/s) and |dt| (s) accepted: squares and sums
+#: of these stay finite in float64 (the time-of-impact kernels square separations and relative
+#: velocities).
+MAX_MAGNITUDE = 1e150
 #: Density of PhET's balls (kg/m^3): the radius of a ball is that of a sphere of this density.
 BALL_DENSITY = 35.0
 #: PhET's radius with "Constant Size" checked (m).
@@ -124,8 +128,10 @@ class Scene:
         object.__setattr__(self, "dimension", int(self.dimension))
         if self.bounds is not None:
             b = _real_tuple(self.bounds, "scene bounds", "(xmin, ymin, xmax, ymax)")
-            if len(b) != 4 or not all(math.isfinite(v) for v in b):
-                raise ValueError(f"scene bounds: expected four finite numbers, got {self.bounds!r}")
+            if len(b) != 4 or not all(abs(v) <= MAX_MAGNITUDE for v in b):
+                raise ValueError(
+                    f"scene bounds: expected four finite numbers within {MAX_MAGNITUDE:g} m, got {self.bounds!r}"
+                )
             if not (b[0] < b[2] and b[1] < b[3]):
                 raise ValueError(f"scene bounds: need xmin < xmax and ymin < ymax, got {b}")
             if self.dimension == 1 and not (b[1] < 0.0 < b[3]):

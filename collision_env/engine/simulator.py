@@ -54,7 +54,7 @@ from .layout import (
 )
 from .modes import MODES as MODE_REGISTRY
 from .physics.motion import apply_impulses
-from .physics.periodic import wrap_positions
+from .physics.periodic import MAX_IMAGES, wrap_positions
 from .scene import Scene
 from .state import (
     RESUME,
@@ -861,7 +861,7 @@ class BatchSimulator:
                 )
         pos, images = self._wrapped(pos)
         if "images" in arrays:
-            images = images + arrays["images"]
+            images = images + self._checked_images(arrays["images"], images)
         np.copyto(self._pos, pos)
         np.copyto(self._images, images)
         np.copyto(self._vel, vel)
@@ -874,6 +874,18 @@ class BatchSimulator:
         self._clock[:, 0] = arrays["time"]
         self._clock[:, 1] = arrays["time_compensation"]
         self._invalidate(scenes)
+
+    def _checked_images(self, given: np.ndarray, wrapped: np.ndarray) -> np.ndarray:
+        """``set_state``'s images (integers), as int64: each, and its sum with the periods
+        ``wrapped`` that wrapping the positions added, within ``MAX_IMAGES`` (raises ValueError)."""
+        far = ~(np.abs(given.astype(np.float64) + wrapped) <= MAX_IMAGES)
+        if far.any():
+            s, i, axis = np.argwhere(far)[0]
+            raise ValueError(
+                f"state images: {self._label(s, i)}expected at most 2**53 periods from the cell, "
+                f"got {given[s, i, axis]} along {'xy'[axis]}"
+            )
+        return given.astype(np.int64)
 
     def _check_clusters(self, clusters, omega):
         """``set_state``'s clusters and spins: each ball's root is a ball index and its own root (every

@@ -18,15 +18,12 @@ from typing import Any
 import numpy as np
 
 from .broadphase import first_overlap, first_overlap_periodic, spans_walls, wall_to_wall
-from .physics.periodic import periods, wrap_positions
+from .physics.periodic import MAX_IMAGES, periods, wrap_positions
 from .physics.tolerance import CONTACT_RTOL, EPS, roundoff
-from .scene import CONSTANT_RADIUS, Scene, radius_from_mass
+from .scene import CONSTANT_RADIUS, MAX_MAGNITUDE, Scene, radius_from_mass
 
 #: Relative tolerance for "touching" in the start-state checks (exact contact is allowed).
 START_CONTACT_RTOL = 1e-12
-#: Largest position (m), speed (m/s) and |dt| (s) accepted: squares and sums of these stay finite in
-#: float64 (the time-of-impact kernels square separations and relative velocities).
-MAX_MAGNITUDE = 1e150
 #: A radius must span this many units in the last place of the scene's coordinates: contact is then
 #: resolved to better than 1e-4 of the radius (``tolerance.contact_tolerance``) anywhere in the scene.
 MIN_RADIUS_ULPS = 2.0**16
@@ -195,6 +192,15 @@ def checked_balls(
     fail(~(np.isfinite(r) & (r > 0) & (r <= big)), lambda s, i: f"radius must be positive and finite, got {r[s, i]}")
     given = pos
     if scene.periodic and scene.bounds is not None:  # (checked where they will be: wrapped into the cell)
+        for axis, length in enumerate(periods(scene.bounds, scene.dimension)):
+            if length > 0.0:
+                fail(
+                    ~(np.abs(pos[..., axis] - scene.bounds[axis]) <= MAX_IMAGES * length),
+                    lambda s, i, axis=axis, length=length: (
+                        f"position {'xy'[axis]} = {pos[s, i, axis]:g} lies more than 2**53 periods "
+                        f"({MAX_IMAGES * length:.6g} m) from the periodic cell, where its image count is not exact"
+                    ),
+                )
         pos, _ = wrap_positions(pos, scene.bounds, scene.dimension)
     # the coordinates' magnitude in each scene: the border, or the balls' own extent
     coordinate = np.abs(pos).max(-1)

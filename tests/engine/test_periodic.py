@@ -151,6 +151,37 @@ def test_state_round_trip_keeps_images_and_steps_alike():
     np.testing.assert_array_equal(sim.images, images)
 
 
+@pytest.mark.parametrize("x", [1e16, -3.7e19, 1e150])
+def test_a_position_beyond_exact_image_counts_is_rejected(x):
+    with pytest.raises(ValueError, match=r"ball 1: position x = .* lies more than 2\*\*53 periods"):
+        Simulator(Scene(bounds=CELL, periodic=True), [[0.5, 0.5], [x, 0.5]], np.zeros((2, 2)), [1.0, 1.0], [0.1, 0.1])
+
+
+@pytest.mark.parametrize(
+    "images, accepted",
+    [
+        (np.array([[0, 0], [3, 4]], dtype=np.uint64), True),
+        (np.array([[0, 0], [2**53, -(2**53)]]), True),
+        (np.array([[0, 0], [0, 2**63 - 1]]), False),
+        (np.array([[0, 0], [-(2**63), 0]]), False),
+        (np.array([[0, 0], [2**64 - 1, 0]], dtype=np.uint64), False),
+    ],
+)
+def test_set_state_takes_images_within_exact_counts(images, accepted):
+    pos = [[0.25, 0.5], [0.75, 0.5]]
+    sim = Simulator(Scene(bounds=CELL, periodic=True), pos, np.ones((2, 2)), [1.0, 1.0], [0.1, 0.1])
+    state = sim.get_state()
+    if accepted:
+        sim.set_state({**state, "images": images})
+        np.testing.assert_array_equal(sim.images, images.astype(np.int64))
+        assert sim.images.dtype == np.int64
+        return
+    with pytest.raises(ValueError, match=r"state images: ball 1: expected at most 2\*\*53 periods from the cell"):
+        sim.set_state({**state, "images": images})
+    for key, value in sim.get_state().items():
+        np.testing.assert_array_equal(value, state[key])
+
+
 # ---------------------------------------------------------------------------- the grid
 def _gas(n, radius, seed, side=1.0):
     rng = np.random.default_rng(seed)

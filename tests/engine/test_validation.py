@@ -63,6 +63,7 @@ def test_construction_rejects_bad_input(changes, message):
         (dict(inelastic="glue"), "inelastic: must be"),
         (dict(bounds=(2, -1, -2, 1)), "bounds: need xmin < xmax"),
         (dict(bounds=(0, 0, math.inf, 1)), "bounds: expected four finite numbers"),
+        (dict(bounds=(-1e151, -1, 1, 1)), r"bounds: expected four finite numbers within 1e\+150 m"),
     ],
 )
 def test_scene_rejects_bad_input(kwargs, message):

@@ -25,6 +25,10 @@ import numpy as np
 from .._jit import njit
 from .toi import INF, toi_pair
 
+#: Most periods a ball may lie from the cell, along an axis: image counts up to this are exact in
+#: float64 (and their sums far from int64's range), so that ``position + images * length`` holds.
+MAX_IMAGES = 2**53
+
 
 def periods(bounds: tuple[float, float, float, float], dim: int) -> tuple[float, float]:
     """The cell lengths ``(lx, ly)`` of a periodic scene's ``bounds`` (``ly = 0`` in 1D), computed as
