@@ -758,8 +758,15 @@ class BatchSimulator:
         """
         time = real_number(time, "time")
         check_seconds(time, "time")
-        idx = np.arange(self._n_scenes)[cast(Any, index)]  # (indices or a mask: numpy's indexing decides)
-        idx = np.atleast_1d(idx)
+        try:  # (indices or a mask: numpy's indexing decides)
+            idx = np.atleast_1d(np.arange(self._n_scenes)[cast(Any, index)])
+        except IndexError:
+            idx = None
+        if idx is None or idx.ndim != 1:
+            raise ValueError(
+                f"index: expected scene indices within the batch of {self._n_scenes} (negative ones count "
+                f"from its end) or a ({self._n_scenes},) bool mask, got {index!r}"
+            )
         if masses is None:
             masses = self._mass[idx]
         if radii is None:

@@ -79,7 +79,8 @@ def check_seconds(value: float, field: str) -> None:
 def real_array(value: Any, shapes: list, field: str, where: Callable, label: Labels | None = None) -> np.ndarray:
     """A float64 copy of ``value``: real numbers (no booleans, strings or complex numbers) in one of
     ``shapes``, the last of them the batched one. ``where(index)`` names the ball of an element, and
-    ``label`` shows shapes (for the error message)."""
+    ``label`` shows shapes (for the error message). A field with the batched shape alone is one that
+    a single simulator wraps in a batch axis of its own: its shape is shown without it."""
     rank = len(shapes[-1])
 
     def expected():
@@ -104,7 +105,7 @@ def real_array(value: Any, shapes: list, field: str, where: Callable, label: Lab
                     raise ValueError(f"{where(index)}{field} must be within float64's range, got {_magnitude(int(x))}")
         arr = obj.astype(np.float64) if obj.shape in shapes else obj
     if arr.shape not in shapes:
-        got = label.shape(arr.shape, arr.ndim == rank) if label else str(arr.shape)
+        got = label.shape(arr.shape, arr.ndim == rank or len(shapes) == 1) if label else str(arr.shape)
         raise ValueError(f"{field}: expected shape {expected()}, got {got}")
     return arr
 

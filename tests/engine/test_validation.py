@@ -139,6 +139,21 @@ def test_batch_errors_name_the_scene():
         np.testing.assert_array_equal(value, before[key])
 
 
+@pytest.mark.parametrize("index", [[3], [-4], [0.5], [True], [[True, False, True]], "a", None, np.zeros((1, 1), int)])
+def test_set_scenes_names_a_bad_index(index):
+    batch = BatchSimulator(Scene(), np.array([[[-1.0, 0.0], [1.0, 0.0]]] * 3), np.zeros((3, 2, 2)), np.ones(2))
+    before = batch.get_state()
+    with pytest.raises(
+        ValueError, match=r"index: expected scene indices within the batch of 3 .* or a \(3,\) bool mask"
+    ):
+        batch.set_scenes(index, [[[-1.0, 0.0], [1.0, 0.0]]], np.zeros((1, 2, 2)))
+    for key, value in batch.get_state().items():
+        np.testing.assert_array_equal(value, before[key])
+    batch.set_scenes([-1], [[[-1.5, 0.0], [1.0, 0.0]]], np.zeros((1, 2, 2)))  # the last scene
+    batch.set_scenes([False, True, False], [[[-1.5, 0.0], [1.0, 0.0]]], np.zeros((1, 2, 2)))
+    assert batch.positions[1:, 0, 0].tolist() == [-1.5, -1.5]
+
+
 @pytest.mark.parametrize(
     "call, message",
     [
@@ -148,6 +163,9 @@ def test_batch_errors_name_the_scene():
         ),
         (lambda: make(masses=[1.0, 2.0, 3.0]), r"masses: expected shape \(2,\), got \(3,\)"),
         (lambda: make().nudge([[1.0, 0.0]]), r"nudge: expected shape \(2, 2\), got \(1, 2\)"),
+        (lambda: make().nudge([1.0, 0.0]), r"nudge: expected shape \(2, 2\), got \(2,\)"),
+        (lambda: make().nudge(0.5), r"nudge: expected shape \(2, 2\), got \(\)"),
+        (lambda: make(positions=[1.0, 0.0]), r"positions: expected shape \(N, 2\), got \(2,\)"),
         (lambda: make().set_balls(velocities=[[1.0, 0.0]]), r"velocities: expected shape \(2, 2\), got \(1, 2\)"),
         (lambda: make().set_state({**make().get_state(), "radii": np.ones(3)}), r"expected shape \(2,\), got \(3,\)"),
     ],
