@@ -75,6 +75,7 @@ from .validation import (
     check_laps,
     check_reach,
     check_seconds,
+    check_stick_clusters,
     checked_balls,
     checked_nudge,
     is_real,
@@ -805,11 +806,13 @@ class BatchSimulator:
         Checked as the constructor checks its balls (shapes, number types, finite and representable
         values, balls inside the border and apart, none spanning the box), and beyond that: the
         clusters are ball indices whose roots are their own roots (every ball its own cluster unless
-        the scene sticks), spins are within 1e150 rad/s, the clocks are times the constructor would accept, each
-        with a compensation below an ulp of it. In naive and posteriori modes, whose steps may end
-        with balls overlapping, overlaps (and touching balls from wall to wall, which these modes
-        step like any others) are accepted. Bad input raises a ``ValueError`` naming
-        the scene, ball and field, and changes nothing. ``images`` may be left out (zeros); in a
+        the scene sticks), a stick cluster's balls move as one rigid body and touch one another in a
+        network, spins are within 1e150 rad/s, the clocks are times the constructor would accept,
+        each with a compensation below an ulp of it. In naive and posteriori modes, whose steps may
+        end with balls overlapping, overlaps (and touching balls from wall to wall, which these
+        modes step like any others) are accepted, and so are stick clusters whose balls do not
+        quite touch. Bad input raises a ``ValueError`` naming the scene, ball and field, and
+        changes nothing. ``images`` may be left out (zeros); in a
         periodic scene, positions outside the cell are wrapped into it, their images counted.
         """
         shapes = {
@@ -858,6 +861,9 @@ class BatchSimulator:
             overlaps=self._spec.leaves_overlaps,
         )
         self._check_clusters(arrays["clusters"], arrays["omega"])
+        if self.scene.sticky:
+            touching = not self._spec.leaves_overlaps  # (the cheap modes stick balls a sub-step apart)
+            check_stick_clusters(pos, vel, mass, radius, arrays["clusters"], arrays["omega"], self._label, touching)
         for sc in scenes:
             time, compensation = float(arrays["time"][sc]), float(arrays["time_compensation"][sc])
             check_seconds(time, f"state time: {self._label(sc)}".rstrip(": "))

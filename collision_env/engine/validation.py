@@ -176,11 +176,11 @@ def checked_balls(
         speed = np.hypot(vel[..., 0], vel[..., 1])
         fail(
             ~(np.abs(pos) <= big).all(-1),
-            lambda s, i: f"position must be finite, within {big:g} m, got {tuple(pos[s, i])}",
+            lambda s, i: f"position must be finite, within {big:g} m, got {tuple(pos[s, i].tolist())}",
         )
         fail(  # (a speed within range bounds both components: hypot is at least either)
             ~(speed <= big),
-            lambda s, i: f"velocity must be finite, speed within {big:g} m/s, got {tuple(vel[s, i])}",
+            lambda s, i: f"velocity must be finite, speed within {big:g} m/s, got {tuple(vel[s, i].tolist())}",
         )
         fail(
             ~(np.isfinite(m) & (m > 0) & np.isfinite(1.0 / m)),
@@ -188,7 +188,7 @@ def checked_balls(
         )
         fail(
             ~np.isfinite(0.5 * m * speed * speed),
-            lambda s, i: f"velocity {tuple(vel[s, i])} gives mass {m[s, i]} a kinetic energy beyond float64",
+            lambda s, i: f"velocity {tuple(vel[s, i].tolist())} gives mass {m[s, i]} a kinetic energy beyond float64",
         )
     fail(~(np.isfinite(r) & (r > 0) & (r <= big)), lambda s, i: f"radius must be positive and finite, got {r[s, i]}")
     given = pos
@@ -251,7 +251,7 @@ def checked_balls(
             out,
             lambda s, i: (
                 f"position must keep the ball inside the reflecting border {scene.bounds}, "
-                f"got {tuple(pos[s, i])} with radius {r[s, i]:.6g}"
+                f"got {tuple(pos[s, i].tolist())} with radius {r[s, i]:.6g}"
             ),
         )
     if scene.ball_collisions and n > 1 and not overlaps:
@@ -324,6 +324,63 @@ def check_laps(scene: Scene, mass: np.ndarray, vel: np.ndarray, dt: float, label
         )
 
 
+#: A stick cluster's members move as one rigid body: a member's velocity may differ from the rigid
+#: motion ``v_cm + omega x (p - p_cm)`` by this much of the cluster's fastest speed (the engine's
+#: rigid-body updates leave ~1e-10 of round-off; a state put together by hand is off by far more).
+RIGID_RTOL = 1e-6
+
+
+def check_stick_clusters(
+    pos: np.ndarray,
+    vel: np.ndarray,
+    mass: np.ndarray,
+    radius: np.ndarray,
+    clusters: np.ndarray,
+    omega: np.ndarray,
+    label: Labels,
+    touching: bool = True,
+) -> None:
+    """Each cluster of ``(K, N)`` ``clusters`` (indices of their root balls, checked) of more than
+    one ball is one body: its balls move rigidly, with the angular velocity ``omega`` of the root,
+    and (if ``touching``) touch one another in a network, within the engine's contact tolerance
+    (they were stuck on contact). Raises a ValueError naming the first ball that does not."""
+    for sc in range(clusters.shape[0]):
+        roots, counts = np.unique(clusters[sc], return_counts=True)
+        for root in roots[counts > 1]:
+            members = np.flatnonzero(clusters[sc] == root)
+            p, v, m, r = pos[sc, members], vel[sc, members], mass[sc, members], radius[sc, members]
+            offset = p - m @ p / m.sum()
+            w = omega[sc, root]
+            rigid = m @ v / m.sum() + w * np.stack([-offset[:, 1], offset[:, 0]], axis=1)
+            scale = np.abs(v).max() + abs(w) * np.abs(offset).max()
+            error = np.abs(v - rigid).max(-1)
+            if error.max() > RIGID_RTOL * scale:
+                k = int(np.argmax(error))
+                raise ValueError(
+                    f"state velocities: {label(sc, members[k])}moves apart from its stick cluster (root ball {root}): "
+                    f"a cluster moves as one rigid body, v = v_cm + omega x (p - p_cm), and this ball's "
+                    f"velocity {tuple(v[k].tolist())} is {error[k]:.3g} m/s off"
+                )
+            if not touching:
+                continue
+            sigma = r[:, None] + r[None, :]
+            gap = np.hypot(*(p[:, None, :] - p[None, :, :]).transpose(2, 0, 1)) - sigma
+            touch = gap <= np.maximum(CONTACT_RTOL * sigma, roundoff(float(np.abs(p).max())))
+            reached = np.zeros(len(members), dtype=bool)
+            reached[0] = True
+            while True:  # (grow the network from the first member)
+                grown = reached | touch[reached].any(0)
+                if (grown == reached).all():
+                    break
+                reached = grown
+            if not reached.all():
+                k = int(np.argmin(reached))
+                raise ValueError(
+                    f"state clusters: {label(sc, members[k])}does not touch the rest of its stick cluster "
+                    f"(root ball {root}) through a network of touching balls: clusters form on contact"
+                )
+
+
 def checked_nudge(dv: Any, scene: Scene, vel: np.ndarray, mass: np.ndarray, label: Labels) -> np.ndarray:
     """``dv`` as a float64 ``(B, N, 2)`` velocity change: finite, 0 along y in 1D, and giving speeds
     that stay representable (bounded through the clusters' spin by the largest change of any of
@@ -333,7 +390,9 @@ def checked_nudge(dv: Any, scene: Scene, vel: np.ndarray, mass: np.ndarray, labe
     # one cheap test on the common path; find the culprit only when there is one
     if not (np.abs(dv) <= MAX_MAGNITUDE).all():
         s, i = np.argwhere(~(np.abs(dv) <= MAX_MAGNITUDE).all(-1))[0]
-        raise ValueError(f"{label(s, i)}nudge must be finite, within {MAX_MAGNITUDE:g} m/s, got {tuple(dv[s, i])}")
+        raise ValueError(
+            f"{label(s, i)}nudge must be finite, within {MAX_MAGNITUDE:g} m/s, got {tuple(dv[s, i].tolist())}"
+        )
     if scene.dimension == 1 and dv[..., 1].any():
         s, i = np.argwhere(dv[..., 1] != 0.0)[0]
         raise ValueError(f"{label(s, i)}nudge y must be 0 in a 1D scene, got {dv[s, i, 1]}")
@@ -347,7 +406,7 @@ def checked_nudge(dv: Any, scene: Scene, vel: np.ndarray, mass: np.ndarray, labe
     if bad.any():
         s, i = np.argwhere(bad)[0]
         raise ValueError(
-            f"{label(s, i)}nudge {tuple(dv[s, i])} would give a speed beyond the representable "
+            f"{label(s, i)}nudge {tuple(dv[s, i].tolist())} would give a speed beyond the representable "
             f"range (speeds up to {MAX_MAGNITUDE:g} m/s, finite kinetic energy)"
         )
     return dv

@@ -291,6 +291,35 @@ def test_set_state_checks_stick_clusters_and_names_missing_keys():
         stick.set_state([1, 2])
 
 
+@pytest.mark.parametrize("mode", ["exact", "naive", "posteriori"])
+def test_set_state_takes_a_stick_cluster_only_as_one_rigid_body_of_touching_balls(mode):
+    pos, vel = [[-1.0, 0.0], [-0.5, 0.1], [1.0, 0.0]], [[1.0, 0.0], [0.0, 0.0], [0.0, 0.0]]
+    sim = Simulator(Scene(elasticity=0.0, inelastic="stick"), pos, vel, [1.0, 2.0, 1.0], [0.25] * 3, mode=mode)
+    sim.step(0.2)  # balls 0 and 1 stick, and the cluster spins
+    state = sim.get_state()
+    assert state["clusters"].tolist() == [0, 0, 2] and state["omega"][0] != 0.0
+    sim.set_state(state)
+
+    def refused(message, **changes):
+        with pytest.raises(ValueError, match=message):
+            sim.set_state({**state, **changes})
+        for key, value in sim.get_state().items():
+            np.testing.assert_array_equal(value, state[key])
+
+    moving = "moves apart from its stick cluster \\(root ball 0\\): a cluster moves as one rigid body"
+    faster = state["velocities"].copy()
+    faster[1] += 1e-3 * np.abs(faster).max()
+    refused(f"state velocities: ball [01]: {moving}", velocities=faster)
+    refused(f"state velocities: ball [01]: {moving}", omega=state["omega"] * 1.01)
+    refused(f"state velocities: ball 2: {moving}", clusters=np.array([0, 0, 0]))
+    translating = {"velocities": np.tile([0.3, 0.0], (3, 1)), "omega": np.zeros(3), "clusters": np.array([0, 0, 0])}
+    if mode == "exact":
+        far = "does not touch the rest of its stick cluster \\(root ball 0\\)"
+        refused(f"state clusters: ball 2: {far}", **translating)
+    else:  # (the cheap modes stick balls that a sub-step left apart)
+        sim.set_state({**state, **translating})
+
+
 @settings(max_examples=60, deadline=None)
 @given(
     n=st.integers(2, 6),
