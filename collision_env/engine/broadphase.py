@@ -166,7 +166,7 @@ def _ball_cells(pos, radius):
     return head, nxt, cell, nx, ny
 
 
-@njit
+@njit(inline="always")
 def _overlap(i, j, dx, dy, pos, radius, rtol):
     """Balls ``i`` and ``j``, ``(dx, dy)`` apart, overlap by more than ``rtol`` of their radii sum and
     the round-off of their coordinates (the engine leaves touching balls a few ulps apart either way:

@@ -464,9 +464,9 @@ class BatchSimulator:
     def _refuse_divergent_past(self, before: list[np.ndarray], dt: float) -> None:
         """After a backward step at e < 1: if a ball's speed or position overflowed, restore
         ``before`` (:meth:`_saved` before the step) and raise a ValueError naming the ball."""
-        lost = ~(np.isfinite(self._pos).all(-1) & np.isfinite(self._vel).all(-1))
-        if lost.any():
-            s, i = np.argwhere(lost)[0]
+        motion = self._balls[..., B_X : B_VX + 2]  # (positions and velocities)
+        if not np.isfinite(motion).all():
+            s, i = np.argwhere(~np.isfinite(motion).all(-1))[0]
             for mine, saved in zip(self._stepped_arrays(), before, strict=True):
                 np.copyto(mine, saved)
             e = self.scene.elasticity
@@ -891,14 +891,16 @@ class BatchSimulator:
     def _checked_images(self, given: np.ndarray, wrapped: np.ndarray) -> np.ndarray:
         """``set_state``'s images (integers), as int64: each, and its sum with the periods
         ``wrapped`` that wrapping the positions added, within ``MAX_IMAGES`` (raises ValueError)."""
+        if -MAX_IMAGES <= given.min() and given.max() <= MAX_IMAGES:  # (then their sum cannot overflow)
+            images = given.astype(np.int64)
+            if not wrapped.any() or np.abs(images + wrapped).max() <= MAX_IMAGES:
+                return images
         far = ~(np.abs(given.astype(np.float64) + wrapped) <= MAX_IMAGES)
-        if far.any():
-            s, i, axis = np.argwhere(far)[0]
-            raise ValueError(
-                f"state images: {self._label(s, i)}expected at most 2**53 periods from the cell, "
-                f"got {given[s, i, axis]} along {'xy'[axis]}"
-            )
-        return given.astype(np.int64)
+        s, i, axis = np.argwhere(far)[0]
+        raise ValueError(
+            f"state images: {self._label(s, i)}expected at most 2**53 periods from the cell, "
+            f"got {given[s, i, axis]} along {'xy'[axis]}"
+        )
 
     def _check_clusters(self, clusters, omega):
         """``set_state``'s clusters and spins: each ball's root is a ball index and its own root (every

@@ -343,42 +343,56 @@ def check_stick_clusters(
     """Each cluster of ``(K, N)`` ``clusters`` (indices of their root balls, checked) of more than
     one ball is one body: its balls move rigidly, with the angular velocity ``omega`` of the root,
     and (if ``touching``) touch one another in a network, within the engine's contact tolerance
-    (they were stuck on contact). Raises a ValueError naming the first ball that does not."""
-    for sc in range(clusters.shape[0]):
-        roots, counts = np.unique(clusters[sc], return_counts=True)
-        for root in roots[counts > 1]:
-            members = np.flatnonzero(clusters[sc] == root)
-            p, v, m, r = pos[sc, members], vel[sc, members], mass[sc, members], radius[sc, members]
-            offset = p - m @ p / m.sum()
-            w = omega[sc, root]
-            rigid = m @ v / m.sum() + w * np.stack([-offset[:, 1], offset[:, 0]], axis=1)
-            scale = np.abs(v).max() + abs(w) * np.abs(offset).max()
-            error = np.abs(v - rigid).max(-1)
-            if error.max() > RIGID_RTOL * scale:
-                k = int(np.argmax(error))
-                raise ValueError(
-                    f"state velocities: {label(sc, members[k])}moves apart from its stick cluster (root ball {root}): "
-                    f"a cluster moves as one rigid body, v = v_cm + omega x (p - p_cm), and this ball's "
-                    f"velocity {tuple(v[k].tolist())} is {error[k]:.3g} m/s off"
-                )
-            if not touching:
-                continue
-            sigma = r[:, None] + r[None, :]
-            gap = np.hypot(*(p[:, None, :] - p[None, :, :]).transpose(2, 0, 1)) - sigma
-            touch = gap <= np.maximum(CONTACT_RTOL * sigma, roundoff(float(np.abs(p).max())))
-            reached = np.zeros(len(members), dtype=bool)
-            reached[0] = True
-            while True:  # (grow the network from the first member)
-                grown = reached | touch[reached].any(0)
-                if (grown == reached).all():
-                    break
-                reached = grown
-            if not reached.all():
-                k = int(np.argmin(reached))
-                raise ValueError(
-                    f"state clusters: {label(sc, members[k])}does not touch the rest of its stick cluster "
-                    f"(root ball {root}) through a network of touching balls: clusters form on contact"
-                )
+    (they were stuck on contact). Raises a ValueError naming the first ball that does not. Every
+    cluster of every scene at once: ``key`` numbers them ``scene * N + root``."""
+    k, n = clusters.shape
+    if (clusters == np.arange(n)).all():  # (no cluster of more than one ball)
+        return
+    key = (clusters + n * np.arange(k)[:, None]).ravel()
+    m = mass.ravel()
+    total = np.bincount(key, weights=m, minlength=k * n)[key]
+
+    def centre(values):  # each ball's cluster's mass-weighted mean of (K, N, 2) values
+        x, y = (np.bincount(key, weights=m * values[..., axis].ravel(), minlength=k * n)[key] for axis in (0, 1))
+        return np.stack([x, y], axis=-1) / total[:, None]
+
+    p, v = pos.reshape(-1, 2), vel.reshape(-1, 2)
+    offset = p - centre(pos)
+    w = omega.ravel()[key]
+    rigid = centre(vel) + w[:, None] * np.stack([-offset[:, 1], offset[:, 0]], axis=-1)
+    scale = np.zeros(k * n)  # each cluster's fastest speed, of a ball or of a point spun by omega
+    np.maximum.at(scale, key, np.abs(v).max(-1) + np.abs(w) * np.abs(offset).max(-1))
+    error = np.abs(v - rigid).max(-1)
+    off = error > RIGID_RTOL * scale[key]
+    if off.any():
+        b = int(np.flatnonzero(off)[0])
+        raise ValueError(
+            f"state velocities: {label(b // n, b % n)}moves apart from its stick cluster (root ball "
+            f"{clusters.flat[b]}): a cluster moves as one rigid body, v = v_cm + omega x (p - p_cm), and this "
+            f"ball's velocity {tuple(v[b].tolist())} is {error[b]:.3g} m/s off"
+        )
+    if not touching:
+        return
+    # a network of touching balls: each ball takes the lowest index it reaches through touching
+    # balls of its cluster, until nothing changes; every ball of a cluster then has its root's
+    sigma = radius[:, :, None] + radius[:, None, :]
+    gap = np.hypot(*np.moveaxis(pos[:, :, None, :] - pos[:, None, :, :], -1, 0)) - sigma
+    coordinate = np.abs(pos).max(-1)
+    tolerance = np.maximum(CONTACT_RTOL * sigma, roundoff(np.maximum(coordinate[:, :, None], coordinate[:, None, :])))
+    linked = (gap <= tolerance) & (clusters[:, :, None] == clusters[:, None, :])
+    reached = np.broadcast_to(np.arange(n), (k, n))
+    while True:
+        lowest = np.where(linked, reached[:, None, :], n).min(-1)
+        if (lowest == reached).all():
+            break
+        reached = lowest
+    apart = reached != np.take_along_axis(reached, clusters, axis=1)
+    if apart.any():
+        sc, i = np.argwhere(apart)[0]
+        raise ValueError(
+            f"state clusters: {label(sc, i)}does not touch the rest of its stick cluster (root ball "
+            f"{clusters[sc, i]}) through a network of touching balls: clusters form on contact"
+        )
 
 
 def checked_nudge(dv: Any, scene: Scene, vel: np.ndarray, mass: np.ndarray, label: Labels) -> np.ndarray:

@@ -311,7 +311,7 @@ def test_set_state_takes_a_stick_cluster_only_as_one_rigid_body_of_touching_ball
     faster[1] += 1e-3 * np.abs(faster).max()
     refused(f"state velocities: ball [01]: {moving}", velocities=faster)
     refused(f"state velocities: ball [01]: {moving}", omega=state["omega"] * 1.01)
-    refused(f"state velocities: ball 2: {moving}", clusters=np.array([0, 0, 0]))
+    refused(f"state velocities: ball 0: {moving}", clusters=np.array([0, 0, 0]))  # (v_cm moves)
     translating = {"velocities": np.tile([0.3, 0.0], (3, 1)), "omega": np.zeros(3), "clusters": np.array([0, 0, 0])}
     if mode == "exact":
         far = "does not touch the rest of its stick cluster \\(root ball 0\\)"
@@ -354,3 +354,22 @@ def test_set_state_refuses_any_bad_value_and_changes_nothing(n, key, ball, value
         sim.set_state(bad)
     for k, v in sim.get_state().items():
         np.testing.assert_array_equal(v, state[k])
+
+
+def test_set_state_names_the_scene_of_a_broken_stick_cluster():
+    pos = [[[-1.0, 0.0], [-0.5, 0.1], [1.0, 0.0]]] * 2
+    vel = [[[1.0, 0.0], [0.0, 0.0], [0.0, 0.0]]] * 2
+    batch = BatchSimulator(Scene(elasticity=0.0, inelastic="stick"), pos, vel, [1.0, 2.0, 1.0], [0.25] * 3)
+    batch.step(0.2)
+    state = batch.get_state()
+    assert state["clusters"].tolist() == [[0, 0, 2]] * 2
+    batch.set_state(state)
+    velocities = state["velocities"].copy()
+    velocities[1, 1] *= 1.1
+    with pytest.raises(ValueError, match="state velocities: scene 1, ball 0: moves apart from its stick cluster"):
+        batch.set_state({**state, "velocities": velocities})
+    clusters = state["clusters"].copy()
+    clusters[1, 2] = 0
+    velocities = np.broadcast_to([0.3, 0.0], (2, 3, 2))
+    with pytest.raises(ValueError, match="state clusters: scene 1, ball 2: does not touch the rest of its stick"):
+        batch.set_state({**state, "velocities": velocities, "omega": np.zeros((2, 3)), "clusters": clusters})
