@@ -893,9 +893,13 @@ class BatchSimulator:
         ``wrapped`` that wrapping the positions added, within ``MAX_IMAGES`` (raises ValueError)."""
         if -MAX_IMAGES <= given.min() and given.max() <= MAX_IMAGES:  # (then their sum cannot overflow)
             images = given.astype(np.int64)
-            if not wrapped.any() or np.abs(images + wrapped).max() <= MAX_IMAGES:
+            if not wrapped.any():
                 return images
-        far = ~(np.abs(given.astype(np.float64) + wrapped) <= MAX_IMAGES)
+            far = np.abs(images + wrapped) > MAX_IMAGES
+            if not far.any():
+                return images
+        else:  # (compared as integers: beyond 2**53, a float64 could round a count into range)
+            far = (given < -MAX_IMAGES) | (given > MAX_IMAGES)
         s, i, axis = np.argwhere(far)[0]
         raise ValueError(
             f"state images: {self._label(s, i)}expected at most 2**53 periods from the cell, "
