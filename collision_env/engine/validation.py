@@ -22,8 +22,11 @@ from .physics.periodic import MAX_IMAGES, periods, wrap_positions
 from .physics.tolerance import CONTACT_RTOL, EPS, roundoff
 from .scene import CONSTANT_RADIUS, MAX_MAGNITUDE, Scene, radius_from_mass
 
-#: Relative tolerance for "touching" in the start-state checks (exact contact is allowed).
-START_CONTACT_RTOL = 1e-12
+#: Relative tolerance for "touching" in the start-state checks: the engine's own contact tolerance,
+#: within which its steps leave touching balls and walls (exact mode's impacts leave pairs a few
+#: 1e-12 of their radii sum apart either way, the cheap modes' walls a ball a few 1e-12 of its
+#: radius past them).
+START_CONTACT_RTOL = CONTACT_RTOL
 #: A radius must span this many units in the last place of the scene's coordinates: contact is then
 #: resolved to better than 1e-4 of the radius (``tolerance.contact_tolerance``) anywhere in the scene.
 MIN_RADIUS_ULPS = 2.0**16
