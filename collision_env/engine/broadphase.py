@@ -22,7 +22,7 @@ import math
 import numpy as np
 
 from ._jit import njit
-from .physics.tolerance import CONTACT_RTOL, balls_touch, coordinate_size, roundoff
+from .physics.tolerance import CONTACT_RTOL, balls_touch, contact_tolerance, coordinate_size, roundoff
 from .physics.walls import wall_contact, wall_count, wall_of
 
 #: Scenes with fewer balls keep one cell (every ball is every other's neighbour): below this size
@@ -168,19 +168,19 @@ def _ball_cells(pos, radius):
 
 @njit(inline="always")
 def _overlap(i, j, dx, dy, pos, radius, rtol):
-    """Balls ``i`` and ``j``, ``(dx, dy)`` apart, overlap by more than ``rtol`` of their radii sum and
-    the round-off of their coordinates (the engine leaves touching balls a few ulps apart either way:
-    far from the origin an ulp can be more than ``rtol`` of the radii)."""
+    """Balls ``i`` and ``j``, ``(dx, dy)`` apart, overlap by more than the contact tolerance: ``rtol``
+    of their radii sum, or the round-off of their coordinates (the engine leaves touching balls a
+    few ulps apart either way: far from the origin an ulp can be more than ``rtol`` of the radii)."""
     coord = max(coordinate_size(i, pos), coordinate_size(j, pos))
     sigma = radius[i] + radius[j]
-    return math.sqrt(dx * dx + dy * dy) < sigma * (1.0 - rtol) - roundoff(coord)
+    return math.sqrt(dx * dx + dy * dy) < sigma - contact_tolerance(sigma, coord, rtol)
 
 
 @njit
 def first_overlap(pos, radius, rtol):
     """The first pair ``(i, j)``, ``i < j`` in lexicographic order, whose disks overlap by more than
-    ``rtol`` of their radii sum and the round-off of their coordinates, or ``(-1, -1)``; O(N)
-    expected time on a grid of the balls' box."""
+    the contact tolerance (``rtol`` of their radii sum, or the round-off of their coordinates), or
+    ``(-1, -1)``; O(N) expected time on a grid of the balls' box."""
     n = pos.shape[0]
     if n < 2:
         return -1, -1

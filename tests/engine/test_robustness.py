@@ -167,8 +167,8 @@ def test_a_scene_translated_far_away_has_the_same_impacts(seed, e, offset):
     dt=st.floats(0.01, 1.0),
 )
 def test_a_state_the_engine_leaves_far_from_the_origin_is_accepted_again(offset, e, speed, dt):
-    # the balls come to rest touching, a few ulps of the coordinates apart either way: at 1e6 m an
-    # ulp is 1e-10 m, more than any tolerance relative to the radii alone would allow
+    # the balls end steps touching, a few ulps of the coordinates apart either way: at 1e7 m an ulp
+    # is 2e-9 m, ten times what a tolerance of 1e-9 of the radii sum alone would allow
     case = (
         Scene(bounds=PLAY_AREA_1D, elasticity=e, dimension=1),
         [[-1.5, 0.0], [-0.8, 0.0]],
