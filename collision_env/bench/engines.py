@@ -56,12 +56,12 @@ class EngineRunner(Runner):
 
     def step(self, dt: float, record: bool = True) -> np.ndarray:
         rows = self._sim.step(dt)
-        if self._sim._capped[0]:
+        if self._sim._stepper.capped[0]:  # (the array itself: cap_reached copies it)
             self._capped = True
         return rows
 
     def state(self) -> tuple[np.ndarray, np.ndarray]:
-        return self._sim._pos[0].copy(), self._sim._vel[0].copy()
+        return self._sim.positions[0], self._sim.velocities[0]
 
     @property
     def impact_count(self) -> int:

@@ -137,26 +137,27 @@ def measure(n: int, cache_kib: int = CACHE_KIB, sites: int = 0) -> dict:
 
     if HAVE_NUMBA:
         raise RuntimeError("measure() traces the Python path: run it with NUMBA_DISABLE_JIT=1 (main() does)")
-    sim = TimedGas(n, trace_memory=False).sim  # (built, and warmed up as the scale benchmark does)
+    # (built, and warmed up as the scale benchmark does; its stepper, whose pack the tracing replaces)
+    stepper = TimedGas(n, trace_memory=False).sim._stepper
     cache = LineCache(cache_kib * 1024 // LINE)
     if sites:
         cache.sites = {}
     traced = []
     bundles = []
-    for bundle in sim._pack:  # (the Python path's pack: the kernel's bundles of arrays)
+    for bundle in stepper._pack:  # (the Python path's pack: the kernel's bundles of arrays)
         views = [array.view(TracedArray) for array in bundle]
         for name, view in zip(bundle._fields, views, strict=True):
             view.tag, view.cache = name, cache
         traced += views
         bundles.append(type(bundle)(*views))
-    sim._pack = tuple(bundles)
+    stepper._pack = tuple(bundles)
     for view in sorted(traced, key=lambda view: -view.nbytes):  # (largest first: what fits stays)
         cache.touch_all(view, view.tag)
-    sim.step(WARM_S)
+    stepper.step(WARM_S)
     cache.counting = True
-    before = sim.stats
-    sim.step(FRAME)
-    after = sim.stats
+    before = stepper.stats()
+    stepper.step(FRAME)
+    after = stepper.stats()
     events = after["events"] - before["events"]
     per_event = {tag: count / events for tag, count in sorted(cache.misses.items(), key=lambda kv: -kv[1])}
     costliest = sorted((cache.sites or {}).items(), key=lambda kv: -kv[1])[:sites]

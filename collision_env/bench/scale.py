@@ -281,13 +281,13 @@ def bench_public(n: int = 10_000, frames: int = 60, rounds: int = 3) -> dict:
     nu = enskog_rate(n / _area(scene), 2 * RADIUS, PACKING, sim.kinetic_energy() / n, 1.0)
     sim.frames(FRAME, max(1, math.ceil(WARM_COLLISIONS / nu / FRAME)))
     start = sim.get_state()
-    batch = sim.batch
+    stepper = sim._stepper
 
     def kernel():
         for _ in range(frames):
-            if batch._kernel(batch._pack, FRAME, START_STEP) < 0:
-                while batch._n_imp[2]:  # (a full impact buffer stopped the step: go on, as step does)
-                    batch._kernel(batch._pack, FRAME, RESUME)
+            if stepper._kernel(stepper._pack, FRAME, START_STEP) < 0:
+                while stepper._n_imp[2]:  # (a full impact buffer stopped the step: go on, as step does)
+                    stepper._kernel(stepper._pack, FRAME, RESUME)
 
     def step():
         for _ in range(frames):

@@ -9,10 +9,13 @@ See :class:`Simulator` (one scene) and :class:`BatchSimulator` (many scenes at o
 """
 
 from ._jit import BACKEND
+from .batch import BatchSimulator, Frames
 from .compression import CompressionWarning, Packing, compress
 from .gas import Gas, disk_gas
 from .impacts import Impact, Impacts
 from .keywords import UnknownKeywordError
+from .layout import IMPACT_DTYPE
+from .modes import MODES as _MODE_REGISTRY
 from .scene import (
     BALL_DENSITY,
     CONSTANT_RADIUS,
@@ -26,16 +29,12 @@ from .scene import (
     Scene,
     radius_from_mass,
 )
-from .simulator import (
-    IMPACT_DTYPE,
-    MAX_SUBSTEPS,
-    MODES,
-    BatchSimulator,
-    EventCapWarning,
-    Frames,
-    Simulator,
-    warm_up,
-)
+from .simulator import Simulator, warm_up
+from .stepper import EventCapWarning
+from .validation import MAX_SUBSTEPS
+
+#: The engine's mode names, cheapest first.
+MODES = tuple(_MODE_REGISTRY)
 
 __all__ = [
     "BACKEND",

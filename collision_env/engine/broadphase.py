@@ -44,7 +44,7 @@ def grid_geometry(
     bounds: tuple[float, float, float, float] | None,
     positions: np.ndarray,
     radii: np.ndarray,
-    use_grid: np.ndarray,
+    use_grid: bool | np.ndarray,
     reach: float = 1.0,
     balls_per_cell: float = 1.0,
     cells_per_ball: float = 1,

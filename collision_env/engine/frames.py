@@ -5,11 +5,11 @@ step's set-up and the Python around it: about a microsecond, as much as an event
 Every mode's stepping kernel is made by :func:`frames_kernel`, which runs either one step (the
 ``start`` codes of :mod:`~collision_env.engine.state`) or, with ``RUN_FRAMES``, the same steps
 (so the same impacts, state and clocks, bit for bit) in a compiled loop that copies each frame's
-ball positions, velocities, clocks and impacts into the caller's arrays (``state.FramesOut``). It
-stops early at a frame that needs Python: one whose step reached the event cap or found the
-kernel's impact buffer full (which the simulator completes as it completes any step), or one
-whose impacts do not fit the caller's buffer. One kernel for both means a mode's step is compiled
-once, not again inside a loop of its own.
+ball positions, velocities, clocks, periodic image counts and impacts into the caller's arrays
+(``state.FramesOut``). It stops early at a frame that needs Python: one whose step reached the
+event cap or found the kernel's impact buffer full (which the simulator completes as it completes
+any step), or one whose impacts do not fit the caller's buffer. One kernel for both means a mode's
+step is compiled once, not again inside a loop of its own.
 """
 
 from __future__ import annotations
@@ -40,10 +40,13 @@ def copy_impacts(buf, out, sign):
 
 
 @njit(refcount=False)
-def record_frame(f, balls, time, times, positions, velocities):
+def record_frame(f, balls, time, images, times, positions, velocities, frame_images):
     """Frame ``f`` of the caller's arrays: every scene's clock, positions and velocities now
-    (``positions`` and ``velocities`` are ``(F, B * N, 2)``: each frame's scenes one after another)."""
+    (``positions`` and ``velocities`` are ``(F, B * N, 2)``: each frame's scenes one after another),
+    and the balls' periodic ``images`` into ``frame_images`` unless it has no rows (``(F, 0, 2)``:
+    a scene that is not periodic, whose images stay 0)."""
     n_scenes, n = balls.shape[0], balls.shape[1]
+    take_images = frame_images.shape[1] > 0
     for sc in range(n_scenes):
         times[f, sc] = time[sc]
         for i in range(n):
@@ -52,6 +55,9 @@ def record_frame(f, balls, time, times, positions, velocities):
             positions[f, row, 1] = balls[sc, i, B_X + 1]
             velocities[f, row, 0] = balls[sc, i, B_VX]
             velocities[f, row, 1] = balls[sc, i, B_VX + 1]
+            if take_images:
+                frame_images[f, row, 0] = images[sc, i, 0]
+                frame_images[f, row, 1] = images[sc, i, 1]
 
 
 @njit(refcount=False, python=False)
@@ -67,7 +73,7 @@ def _take_frame(f, rows, state, out):
         return False
     copy_impacts(state.imp, out.out[n_out : n_out + rows], 1.0)
     request[FRAME_ROWS] = n_out + rows
-    record_frame(f, state.balls, state.time, out.times, out.positions, out.velocities)
+    record_frame(f, state.balls, state.time, state.images, out.times, out.positions, out.velocities, out.images)
     return True
 
 

@@ -45,8 +45,8 @@ __all__ = [
 ]
 
 
-def _is_real(x):
-    """A real number that is not a boolean (numpy scalar types included)."""
+def is_real(x: object) -> bool:
+    """A real number that is not a boolean (Python or numpy scalar types alike)."""
     return isinstance(x, numbers.Real) and not isinstance(x, (bool, np.bool_))
 
 
@@ -57,7 +57,7 @@ def _real_tuple(values, field, expected):
     except TypeError:
         raise ValueError(f"{field}: expected {expected}, got {values!r}") from None
     for v in items:
-        if not _is_real(v):
+        if not is_real(v):
             raise ValueError(f"{field}: expected real numbers {expected}, got {v!r} ({type(v).__name__}) in {values!r}")
     try:
         return tuple(float(v) for v in items)
@@ -137,7 +137,7 @@ class Scene:
             if self.dimension == 1 and not (b[1] < 0.0 < b[3]):
                 raise ValueError(f"scene bounds: a 1D scene needs ymin < 0 < ymax (balls move on y = 0), got {b}")
             object.__setattr__(self, "bounds", b)
-        if not _is_real(self.elasticity):
+        if not is_real(self.elasticity):
             raise ValueError(f"scene elasticity: expected a number in [0, 1], got {self.elasticity!r}")
         if not (0 <= self.elasticity <= 1):  # (compared as given: a huge int has no float)
             raise ValueError(f"scene elasticity: must lie in [0, 1], got {self.elasticity!r}")

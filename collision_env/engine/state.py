@@ -102,6 +102,7 @@ class FramesOut(NamedTuple):
     times: np.ndarray  #: (F, B) float64
     positions: np.ndarray  #: (F, B * N, 2) float64
     velocities: np.ndarray  #: (F, B * N, 2) float64
+    images: np.ndarray  #: (F, B * N, 2) int64 periodic image counts, or (F, 0, 2): not recorded
     out: np.ndarray  #: impact records, ``layout.IMPACT_DTYPE``
 
 
@@ -272,7 +273,8 @@ if HAVE_NUMBA:
             view(h, s + 1, np.float64, 2),
             view(h, s + 2, np.float64, 3),
             view(h, s + 3, np.float64, 3),
-            view(h, s + 4, IMPACT_DTYPE, 1),
+            view(h, s + 4, np.int64, 3),
+            view(h, s + 5, IMPACT_DTYPE, 1),
         )
 
 else:

@@ -38,11 +38,11 @@ def test_a_pack_follows_its_arrays_when_the_impact_buffer_grows():
     pos = np.stack([x.ravel(), y.ravel()], 1)
     sim = Simulator(Scene(), pos, rng.normal(size=(n, 2)) * 3, np.ones(n), np.full(n, 0.05), mode="naive")
     reference = Simulator(Scene(), pos, sim.velocities, np.ones(n), np.full(n, 0.05), mode="naive")
-    small = sim.batch
+    small = sim._stepper
     small._alloc_work(64)  # far fewer rows than a step records
     slot = (STATE_SLOT + State._fields.index("imp")) * SLOT  # (the impact buffer's slot)
     address = small._pack[slot]
-    got, want = small.step(0.5), reference.batch.step(0.5)
+    got, want = sim.batch.step(0.5), reference.batch.step(0.5)
     assert small._pack[slot] == small._imp.ctypes.data != address
     assert len(got) == len(want) > 64
     np.testing.assert_array_equal(got, want)

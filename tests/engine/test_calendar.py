@@ -12,12 +12,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import collision_env.engine.simulator as simulator_module
+import collision_env.engine.stepper as stepper_module
 from collision_env.engine import BatchSimulator, Scene, Simulator
 from collision_env.engine.broadphase import GRID_MIN_BALLS
 from collision_env.engine.exact import calendar
 from collision_env.engine.exact.calendar import QUEUE_MIN_BALLS
-from collision_env.engine.layout import W_QUEUE_FAR, W_QUEUE_HEAP, W_QUEUE_RING
+from collision_env.engine.layout import W_GRID_NX, W_QUEUE_FAR, W_QUEUE_HEAP, W_QUEUE_RING
 
 
 def gas(n, phi=0.3, r=0.01, seed=0, speed=1.0):
@@ -107,10 +107,10 @@ def test_a_large_scene_queues_most_events_in_time_buckets():
     sim = Simulator(scene, pos, vel, np.ones(LARGE), radii=radii)
     for _ in range(3):
         sim.step(1 / 60)
-    queue = sim.batch._work_i[0]
+    queue = sim._stepper.work_i[0]
     assert queue[W_QUEUE_HEAP] + queue[W_QUEUE_RING] + queue[W_QUEUE_FAR] == LARGE
     assert queue[W_QUEUE_HEAP] < LARGE / 20 < queue[W_QUEUE_RING]
-    assert sim.batch._mode_arrays[0].buckets.shape == (1, LARGE // 2 + 1)
+    assert sim._stepper.mode_arrays[0].buckets.shape == (1, LARGE // 2 + 1)
 
 
 def test_a_large_scene_steps_bit_for_bit_as_with_a_heap_of_every_ball(monkeypatch):
@@ -119,7 +119,7 @@ def test_a_large_scene_steps_bit_for_bit_as_with_a_heap_of_every_ball(monkeypatc
     sim = Simulator(scene, pos, vel, np.ones(LARGE), radii=radii)
     monkeypatch.setattr(calendar, "bucket_count", lambda n: 0)
     heap = Simulator(scene, pos, vel, np.ones(LARGE), radii=radii)
-    assert heap.batch._mode_arrays[0].buckets.shape == (1, 1) and sim.batch._mode_arrays[0].buckets.shape[1] > 1
+    assert heap._stepper.mode_arrays[0].buckets.shape == (1, 1) and sim._stepper.mode_arrays[0].buckets.shape[1] > 1
     dv = np.zeros((LARGE, 2))
     dv[:: LARGE // 7] = (0.4, -0.9)
     for frame in range(12):
@@ -143,7 +143,7 @@ def test_forward_then_back_returns_to_the_start_with_the_calendar_kept():
 
 
 def without_grid(monkeypatch):
-    monkeypatch.setattr(simulator_module, "GRID_MIN_BALLS", 10**9)
+    monkeypatch.setattr(stepper_module, "GRID_MIN_BALLS", 10**9)
 
 
 def test_a_ball_crossing_many_cells_in_one_step(monkeypatch):
@@ -151,10 +151,10 @@ def test_a_ball_crossing_many_cells_in_one_step(monkeypatch):
     vel[:] = 0.0
     vel[0] = (37.0, 11.0)  # a bullet: ~20 cells per step
     sim = Simulator(scene, pos, vel, np.ones(200), radii=radii)
-    assert sim.batch._work_i[0, simulator_module.W_GRID_NX] > 10
+    assert sim._stepper.work_i[0, W_GRID_NX] > 10
     without_grid(monkeypatch)
     reference = Simulator(scene, pos, vel, np.ones(200), radii=radii)
-    assert reference.batch._work_i[0, simulator_module.W_GRID_NX] == 1
+    assert reference._stepper.work_i[0, W_GRID_NX] == 1
     step_both(sim, reference, 1 / 30, 10)
     assert sim.stats["cell_crossings"] > 100
     assert sim.stats["events"] > 20
@@ -210,8 +210,8 @@ def test_memory_and_construction_are_linear_in_the_balls():
     n = 20_000
     scene, pos, vel, radii = gas(n)
     sim = Simulator(scene, pos, vel, np.ones(n), radii=radii)
-    arrays = [v for v in vars(sim.batch).values() if isinstance(v, np.ndarray)]
-    arrays += [a for bundle in sim.batch._mode_arrays for a in bundle]  # (the calendar and work space)
+    arrays = [v for v in vars(sim._stepper).values() if isinstance(v, np.ndarray)]
+    arrays += [a for bundle in sim._stepper.mode_arrays for a in bundle]  # (the calendar and work space)
     per_ball = sum({id(a): a.nbytes for a in arrays}.values()) / n
     assert per_ball < 2048
     assert GRID_MIN_BALLS < n
@@ -235,7 +235,7 @@ def test_a_step_that_stalls_on_a_full_impact_buffer_is_bit_for_bit_the_same(elas
     masses = np.ones(150)
     batch = BatchSimulator(scene, [p for p, _ in starts], [v for _, v in starts], masses, radii=radii)
     singles = [Simulator(scene, p, v, masses, radii=radii) for p, v in starts]
-    batch._alloc_work(300)  # a few dozen events per call
+    batch._stepper._alloc_work(300)  # a few dozen events per call
     for _ in range(3):
         got = batch.step(0.2)
         for k, sim in enumerate(singles):

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from collision_env.engine import BatchSimulator, EventCapWarning, Scene, Simulator
+from collision_env.engine.stepper import Stepper
 from tests.engine.test_calendar import gas
 
 FIELDS = ["scene", "time", "ball", "other", "wall", "x", "y", "speed", "impulse"]
@@ -18,14 +19,14 @@ FIELDS = ["scene", "time", "ball", "other", "wall", "x", "y", "speed", "impulse"
 def loop_exits(monkeypatch):
     """Where each call of the compiled loop stopped: ``(frame, stepped)`` (see ``frames.frames_kernel``)."""
     exits = []
-    compiled = BatchSimulator._run_frames
+    compiled = Stepper._run_frames
 
     def spy(self, *args):
         result = compiled(self, *args)
         exits.append((result[0], result[1]))
         return result
 
-    monkeypatch.setattr(BatchSimulator, "_run_frames", spy)
+    monkeypatch.setattr(Stepper, "_run_frames", spy)
     return exits
 
 
@@ -52,10 +53,10 @@ def assert_frames_are_a_step_loop(sim, loop, dt, n):
     np.testing.assert_array_equal(sim.time, loop.time)
     np.testing.assert_array_equal(sim.cap_reached, loop.cap_reached)
     assert sim.stats == loop.stats
-    for name in ("_body", "_clock"):  # the clusters and clocks too
-        np.testing.assert_array_equal(getattr(sim, name), getattr(loop, name))
-    if sim._spec.persistent:  # and exact mode's calendar
-        for mine, theirs in zip(sim._mode_arrays[0], loop._mode_arrays[0], strict=True):
+    for name in ("body", "clock"):  # the clusters and clocks too
+        np.testing.assert_array_equal(getattr(sim._stepper, name), getattr(loop._stepper, name))
+    if sim._stepper.spec.persistent:  # and exact mode's calendar
+        for mine, theirs in zip(sim._stepper.mode_arrays[0], loop._stepper.mode_arrays[0], strict=True):
             np.testing.assert_array_equal(mine, theirs)
     return rec
 
@@ -118,7 +119,7 @@ def test_frames_past_full_impact_buffers_and_the_event_cap(dt, n, max_events, ca
     starts = [(pos, vel * s) for s in (1.0, 0.5, 2.0)]
     sim, loop = twin_batches(scene, starts, radii, max_events=max_events)
     for b in (sim, loop):
-        b._alloc_work(300)
+        b._stepper._alloc_work(300)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         rec = assert_frames_are_a_step_loop(sim, loop, dt, n)

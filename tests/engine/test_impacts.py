@@ -22,7 +22,7 @@ from collision_env.engine import (
     Scene,
     Simulator,
 )
-from collision_env.engine.simulator import EVENTS_PER_BALL, MIN_EVENT_CAP, default_event_cap
+from collision_env.engine.stepper import EVENTS_PER_BALL, MIN_EVENT_CAP, default_event_cap
 
 
 def _box_gas(n=12, seed=0, masses=None, e=1.0):

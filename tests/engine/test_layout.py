@@ -35,17 +35,17 @@ def test_engine_arrays_are_as_wide_as_their_layouts():
     from collision_env.engine import Scene, Simulator
 
     sim = Simulator(Scene(), [[0.0, 0.0], [1.0, 0.0]], [[1.0, 0.0], [0.0, 0.0]], [1.0, 1.0])
-    b = sim.batch
-    assert b._balls.shape[-1] == len(layout.BALL)
-    calendar = b._mode_arrays[0]
+    b = sim._stepper
+    assert b.balls.shape[-1] == len(layout.BALL)
+    calendar = b.mode_arrays[0]
     assert calendar.rec.dtype == layout.CAL_RECORD
     assert calendar.ci.shape[-1] == len(layout.CAL_I)
     assert calendar.heap.shape[-1] == len(layout.HEAP)
-    assert b._fparams.shape == (len(layout.SCENE_F),)
-    assert b._iparams.shape == (len(layout.SCENE_I),)
-    assert b._work_f.shape[-1] == len(layout.WORK_F)
-    assert b._work_i.shape[-1] == len(layout.WORK_I)
-    assert b._fparams[layout.S_XMAX] == 2.0 and b._iparams[layout.S_DIM] == 2
+    assert b.fparams.shape == (len(layout.SCENE_F),)
+    assert b.iparams.shape == (len(layout.SCENE_I),)
+    assert b.work_f.shape[-1] == len(layout.WORK_F)
+    assert b.work_i.shape[-1] == len(layout.WORK_I)
+    assert b.fparams[layout.S_XMAX] == 2.0 and b.iparams[layout.S_DIM] == 2
 
 
 def test_a_calendar_record_is_one_cache_line():
@@ -57,5 +57,5 @@ def test_a_calendar_record_is_one_cache_line():
     sim = Simulator(
         Scene(), np.stack([np.linspace(-1.8, 1.8, n), np.zeros(n)], 1), np.zeros((n, 2)), np.ones(n), np.full(n, 0.01)
     )
-    for cal in (sim.batch._mode_arrays[0].rec, sim.copy().batch._mode_arrays[0].rec):
+    for cal in (sim._stepper.mode_arrays[0].rec, sim.copy()._stepper.mode_arrays[0].rec):
         assert cal.ctypes.data % 64 == 0

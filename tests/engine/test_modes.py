@@ -133,7 +133,7 @@ def test_a_step_too_big_for_the_impact_buffer_resumes_and_matches_single_scenes(
     pos = np.stack([grid + rng.uniform(-0.05, 0.05, grid.shape) for _ in range(b)])
     vel = rng.normal(size=(b, n, 2)) * 2.0
     batch = BatchSimulator(Scene(), pos, vel, np.ones((b, n)), radii=np.full((b, n), r), mode=mode, substeps=substeps)
-    buffer = len(batch._imp)  # (it grows after the step, to hold the next one)
+    buffer = len(batch._stepper._imp)  # (it grows after the step, to hold the next one)
     rows = batch.step(4.0)
     assert len(rows) > buffer  # the step really stalled at least once
     assert np.all(np.diff(rows["scene"]) >= 0)

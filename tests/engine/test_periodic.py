@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 
 from collision_env.engine import BatchSimulator, EventCapWarning, Scene, Simulator
 from collision_env.engine.broadphase import GRID_MIN_BALLS
+from collision_env.engine.layout import W_GRID_NX
 
 MODES = ["exact", "naive", "posteriori"]
 CELL = (0.0, 0.0, 1.0, 1.0)
@@ -209,11 +210,11 @@ def test_wrapping_grid_finds_what_all_pairs_find(n, monkeypatch):
     radius = 0.25 / math.sqrt(n)
     pos, vel = _gas(n, radius, seed=n)
     grid = Simulator(Scene(bounds=CELL, periodic=True), pos, vel, np.ones(n), np.full(n, radius))
-    import collision_env.engine.simulator as simulator
+    import collision_env.engine.stepper as stepper
 
-    monkeypatch.setattr(simulator, "GRID_MIN_BALLS", 10**9)
+    monkeypatch.setattr(stepper, "GRID_MIN_BALLS", 10**9)
     brute = Simulator(Scene(bounds=CELL, periodic=True), pos, vel, np.ones(n), np.full(n, radius))
-    assert grid.batch._work_i[0, simulator.W_GRID_NX] >= 3 and brute.batch._work_i[0, simulator.W_GRID_NX] == 1
+    assert grid._stepper.work_i[0, W_GRID_NX] >= 3 and brute._stepper.work_i[0, W_GRID_NX] == 1
     total = 0
     for _ in range(5):
         a = grid.step(0.02)
@@ -232,9 +233,9 @@ def test_cheap_modes_wrapping_grid_agrees_with_all_pairs(mode, monkeypatch):
     radius = 0.2 / math.sqrt(n)
     pos, vel = _gas(n, radius, seed=7)
     grid = Simulator(Scene(bounds=CELL, periodic=True), pos, vel, np.ones(n), np.full(n, radius), mode=mode, substeps=4)
-    import collision_env.engine.simulator as simulator
+    import collision_env.engine.stepper as stepper
 
-    monkeypatch.setattr(simulator, "GRID_MIN_BALLS", 10**9)
+    monkeypatch.setattr(stepper, "GRID_MIN_BALLS", 10**9)
     brute = Simulator(
         Scene(bounds=CELL, periodic=True), pos, vel, np.ones(n), np.full(n, radius), mode=mode, substeps=4
     )

@@ -312,12 +312,11 @@ def test_set_state_takes_a_stick_cluster_only_as_one_rigid_body_of_touching_ball
     refused(f"state velocities: ball [01]: {moving}", velocities=faster)
     refused(f"state velocities: ball [01]: {moving}", omega=state["omega"] * 1.01)
     refused(f"state velocities: ball 0: {moving}", clusters=np.array([0, 0, 0]))  # (v_cm moves)
+    # ball 2, 1.3 m from the others, glued to them: refused in every mode (the cheap modes stick
+    # balls up to a sub-step's reconstruction error apart, not a metre)
     translating = {"velocities": np.tile([0.3, 0.0], (3, 1)), "omega": np.zeros(3), "clusters": np.array([0, 0, 0])}
-    if mode == "exact":
-        far = "does not touch the rest of its stick cluster \\(root ball 0\\)"
-        refused(f"state clusters: ball 2: {far}", **translating)
-    else:  # (the cheap modes stick balls that a sub-step left apart)
-        sim.set_state({**state, **translating})
+    far = "does not touch the rest of its stick cluster \\(root ball 0\\)"
+    refused(f"state clusters: ball 2: {far}", **translating)
 
 
 @settings(max_examples=60, deadline=None)

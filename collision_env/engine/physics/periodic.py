@@ -115,19 +115,25 @@ def toi_images(dx, dy, dvx, dvy, sigma, lx, ly):
 
 
 def wrap_positions(
-    positions: np.ndarray, bounds: tuple[float, float, float, float], dim: int
+    positions: np.ndarray, bounds: tuple[float, float, float, float], dim: int, keep: float = 0.0
 ) -> tuple[np.ndarray, np.ndarray]:
     """``(..., 2)`` positions wrapped into a periodic cell by floor division, and the periods each
-    was moved by (int64, ``(..., 2)``): ``positions = wrapped + images * (lx, ly)`` up to round-off."""
+    was moved by (int64, ``(..., 2)``): ``positions = wrapped + images * (lx, ly)`` up to round-off.
+    Coordinates less than ``keep`` (m) outside the cell stay as they are: a step leaves balls a
+    round-off past the cell's edge (they are wrapped at their next crossing), and a state read from
+    a simulator goes back into one bit for bit."""
     lx, ly = periods(bounds, dim)
     out = np.array(positions, dtype=np.float64, copy=True)
     images = np.zeros(out.shape, dtype=np.int64)
     for axis, (lo, length) in enumerate(((bounds[0], lx), (bounds[1], ly))):
         if length > 0.0:
-            k = np.floor((out[..., axis] - lo) / length)
-            x = out[..., axis] - k * length
-            high = x >= lo + length
-            low = x < lo
+            x = out[..., axis]
+            near = (x >= lo - keep) & (x < lo + length + keep)
+            k = np.where(near, 0.0, np.floor((x - lo) / length))
+            x = x - k * length
+            # (round-off of the division can leave x a hair outside the cell)
+            high = ~near & (x >= lo + length)
+            low = ~near & (x < lo)
             x = np.where(high, x - length, np.where(low, x + length, x))
             k = k + high - low
             out[..., axis] = x

@@ -1,0 +1,588 @@
+"""How a simulator steps: the engine's state arrays, the mode's kernel with its packed arguments,
+and the impact buffer, owned by one :class:`Stepper`.
+
+:class:`~collision_env.engine.BatchSimulator` and :class:`~collision_env.engine.Simulator` are the
+public faces of a stepper: they check what users hand them (:mod:`~collision_env.engine.validation`)
+and shape what they return; the stepper only runs the kernels on input that is already checked. It
+packs the kernel's arguments once (``state.pack``) and updates its arrays in place ever after, so
+that a step from Python costs one call of a compiled kernel with nothing to convert.
+"""
+
+from __future__ import annotations
+
+import copy
+import warnings
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from ._jit import BACKEND
+from .broadphase import GRID_MIN_BALLS, grid_geometry
+from .frames import copy_impacts, record_frame
+from .layout import (
+    B_INV_MASS,
+    B_MASS,
+    B_OMEGA,
+    B_RADIUS,
+    B_VX,
+    B_X,
+    BALL,
+    COUNTERS,
+    FRAME_FIELDS,
+    FRAME_FIRST,
+    FRAME_LAST,
+    FRAME_ROWS,
+    FRAME_STEPPED,
+    FRAME_STOPPED_AT,
+    IMPACT_DTYPE,
+    S_ELASTICITY,
+    S_PAIRS,
+    S_SIGN,
+    SCENE_F,
+    SCENE_I,
+    W_CALENDAR_VALID,
+    W_GRID_NX,
+    W_GRID_X0,
+    WORK_F,
+    WORK_I,
+)
+from .modes import MODES, Mode
+from .physics.periodic import wrap_positions
+from .scene import Scene
+from .state import (
+    RESUME,
+    RUN_FRAMES,
+    START_NEXT,
+    START_STEP,
+    FramesOut,
+    State,
+    aligned_copy,
+    aligned_zeros,
+    pack,
+    with_frames,
+)
+from .validation import (
+    MAX_MAGNITUDE,
+    Labels,
+    Settings,
+    check_laps,
+    check_reach,
+    check_seconds,
+    periodic_slack,
+)
+
+#: The default event cap's budget per ball and step, and its floor (see :func:`default_event_cap`).
+EVENTS_PER_BALL = 1_000
+MIN_EVENT_CAP = 10_000
+
+
+def default_event_cap(n: int) -> int:
+    """The default cap on events per scene and step for scenes of ``n`` balls:
+    ``max(MIN_EVENT_CAP, EVENTS_PER_BALL * n)`` (10^4, or 1,000 events per ball).
+
+    An ordinary scene never reaches it: a hard-disk gas's collision rate per disk is
+    ``omega = 2 sqrt(pi) rho sigma g(sigma) sqrt(kT/m)`` (Enskog; see :mod:`collision_env.observables`),
+    so the events per ball of a step of ``dt`` are ``omega dt / 2`` plus its wall impacts: about 6 in a
+    1/60 s frame of disks of diameter 0.02 m at unit mean square speed and area fraction 0.7 (a dense
+    fluid, Z = 10.3), 160 times below the budget, whatever the number of disks. What reaches it
+    is a cascade whose event count does not scale with the step: an inelastic collapse, a light
+    ball squeezed by a far heavier one (about ``pi sqrt(M/m)`` collisions, Galperin 2003), a jammed
+    network. Such a scene stops after at most ``EVENTS_PER_BALL`` events per ball (a millisecond or
+    so of work per ball, some hundred frames' worth of the dense gas) with an
+    :class:`EventCapWarning`, in a valid state. A scene whose steps really need more (long steps of
+    a dense gas, say) sets ``max_events``."""
+    return max(MIN_EVENT_CAP, EVENTS_PER_BALL * int(n))
+
+
+#: What a step without impacts returns: one shared array of no rows (read-only, as nothing can be
+#: written to it; a fresh empty structured array costs more than a small scene's step).
+NO_IMPACTS = np.empty(0, dtype=IMPACT_DTYPE)
+NO_IMPACTS.flags.writeable = False
+
+#: The impact buffer grows to hold a step's impacts up to this many rows (72 MB): a step that fills
+#: it is run in calls that each fill it, whose impacts are then joined (a cost per row far below an
+#: event's).
+MAX_IMPACT_ROWS = 1 << 20
+
+
+class EventCapWarning(RuntimeWarning):
+    """A scene reached the cap on events per step and stopped early (in a valid state)."""
+
+
+class LiveArrays(NamedTuple):
+    """The engine's own state arrays (not copies): see :meth:`BatchSimulator.live_arrays`."""
+
+    balls: np.ndarray  #: (B, N, 8) per-ball state, laid out as ``layout.BALL``
+    positions: np.ndarray  #: (B, N, 2) view of ``balls``
+    velocities: np.ndarray  #: (B, N, 2) view of ``balls``
+    masses: np.ndarray  #: (B, N) view of ``balls``
+    radii: np.ndarray  #: (B, N) view of ``balls``
+    time: np.ndarray  #: (B,) clocks
+    clusters: np.ndarray  #: (B, N) root ball of each ball's cluster
+    capped: np.ndarray  #: (B,) the last step stopped at the event cap
+
+
+class FrameArrays(NamedTuple):
+    """Where a run of frames is recorded, with the batch axis: clocks ``(F, B)``, positions and
+    velocities ``(F, B, N, 2)``, image counts ``(F, B, N, 2)`` (int64; recorded in periodic scenes
+    only, zeros elsewhere)."""
+
+    times: np.ndarray
+    positions: np.ndarray
+    velocities: np.ndarray
+    images: np.ndarray
+
+    def rows(self, periodic: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Positions, velocities and images as the kernels record them: ``(F, B * N, 2)`` views
+        (images ``(F, 0, 2)`` outside a ``periodic`` scene, where they stay 0 and are not recorded)."""
+        f, b, n, _ = self.positions.shape
+        images = self.images.reshape(f, b * n, 2) if periodic else np.empty((f, 0, 2), np.int64)
+        return self.positions.reshape(f, b * n, 2), self.velocities.reshape(f, b * n, 2), images
+
+
+class Stepper:
+    """``B`` scenes of ``N`` balls sharing one :class:`Scene`, stepped by the kernel of a mode:
+    the state arrays, the kernel's packed arguments and the impact buffer.
+
+    Built empty: :meth:`put` writes each scene's balls (checked by the caller). ``label`` names
+    balls and shapes in the messages it raises and warns with.
+    """
+
+    def __init__(self, scene: Scene, settings: Settings, n_scenes: int, n: int, label: Labels) -> None:
+        spec = MODES[settings.mode]
+        self.scene = scene
+        self.spec: Mode = spec
+        self.settings = settings
+        self.label = label
+        self.n_scenes = n_scenes
+        self.n = n
+        # Every per-ball float lives in one (B, N, 8) array, pos, vel, ... are views into it: each
+        # array handed to a kernel costs ~0.1 us per call, which is most of a small scene's step.
+        self.balls = aligned_zeros((n_scenes, n, len(BALL)), np.float64)
+        self._bind_views()
+        self.body = np.tile(np.arange(n, dtype=np.int64), (n_scenes, 1))
+        self.images = np.zeros((n_scenes, n, 2), dtype=np.int64)  # (a periodic cell's lengths crossed)
+        self.time = np.zeros(n_scenes)
+        self.clock = np.zeros((n_scenes, 2))  # per scene: time as the clock set it, its compensation
+        self.capped = np.zeros(n_scenes, dtype=np.bool_)
+        self.counters = np.zeros(len(COUNTERS), dtype=np.int64)
+
+        bounds = scene.bounds if scene.bounds is not None else (0.0, 0.0, 0.0, 0.0)
+        scene_f = dict(
+            zip(("xmin", "ymin", "xmax", "ymax"), bounds, strict=True),
+            elasticity=scene.elasticity,
+            collapse_ratio=settings.collapse_ratio,
+            sign=1.0,
+            collapse_floor=settings.collapse_floor,
+        )
+        scene_i = dict(
+            has_walls=scene.bounds is not None and not scene.periodic,
+            pairs=scene.ball_collisions and n > 1,
+            dim=scene.dimension,
+            sticky=scene.sticky,
+            max_events=settings.max_events,
+            substeps=settings.substeps,
+        )
+        self.fparams = np.array([scene_f[name] for name in SCENE_F])
+        self.iparams = np.array([scene_i[name] for name in SCENE_I], dtype=np.int64)
+        self.work_f = np.zeros((n_scenes, len(WORK_F)))
+        self.work_i = np.zeros((n_scenes, len(WORK_I)), dtype=np.int64)
+        # the mode's own arrays (exact mode's event calendar and grid, kept from step to step, and work
+        # space), and its kernel for this kind of scene
+        self.mode_arrays = spec.arrays(scene, n_scenes, n)
+        self._kernel = spec.kernel(scene, n)
+        self.start = START_STEP  # how the next kernel call starts (see step)
+        self._after_step = START_NEXT
+        self._alloc_work()
+
+    def _bind_views(self) -> None:
+        b = self.balls
+        self.pos = b[..., B_X : B_X + 2]
+        self.vel = b[..., B_VX : B_VX + 2]
+        self.mass = b[..., B_MASS]
+        self.inv_mass = b[..., B_INV_MASS]
+        self.radius = b[..., B_RADIUS]
+        self.omega = b[..., B_OMEGA]
+
+    # ------------------------------------------------------------------ writing scenes
+    def wrapped(self, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Positions ``(K, N, 2)`` wrapped into a periodic scene's cell (but for those a step's
+        round-off may leave outside it, ``validation.periodic_slack``), and the periods each was
+        moved by (zeros, and ``pos`` itself, in other scenes)."""
+        if not self.scene.periodic or self.scene.bounds is None:
+            return pos, np.zeros(pos.shape, dtype=np.int64)
+        return wrap_positions(pos, self.scene.bounds, self.scene.dimension, periodic_slack(self.scene))
+
+    def put(
+        self,
+        scenes: np.ndarray,
+        pos: np.ndarray,
+        vel: np.ndarray,
+        mass: np.ndarray,
+        radius: np.ndarray,
+        *,
+        time: np.ndarray | float,
+        compensation: np.ndarray | float = 0.0,
+        images: np.ndarray | None = None,
+        clusters: np.ndarray | None = None,
+        omega: np.ndarray | float = 0.0,
+    ) -> None:
+        """Start ``scenes`` (indices) afresh from checked ``(K, N, ...)`` balls, at ``time`` (with
+        its clock's ``compensation``). Periodic positions are wrapped into the cell, the periods
+        counted in their ``images`` (zeros if None); ``clusters`` default to every ball its own."""
+        pos, wrapped = self.wrapped(pos)
+        self.pos[scenes] = pos
+        self.images[scenes] = wrapped if images is None else wrapped + images
+        self.vel[scenes] = vel
+        self.mass[scenes] = mass
+        self.inv_mass[scenes] = 1.0 / mass
+        self.radius[scenes] = radius
+        self.body[scenes] = np.arange(self.n) if clusters is None else clusters
+        self.omega[scenes] = omega
+        self.time[scenes] = time
+        self.clock[scenes, 0] = time
+        self.clock[scenes, 1] = compensation
+        self.invalidate(scenes)
+
+    def changed(self) -> None:
+        """The balls were changed outside a step (a nudge): the next step compares every ball with
+        the state the last step left it in."""
+        self.start = START_STEP
+
+    def invalidate(self, scenes: np.ndarray) -> None:
+        """Drop the calendar's predictions for ``scenes`` (they are made afresh at the next step)
+        and lay out their grid for the balls they now hold."""
+        period = self.scene.period if self.scene.periodic else None
+        origin_and_cells, counts = grid_geometry(
+            self.scene.bounds,
+            self.pos[scenes],
+            self.radius[scenes],
+            self.uses_grid(),
+            **self.spec.grid,
+            period=period,
+        )
+        self.work_f[scenes, W_GRID_X0 : W_GRID_X0 + 4] = origin_and_cells
+        self.work_i[scenes, W_GRID_NX : W_GRID_NX + 2] = counts
+        self.work_i[scenes, W_CALENDAR_VALID] = 0
+        self.start = START_STEP
+
+    def uses_grid(self) -> bool:
+        """The broad phase pays only in large scenes with ball pairs (and no stick clusters)."""
+        return self.scene.ball_collisions and self.n >= GRID_MIN_BALLS and not self.scene.sticky
+
+    def _alloc_work(self, rows: int | None = None) -> None:
+        if rows is None:
+            rows = self.spec.impact_rows(self.scene, self.n, self.uses_grid())
+        self._imp = np.empty(rows, dtype=IMPACT_DTYPE)
+        self._imp_bytes = self._imp.view(np.uint8).data
+        counts = getattr(self, "_n_imp", None)  # (kept when the buffer grows in the middle of a step)
+        self._n_imp = np.zeros(3, dtype=np.int64)  # rows filled, scenes that reached the cap, stalled
+        if counts is not None:
+            self._n_imp[:] = counts
+        # the kernel's arguments, packed once (the arrays are only ever updated in place)
+        state = State(
+            self.balls,
+            self.body,
+            self.time,
+            self.capped,
+            self.fparams,
+            self.iparams,
+            self._imp,
+            self._n_imp,
+            self.counters,
+            self.work_f,
+            self.work_i,
+            self.clock,
+            self.images,
+        )
+        self._pack = pack(state, *self.mode_arrays, frames=True)
+        self._sign = float(self.fparams[S_SIGN])  # the direction fparams are set for (see step)
+        # step's fast path applies (not to periodic scenes: each step's laps are checked)
+        self._forward = self._sign > 0.0 and self.scene.bounds is not None and not self.scene.periodic
+        self.live = LiveArrays(
+            self.balls, self.pos, self.vel, self.mass, self.radius, self.time, self.body, self.capped
+        )
+
+    # ------------------------------------------------------------------ stepping
+    def step(self, dt: float, stacklevel: int = 4) -> np.ndarray:
+        """Advance every scene by ``dt`` (a float: the caller made it one), the impacts as records
+        ordered by scene and time; ``stacklevel`` names the caller's caller in an
+        :class:`EventCapWarning` (4: this, the public ``step`` and its caller, plus the warning's
+        own frame).
+
+        A step that follows a completed forward step, with nothing changed in between, starts with
+        ``START_NEXT``: the kernel then need not compare every ball with its calendar record, which
+        is most of a small scene's fixed cost. ``start`` says which: every other way of changing the
+        state (a nudge, :meth:`put`, :meth:`load`, a step of another kind, frames) sets it back to
+        ``START_STEP``, and once :meth:`live_arrays` has handed the arrays out, where anyone may
+        write them, it stays there."""
+        if self._forward and 0.0 < dt <= MAX_MAGNITUDE:  # the common case, checked in one test
+            rows = self._kernel(self._pack, dt, self.start)
+            if rows >= 0:  # no scene stalled or reached the event cap
+                self.start = self._after_step
+                return self._take_impacts(rows) if rows else NO_IMPACTS
+            self.start = START_STEP
+            return self._finish(self._run(dt, first_done=True), 1.0, stacklevel)
+        self.start = START_STEP
+        return self._checked_step(dt, stacklevel + 1)
+
+    def _checked_step(self, dt: float, stacklevel: int) -> np.ndarray:
+        """:meth:`step` off its fast path: backwards, without a border, in a periodic cell, or of a
+        step checked for the first time."""
+        label = self.label
+        check_seconds(dt, "dt")
+        if self.scene.bounds is None:
+            check_reach(self.pos, self.vel, dt, label)
+        if self.scene.periodic:
+            check_laps(self.scene, self.mass, self.vel, dt, label)
+        e = self.scene.elasticity
+        if dt < 0.0 and e == 0.0:
+            raise ValueError(
+                "dt: cannot step backwards with elasticity 0 (a perfectly inelastic collision has no inverse)"
+            )
+        if dt == 0.0:
+            self.capped[:] = False
+            return NO_IMPACTS
+        sign = 1.0 if dt > 0.0 else -1.0
+        if sign != self._sign:  # reverse steps use 1/e
+            self.fparams[S_ELASTICITY] = e if sign > 0 else 1.0 / e
+            self.fparams[S_SIGN] = sign
+            self._sign = sign
+            self._forward = sign > 0.0 and self.scene.bounds is not None and not self.scene.periodic
+        # reversed, a bounce at e < 1 multiplies the speed by 1/e, and the bounces come ever faster:
+        # a past may diverge within finite time. Such a step is refused, from a copy kept here.
+        before = self.saved() if sign < 0 and e < 1.0 else None
+        if sign < 0:
+            np.negative(self.vel, out=self.vel)
+            np.negative(self.omega, out=self.omega)
+        try:
+            chunks = self._run(abs(dt))
+        finally:
+            if sign < 0:
+                np.negative(self.vel, out=self.vel)
+                np.negative(self.omega, out=self.omega)
+        if before is not None:
+            self._refuse_divergent_past(before, dt)
+        return self._finish(chunks, sign, stacklevel)
+
+    def _refuse_divergent_past(self, before: list[np.ndarray], dt: float) -> None:
+        """After a backward step at e < 1: if a ball's speed or position overflowed, restore
+        ``before`` (:meth:`saved` before the step) and raise a ValueError naming the ball."""
+        motion = self.balls[..., B_X : B_VX + 2]  # (positions and velocities)
+        if not np.isfinite(motion).all():
+            s, i = np.argwhere(~np.isfinite(motion).all(-1))[0]
+            self.restore(before)
+            e = self.scene.elasticity
+            raise ValueError(
+                f"dt: the past of {self.label(s, i).rstrip(': ')} diverges within this step of {dt:g} s: "
+                f"reversed, each bounce at elasticity {e:g} multiplies its speed by {1.0 / e:.6g}, and the "
+                "bounces come ever faster, until the speed overflows (the state is unchanged)"
+            )
+
+    def frames(self, dt: float, out: FrameArrays, stacklevel: int) -> np.ndarray:
+        """Take ``len(out.times)`` steps of ``dt`` (checked), recording every scene after each into
+        ``out``; returns every step's impacts in step order. Forward steps run in one compiled loop
+        (the same kernel as :meth:`step`, so the same steps bit for bit); the others, and a step
+        the loop cannot complete, as :meth:`step` takes them."""
+        n = len(out.times)
+        self.start = START_STEP
+        pieces = []
+        f = 0
+        buffer = None  # the compiled loop's copy of the impacts
+        size = len(self._imp)
+        if self.scene.periodic:  # (the run's laps, checked once: a periodic step has no fast path)
+            check_laps(self.scene, self.mass, self.vel, dt * n, self.label)
+        while f < n:
+            forward = self._forward or (self.scene.periodic and self._sign > 0.0)
+            if not (forward and 0.0 < dt <= MAX_MAGNITUDE):
+                # backwards or without a border: a step as step takes it (which may make the next
+                # ones forward steps with a border)
+                pieces.append(self.step(dt, stacklevel + 1))
+                self._record(f, out)
+                f += 1
+                continue
+            if buffer is None:
+                buffer = np.empty(size, dtype=IMPACT_DTYPE)
+            f, stepped, rows = self._run_frames(dt, f, out, buffer)
+            if rows:  # (kept, if at least half full: the next run gets a buffer of its own)
+                pieces.append(buffer[:rows] if 2 * rows >= len(buffer) else buffer[:rows].copy())
+            buffer = None
+            if f == n:
+                break
+            # frame f's impacts did not fit (the next frames get a buffer twice the size), or
+            # its step needs completing, as step completes it
+            if stepped:
+                pieces.append(self._take_impacts(self._n_imp[0]))
+                size *= 2
+            else:
+                pieces.append(self._finish(self._run(dt, first_done=True), 1.0, stacklevel))
+            self._record(f, out)
+            f += 1
+        if len(pieces) == 1:
+            return pieces[0]
+        return np.concatenate(pieces) if pieces else NO_IMPACTS.copy()
+
+    def _record(self, f: int, out: FrameArrays) -> None:
+        """Frame ``f`` of ``out``: the state now."""
+        record_frame(f, self.balls, self.time, self.images, out.times, *out.rows(self.scene.periodic))
+
+    def _run_frames(self, dt: float, first: int, out: FrameArrays, buffer: np.ndarray) -> tuple[int, bool, int]:
+        """Frames ``first`` to the last of ``out`` in one call of the kernel (see
+        ``frames.frames_kernel``), the impacts into ``buffer``. Returns ``(f, stepped, rows)``: every
+        frame was recorded if ``f`` is their number; else frame ``f`` was not, and ``stepped`` says
+        whether its step was taken (its impacts did not fit ``buffer``) or needs completing; ``rows``
+        of ``buffer`` were written."""
+        request = np.zeros(len(FRAME_FIELDS), dtype=np.int64)
+        request[FRAME_FIRST] = first
+        request[FRAME_LAST] = len(out.times)
+        bundle = FramesOut(request, out.times, *out.rows(self.scene.periodic), buffer)
+        self._kernel(with_frames(self._pack, self.spec.frames_slot, bundle), dt, RUN_FRAMES)
+        return int(request[FRAME_STOPPED_AT]), bool(request[FRAME_STEPPED]), int(request[FRAME_ROWS])
+
+    def _finish(self, chunks: list[np.ndarray], sign: float, stacklevel: int) -> np.ndarray:
+        """Warn about scenes that reached the event cap; the step's impacts as one array."""
+        if self._n_imp[1]:
+            warnings.warn(
+                f"event cap of {self.settings.max_events} per step reached in scene(s) "
+                f"{np.flatnonzero(self.capped).tolist()}; they stopped early at their last event "
+                "(see cap_reached and time)",
+                EventCapWarning,
+                stacklevel=stacklevel,
+            )
+        if not chunks:
+            return NO_IMPACTS
+        if len(chunks) == 1:
+            return chunks[0]
+        out = np.concatenate(chunks)  # a stalled step: a scene's impacts may span chunks
+        if self.n_scenes == 1:  # (one scene's chunks come in its order: each resumes where the last stopped)
+            return out
+        return out[np.lexsort((sign * out["time"], out["scene"]))]
+
+    def _run(self, dt_abs: float, first_done: bool = False) -> list[np.ndarray]:
+        """Run the mode's kernel until every scene has stepped ``dt_abs``; the impacts in chunks,
+        one per call (a call stops the scenes that find the impact buffer full, which the next
+        call resumes). ``first_done``: the step's first call was made already."""
+        chunks = []
+        kernel, n_imp = self._kernel, self._n_imp
+        if not first_done:
+            kernel(self._pack, dt_abs, START_STEP)
+        while True:  # each call resets n_imp[0] and fills the impact buffer from row 0
+            rows = n_imp[0]
+            if rows:
+                chunks.append(self._take_impacts(rows))
+            if not n_imp[2]:  # no scene stalled
+                if len(chunks) > 1:  # the next steps like this one fit the buffer, up to MAX_IMPACT_ROWS
+                    total = sum(len(chunk) for chunk in chunks)
+                    self._alloc_work(max(len(self._imp), min(MAX_IMPACT_ROWS, 1 << (total - 1).bit_length())))
+                return chunks
+            if not rows:  # not even one sub-step's worst case fits: a bigger buffer
+                self._alloc_work(2 * len(self._imp))
+                n_imp = self._n_imp
+            kernel(self._pack, dt_abs, RESUME)
+
+    def _take_impacts(self, rows: int) -> np.ndarray:
+        """A copy of the first ``rows`` impact records. Exact mode records each scene's impacts in
+        the order they happen, scenes in order; the cheap modes' reconstructed times need sorting
+        within each scene."""
+        if self.spec.sorted_impacts:
+            # (numpy copies structured arrays slowly: a byte copy is several times cheaper)
+            return np.ndarray(rows, IMPACT_DTYPE, bytearray(self._imp_bytes[: rows * IMPACT_DTYPE.itemsize]))
+        out = np.empty(rows, dtype=IMPACT_DTYPE)
+        copy_impacts(self._imp, out, self._sign)
+        return out
+
+    # ------------------------------------------------------------------ what it holds
+    def live_arrays(self) -> LiveArrays:
+        """The state arrays themselves; from now on every step compares each ball with the state
+        the last step left it in (whoever holds them may write them)."""
+        self.start = self._after_step = START_STEP
+        return self.live
+
+    def models(self) -> dict[str, Any]:
+        """What the engine computes for this scene, and nothing else."""
+        return {
+            "mode": self.settings.mode,
+            "substeps": self.settings.substeps,
+            "dimension": self.scene.dimension,
+            "walls": self.scene.bounds is not None and not self.scene.periodic,
+            "periodic": self.scene.periodic,
+            "ball_pairs": bool(self.iparams[S_PAIRS]),
+            "clusters": self.scene.sticky,
+            "backend": BACKEND,
+        }
+
+    def stats(self) -> dict[str, int]:
+        """The work counters, by name."""
+        return {name: int(count) for name, count in zip(COUNTERS, self.counters, strict=True)}
+
+    def state(self) -> dict[str, np.ndarray]:
+        """Copies of every array a state is made of (see ``BatchSimulator.get_state``)."""
+        return {
+            "positions": self.pos.copy(),
+            "velocities": self.vel.copy(),
+            "masses": self.mass.copy(),
+            "radii": self.radius.copy(),
+            "clusters": self.body.copy(),
+            "omega": self.omega.copy(),
+            "time": self.time.copy(),
+            "time_compensation": self.clock[:, 1].copy(),
+            "images": self.images.copy(),
+        }
+
+    # ------------------------------------------------------------------ copies
+    def load(self, other: Stepper) -> None:
+        """Take ``other``'s whole state in place (the caller checked that it fits)."""
+        for mine, theirs in zip(self.stepped_arrays(), other.stepped_arrays(), strict=True):
+            np.copyto(mine, theirs)
+        for field in (S_ELASTICITY, S_SIGN):  # (the direction of time the state is kept for)
+            self.fparams[field] = other.fparams[field]
+        self._sign = other._sign
+        self._forward = other._forward
+        self.start = START_STEP
+
+    def stepped_arrays(self) -> list[np.ndarray]:
+        """The arrays a step changes: balls, clusters, clocks and, in exact mode, the event
+        calendar (what :meth:`load` takes from another stepper)."""
+        arrays = [self.balls, self.body, self.time, self.clock, self.capped, self.work_f, self.work_i, self.images]
+        return arrays + list(self.mode_arrays[0]) if self.spec.persistent else arrays
+
+    def saved(self) -> list[np.ndarray]:
+        """Copies of :meth:`stepped_arrays`, to :meth:`restore` a step's start from."""
+        return [a.copy() for a in self.stepped_arrays()]
+
+    def restore(self, saved: list[np.ndarray]) -> None:
+        """Put back the arrays :meth:`saved` copied."""
+        for mine, kept in zip(self.stepped_arrays(), saved, strict=True):
+            np.copyto(mine, kept)
+        self.start = START_STEP
+
+    #: What a copy or a pickle rebuilds rather than carries: work space, and what is bound to it.
+    _REBUILT = (
+        "_imp", "_imp_bytes", "_n_imp", "_kernel", "_pack", "_sign", "_forward", "live", "pos", "vel", "mass",
+        "inv_mass", "radius", "omega", "spec", "start", "_after_step",
+    )  # fmt: skip
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = {key: value for key, value in self.__dict__.items() if key not in self._REBUILT}
+        # (exact mode's calendar persists; its work space, and the cheap modes' scratch, are made anew)
+        state["mode_arrays"] = self.mode_arrays[:1] if self.spec.persistent else ()
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self.spec = MODES[self.settings.mode]
+        # a copy or an unpickled array has numpy's alignment
+        self.balls = aligned_copy(self.balls)
+        fresh = self.spec.arrays(self.scene, self.n_scenes, self.n)
+        kept = tuple(type(b)(*(aligned_copy(a) for a in b)) for b in self.mode_arrays)
+        self.mode_arrays = kept + fresh[len(kept) :]
+        self._kernel = self.spec.kernel(self.scene, self.n)
+        self.start = START_STEP
+        self._after_step = START_NEXT
+        self._bind_views()
+        self._alloc_work()
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> Stepper:
+        new = object.__new__(type(self))
+        new.__setstate__(copy.deepcopy(self.__getstate__(), memo))
+        return new
