@@ -38,8 +38,11 @@ MAX_SUBSTEPS = 100_000
 #: Largest event cap (``max_events``): the kernels count events in int64.
 MAX_EVENT_CAP = 2**63 - 1
 #: How far apart the cheap modes may leave two balls they stuck together, relative to their radii
-#: sum (they stick balls found overlapping after a sub-step, at the contact they reconstruct).
-CHEAP_STICK_GAP_RTOL = 1e-3
+#: sum: posteriori reconstructs each contact of a sub-step on its own, and the re-advance of the
+#: bodies it stuck leaves gaps (measured on 6,600 random stick scenes, up to 16 sub-steps, speeds
+#: 0.5-50 m/s, steps up to 1 s: at most 0.29 of the radii sum; naive leaves none). A cluster glued
+#: across more than its balls' size is refused.
+CHEAP_STICK_GAP_RTOL = 1.0
 #: The largest finite float64: a Python int beyond it has no float64 value (``float`` raises).
 _LARGEST_FLOAT = int(np.finfo(np.float64).max)
 

@@ -248,3 +248,26 @@ def test_a_step_sees_a_change_made_since_the_last_step(change):
         a, b = sim.step(1 / 60), fresh.step(1 / 60)
         assert [(i.ball, i.other, i.wall) for i in a] == [(i.ball, i.other, i.wall) for i in b] and len(a) > 0
     np.testing.assert_allclose(sim.positions, fresh.positions, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("single", [True, False], ids=["Simulator", "BatchSimulator"])
+def test_frames_record_the_periodic_image_counts(single):
+    """Each frame's images are the simulator's after that step, so that ``positions + images *
+    period`` is the unwrapped trajectory (zeros in a walled box)."""
+    scene = Scene(bounds=(-1.0, -1.0, 1.0, 1.0), periodic=True)
+    pos, vel = [[0.0, 0.0], [0.5, 0.5]], [[7.0, -3.0], [-2.0, 5.0]]
+    if single:
+        sim, loop = (Simulator(scene, pos, vel, [1.0, 1.0], [0.1, 0.1]) for _ in range(2))
+    else:
+        sim, loop = (BatchSimulator(scene, [pos, pos], [vel, vel], [1.0, 1.0], [0.1, 0.1]) for _ in range(2))
+    rec = sim.frames(0.1, 30)
+    for f in range(30):
+        loop.step(0.1)
+        np.testing.assert_array_equal(rec.images[f], loop.images)
+        np.testing.assert_array_equal(rec.positions[f], loop.positions)
+    assert np.abs(rec.images).max() >= 3
+    unwrapped = rec.positions + rec.images * np.array(scene.period)
+    np.testing.assert_allclose(unwrapped[-1], loop.unwrapped_positions)
+    box = Simulator(Scene(bounds=(-1.0, -1.0, 1.0, 1.0)), pos, vel, [1.0, 1.0], [0.1, 0.1])
+    walled = box.frames(0.1, 5)
+    assert walled.images.shape == (5, 2, 2) and not walled.images.any()

@@ -372,3 +372,47 @@ def test_set_state_names_the_scene_of_a_broken_stick_cluster():
     velocities = np.broadcast_to([0.3, 0.0], (2, 3, 2))
     with pytest.raises(ValueError, match="state clusters: scene 1, ball 2: does not touch the rest of its stick"):
         batch.set_state({**state, "velocities": velocities, "omega": np.zeros((2, 3)), "clusters": clusters})
+
+
+def test_set_state_refuses_an_unknown_key_naming_the_closest_and_changes_nothing():
+    sim = Simulator(Scene(periodic=True), [[0.0, 0.0], [1.0, 0.0]], [[1.0, 0.0], [0.0, 0.0]], [1.0, 1.0])
+    sim.step(3.0)  # (ball 1, hit by ball 0, crosses the cell)
+    state = sim.get_state()
+    images = state.pop("images")
+    assert images.any()
+    typo = {**state, "image": images}  # (with 'images' left out, they would be taken as zeros)
+    with pytest.raises(ValueError, match=r"state: unknown key\(s\) 'image' \(did you mean 'images'"):
+        sim.set_state(typo)
+    np.testing.assert_array_equal(sim.images, images)
+
+
+def test_an_event_cap_beyond_int64_is_refused_by_name():
+    with pytest.raises(ValueError, match="max_events: must be at most 9,223,372,036,854,775,807"):
+        Simulator(Scene(), [[0.0, 0.0]], [[1.0, 0.0]], [1.0], max_events=10**20)
+
+
+@pytest.mark.parametrize("past", [1.6e-15, -1.6e-15])
+def test_a_position_a_round_off_outside_a_periodic_cell_goes_back_bit_for_bit(past):
+    """A step may leave a ball a round-off outside the periodic cell (it is wrapped at its next
+    crossing): set_state takes it where it is, so that a state goes back bit for bit."""
+    scene = Scene(periodic=True)
+    edge = scene.bounds[2] if past > 0 else scene.bounds[0]
+    x = edge + past
+    sim = Simulator(scene, [[0.0, 0.0], [1.0, 0.3]], [[0.7, 0.2], [-0.3, 0.1]], [1.0, 2.0])
+    state = sim.get_state()
+    state["positions"][0] = (x, 0.0)
+    sim.set_state(state)
+    got = sim.get_state()
+    np.testing.assert_array_equal(got["positions"], state["positions"])
+    np.testing.assert_array_equal(got["images"], state["images"])
+    twin = sim.copy()
+    twin.set_state(sim.get_state())
+    for _ in range(20):
+        a, b = sim.step(0.25), twin.step(0.25)
+        assert [(i.time, i.point) for i in a] == [(i.time, i.point) for i in b]
+    np.testing.assert_array_equal(sim.positions, twin.positions)
+    # a position well outside the cell is wrapped into it, its period counted
+    state["positions"][0] = (edge + 1e-9 * np.sign(past), 0.0)
+    sim.set_state(state)
+    assert scene.bounds[0] <= sim.positions[0, 0] < scene.bounds[2]
+    assert sim.images[0, 0] == np.sign(past)
