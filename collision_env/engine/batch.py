@@ -463,10 +463,11 @@ class BatchSimulator:
         each with a compensation below an ulp of it. In naive and posteriori modes, whose steps may
         end with balls overlapping, overlaps (and touching balls from wall to wall, which these
         modes step like any others) are accepted, and so are stick clusters whose balls are up to
-        their radii sum apart (posteriori's reconstruction leaves gaps of up to ~0.3 of it). Bad input raises a ``ValueError`` naming the scene,
-        ball and field, and changes nothing. In a periodic scene, positions outside the cell are
-        wrapped into it, their images counted (those a step leaves a round-off outside stay as
-        they are, so that a state goes back bit for bit).
+        their radii sum apart (posteriori's reconstruction leaves gaps of up to ~0.3 of it). Bad
+        input raises a ``ValueError`` naming the scene, ball and field, and changes nothing. In a
+        periodic scene, positions outside the cell are wrapped into it, their images counted
+        (those a step leaves a round-off outside stay as they are, so that a state goes back bit
+        for bit).
         """
         s = self._stepper
         checked = checked_state(state, s.scene, s.label, (s.n_scenes, s.n), s.spec.leaves_overlaps)
