@@ -33,9 +33,9 @@ def scratch_size(n: int) -> int:
 
 
 @njit(inline="always")
-def cell_lists(n, p, v, h, scratch, geo):
-    """Sort the balls into the grid's cells where they will be after the sub-step's move of ``h``
-    seconds (before it is made, so that a scene can still stall untouched)."""
+def empty_lists(n, scratch, geo):
+    """Cell lists of ``n`` balls in ``scratch``, every cell empty if the grid has more than one (a
+    grid of one cell keeps no lists: every ball is every other's neighbour)."""
     m = CHEAP_CELLS_PER_BALL * n  # (``near`` holds a count per cell, or a ball's neighbours)
     head, nxt, cell, near = (
         scratch[0:m],
@@ -47,11 +47,27 @@ def cell_lists(n, p, v, h, scratch, geo):
     if geo.nx * geo.ny > 1:
         for c in range(geo.nx * geo.ny):
             cells.head[c] = -1
+    return cells
+
+
+@njit(inline="always")
+def file_ball(cells, i, c):
+    """Put ball ``i`` in cell ``c`` (at the head of its list: balls filed from the last to the
+    first are listed in index order)."""
+    cells.cell[i] = c
+    cells.nxt[i] = cells.head[c]
+    cells.head[c] = i
+
+
+@njit(inline="always")
+def cell_lists(n, p, v, h, scratch, geo):
+    """Sort the balls into the grid's cells where they will be after the sub-step's move of ``h``
+    seconds (before it is made, so that a scene can still stall untouched)."""
+    cells = empty_lists(n, scratch, geo)
+    if geo.nx * geo.ny > 1:
         for i in range(n - 1, -1, -1):
-            c = cell_of(p[i, 0] + v[i, 0] * h, p[i, 1] + v[i, 1] * h, geo.x0, geo.y0, geo.hx, geo.hy, geo.nx, geo.ny)
-            cells.cell[i] = c
-            cells.nxt[i] = cells.head[c]
-            cells.head[c] = i
+            x, y = p[i, 0] + v[i, 0] * h, p[i, 1] + v[i, 1] * h
+            file_ball(cells, i, cell_of(x, y, geo.x0, geo.y0, geo.hx, geo.hy, geo.nx, geo.ny))
     return cells
 
 

@@ -17,32 +17,20 @@ from ..broadphase import cell_of
 from ..layout import PAIR_TESTS
 from ..physics.periodic import cell_lengths, nearest, wrap_all, wrap_coordinate, wrap_point
 from . import naive, posteriori
-from .cells import CHEAP_CELLS_PER_BALL, CellLists, insert_sorted
+from .cells import empty_lists, file_ball, insert_sorted
 
 
 @njit(inline="always")
 def cell_lists(n, p, v, h, scratch, geo, bounds, dim):
     """``cells.cell_lists`` for a periodic cell: the balls are sorted by where they will be after
     the sub-step's move, wrapped into the cell."""
-    m = CHEAP_CELLS_PER_BALL * n
-    head, nxt, cell, near = (
-        scratch[0:m],
-        scratch[m : m + n],
-        scratch[m + n : m + 2 * n],
-        scratch[m + 2 * n : 2 * m + 2 * n],
-    )
-    cells = CellLists(head, nxt, cell, near, geo.nx, geo.ny)
+    cells = empty_lists(n, scratch, geo)
     if geo.nx * geo.ny > 1:
         lx, ly = cell_lengths(bounds, dim)
-        for c in range(geo.nx * geo.ny):
-            cells.head[c] = -1
         for i in range(n - 1, -1, -1):
             x = wrap_coordinate(p[i, 0] + v[i, 0] * h, bounds[0], lx)[0]
             y = wrap_coordinate(p[i, 1] + v[i, 1] * h, bounds[1], ly)[0]
-            c = cell_of(x, y, geo.x0, geo.y0, geo.hx, geo.hy, geo.nx, geo.ny)
-            cells.cell[i] = c
-            cells.nxt[i] = cells.head[c]
-            cells.head[c] = i
+            file_ball(cells, i, cell_of(x, y, geo.x0, geo.y0, geo.hx, geo.hy, geo.nx, geo.ny))
     return cells
 
 
