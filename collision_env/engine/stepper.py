@@ -246,8 +246,16 @@ class Stepper:
 
     def changed(self) -> None:
         """The balls were changed outside a step (a nudge): the next step compares every ball with
-        the state the last step left it in."""
+        the state the last step left it in, and checks what a step needs checked afresh."""
         self.start = START_STEP
+        self._reset_fast_path()
+
+    def _reset_fast_path(self) -> None:
+        """Set the longest step that takes :meth:`step`'s fast path, ``_fast_dt``, for the state as it
+        is now: any forward step with a border; none in a periodic cell, until a checked step has
+        bounded its laps (:meth:`_checked_step`); none without a border or backwards."""
+        forward = self._sign > 0.0 and self.scene.bounds is not None
+        self._fast_dt = MAX_MAGNITUDE if forward and not self.scene.periodic else 0.0
 
     def invalidate(self, scenes: np.ndarray) -> None:
         """Drop the calendar's predictions for ``scenes`` (they are made afresh at the next step)
@@ -264,7 +272,7 @@ class Stepper:
         self.work_f[scenes, W_GRID_X0 : W_GRID_X0 + 4] = origin_and_cells
         self.work_i[scenes, W_GRID_NX : W_GRID_NX + 2] = counts
         self.work_i[scenes, W_CALENDAR_VALID] = 0
-        self.start = START_STEP
+        self.changed()
 
     def uses_grid(self) -> bool:
         """The broad phase pays only in large scenes with ball pairs (and no stick clusters)."""
@@ -297,8 +305,8 @@ class Stepper:
         )
         self._pack = pack(state, *self.mode_arrays, frames=True)
         self._sign = float(self.fparams[S_SIGN])  # the direction fparams are set for (see step)
-        # step's fast path applies (not to periodic scenes: each step's laps are checked)
-        self._forward = self._sign > 0.0 and self.scene.bounds is not None and not self.scene.periodic
+        self._shared = getattr(self, "_shared", False)  # (live_arrays handed out: see _reset_fast_path)
+        self._reset_fast_path()
         self.live = LiveArrays(
             self.balls, self.pos, self.vel, self.mass, self.radius, self.time, self.body, self.capped
         )
@@ -315,8 +323,12 @@ class Stepper:
         is most of a small scene's fixed cost. ``start`` says which: every other way of changing the
         state (a nudge, :meth:`put`, :meth:`load`, a step of another kind, frames) sets it back to
         ``START_STEP``, and once :meth:`live_arrays` has handed the arrays out, where anyone may
-        write them, it stays there."""
-        if self._forward and 0.0 < dt <= MAX_MAGNITUDE:  # the common case, checked in one test
+        write them, it stays there.
+
+        The fast path takes forward steps up to ``_fast_dt``: with a border, steps that need no
+        check but ``dt``'s own; in a periodic cell, those whose laps round the cell a checked step
+        bounded (see :meth:`_checked_step`)."""
+        if 0.0 < dt <= self._fast_dt:  # the common case, checked in one test
             rows = self._kernel(self._pack, dt, self.start)
             if rows >= 0:  # no scene stalled or reached the event cap
                 self.start = self._after_step
@@ -333,8 +345,7 @@ class Stepper:
         check_seconds(dt, "dt")
         if self.scene.bounds is None:
             check_reach(self.pos, self.vel, dt, label)
-        if self.scene.periodic:
-            check_laps(self.scene, self.mass, self.vel, dt, label)
+        longest = check_laps(self.scene, self.mass, self.vel, dt, label) if self.scene.periodic else 0.0
         e = self.scene.elasticity
         if dt < 0.0 and e == 0.0:
             raise ValueError(
@@ -348,7 +359,7 @@ class Stepper:
             self.fparams[S_ELASTICITY] = e if sign > 0 else 1.0 / e
             self.fparams[S_SIGN] = sign
             self._sign = sign
-            self._forward = sign > 0.0 and self.scene.bounds is not None and not self.scene.periodic
+        self._reset_fast_path()
         # reversed, a bounce at e < 1 multiplies the speed by 1/e, and the bounces come ever faster:
         # a past may diverge within finite time. Such a step is refused, from a copy kept here.
         before = self.saved() if sign < 0 and e < 1.0 else None
@@ -363,6 +374,11 @@ class Stepper:
                 np.negative(self.omega, out=self.omega)
         if before is not None:
             self._refuse_divergent_past(before, dt)
+        if sign > 0.0 and not self._shared and self.settings.collapse_floor == 0.0:
+            # Forward, collisions never add energy (but for the collapse regulariser's floor), so no
+            # ball can ever go faster than check_laps allowed for: until the balls are changed from
+            # outside a step, steps up to its longest step need no check of their laps.
+            self._fast_dt = max(self._fast_dt, min(longest, MAX_MAGNITUDE))
         return self._finish(chunks, sign, stacklevel)
 
     def _refuse_divergent_past(self, before: list[np.ndarray], dt: float) -> None:
@@ -393,7 +409,7 @@ class Stepper:
         if self.scene.periodic:  # (the run's laps, checked once: a periodic step has no fast path)
             check_laps(self.scene, self.mass, self.vel, dt * n, self.label)
         while f < n:
-            forward = self._forward or (self.scene.periodic and self._sign > 0.0)
+            forward = self._sign > 0.0 and self.scene.bounds is not None
             if not (forward and 0.0 < dt <= MAX_MAGNITUDE):
                 # backwards or without a border: a step as step takes it (which may make the next
                 # ones forward steps with a border)
@@ -494,8 +510,11 @@ class Stepper:
     # ------------------------------------------------------------------ what it holds
     def live_arrays(self) -> LiveArrays:
         """The state arrays themselves; from now on every step compares each ball with the state
-        the last step left it in (whoever holds them may write them)."""
+        the last step left it in, and checks a periodic cell's laps (whoever holds them may write
+        them)."""
         self.start = self._after_step = START_STEP
+        self._shared = True
+        self._reset_fast_path()
         return self.live
 
     def models(self) -> dict[str, Any]:
@@ -537,8 +556,7 @@ class Stepper:
         for field in (S_ELASTICITY, S_SIGN):  # (the direction of time the state is kept for)
             self.fparams[field] = other.fparams[field]
         self._sign = other._sign
-        self._forward = other._forward
-        self.start = START_STEP
+        self.changed()
 
     def stepped_arrays(self) -> list[np.ndarray]:
         """The arrays a step changes: balls, clusters, clocks and, in exact mode, the event
@@ -554,11 +572,11 @@ class Stepper:
         """Put back the arrays :meth:`saved` copied."""
         for mine, kept in zip(self.stepped_arrays(), saved, strict=True):
             np.copyto(mine, kept)
-        self.start = START_STEP
+        self.changed()
 
     #: What a copy or a pickle rebuilds rather than carries: work space, and what is bound to it.
     _REBUILT = (
-        "_imp", "_imp_bytes", "_n_imp", "_kernel", "_pack", "_sign", "_forward", "live", "pos", "vel", "mass",
+        "_imp", "_imp_bytes", "_n_imp", "_kernel", "_pack", "_sign", "_fast_dt", "live", "pos", "vel", "mass",
         "inv_mass", "radius", "omega", "spec", "start", "_after_step",
     )  # fmt: skip
 

@@ -410,14 +410,16 @@ def check_reach(pos: np.ndarray, vel: np.ndarray, dt: float, label: Labels) -> N
 MAX_LAPS = 2.0**20
 
 
-def check_laps(scene: Scene, mass: np.ndarray, vel: np.ndarray, dt: float, label: Labels) -> None:
+def check_laps(scene: Scene, mass: np.ndarray, vel: np.ndarray, dt: float, label: Labels) -> float:
     """In a periodic cell, a step of ``dt`` must not take any ball round the cell more than
     :data:`MAX_LAPS` times, at the fastest speed the energy of its scene allows any of its balls
-    (collisions never add energy)."""
-    with np.errstate(over="ignore", invalid="ignore"):
+    (collisions never add energy). Returns the longest step that would pass (s; inf if no ball moves)."""
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         energy = (mass * (vel**2).sum(-1)).sum(-1)
         fastest = np.sqrt(energy / mass.min(-1))
-        laps = fastest * abs(dt) / min(length for length in scene.period if length > 0.0)
+        length = min(length for length in scene.period if length > 0.0)
+        laps = fastest * abs(dt) / length
+        longest = float(MAX_LAPS * length / fastest.max())
     if not (laps <= MAX_LAPS).all():
         s = int(np.flatnonzero(~(laps <= MAX_LAPS))[0])
         where = label(s).rstrip(": ")
@@ -425,6 +427,7 @@ def check_laps(scene: Scene, mass: np.ndarray, vel: np.ndarray, dt: float, label
             f"dt: a step of {dt:g} s could take a ball{' of ' + where if where else ''} round the periodic "
             f"cell {laps[s]:.3g} times (at most {MAX_LAPS:g}: each crossing is an event); take shorter steps"
         )
+    return longest
 
 
 #: A stick cluster's members move as one rigid body: a member's velocity may differ from the rigid
