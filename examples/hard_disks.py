@@ -14,11 +14,12 @@ import argparse
 
 import numpy as np
 
-from collision_env.bench.metrics import henderson_z, kolafa_rottner_z
 from collision_env.engine import compress, disk_gas
 from collision_env.engine.compression import DEFAULT_RATE
 from collision_env.observables import (
     collision_rate,
+    henderson_z,
+    kolafa_rottner_z,
     mean_free_time,
     mean_squared_displacement,
     radial_distribution,
@@ -54,7 +55,7 @@ def main(argv: list[str] | None = None) -> None:
         unwrapped.append(sim.unwrapped_positions)
     impacts = np.concatenate(impacts)
     duration = frames * dt
-    z = reduced_pressure(impacts, gas.radii, duration, sim.kinetic_energy())
+    z = reduced_pressure(impacts, gas.radii, duration, sim.kinetic_energy(), scene=gas.scene)
     print(
         f"Z = PA/NkT = {z:.4f}: Kolafa & Rottner (2006) {kolafa_rottner_z(args.packing):.4f}, "
         f"Henderson (1975) {henderson_z(args.packing):.4f}"
