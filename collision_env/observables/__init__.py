@@ -13,6 +13,9 @@ Boltzmann constant: ``kT`` is an energy), ``N`` is the number of disks, ``A`` th
 - :mod:`~collision_env.observables.structure`: g(r) (:func:`radial_distribution`, O(N) memory
   through a cell list, in a box or a periodic cell) and the mean squared displacement
   (:func:`mean_squared_displacement`, :func:`unwrapped_positions`);
+- :mod:`~collision_env.observables.order`: the hexatic order (:func:`hexatic_order`,
+  :func:`global_hexatic_order`) and its correlation (:func:`hexatic_correlation`), through freud
+  (the ``analysis`` extra);
 - :mod:`~collision_env.observables.reference`: what the hard-disk fluid is known to do, to compare
   with: the equation of state (:func:`kolafa_rottner_z`, :func:`henderson_z`), the contact value
   :func:`henderson_g` and Enskog's collision rate :func:`enskog_rate`.
@@ -31,6 +34,7 @@ Every name is importable from ``collision_env.observables`` itself. Impacts are
 (1.25, 0.5)
 """
 
+from .order import SHORTEST_EDGE, global_hexatic_order, hexatic_correlation, hexatic_order
 from .pressure import (
     PressureAccumulator,
     collision_rate,
@@ -48,6 +52,7 @@ __all__ = [
     "KOLAFA_ROTTNER",
     "KOLAFA_ROTTNER_MAX",
     "PAIR_CHUNK",
+    "SHORTEST_EDGE",
     "BlockAverage",
     "Blocking",
     "PressureAccumulator",
@@ -55,8 +60,11 @@ __all__ = [
     "collision_rate",
     "collision_virial",
     "enskog_rate",
+    "global_hexatic_order",
     "henderson_g",
     "henderson_z",
+    "hexatic_correlation",
+    "hexatic_order",
     "kolafa_rottner_z",
     "mean_free_time",
     "mean_squared_displacement",
