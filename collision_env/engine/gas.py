@@ -155,11 +155,14 @@ def disk_gas(
     sigma = 2.0 * radii.max()
     if arrangement == "crystal":
         width, height, positions = _crystal(n, area, sigma, ratio)
+        _roomy(width, height, sigma, periodic)
     elif arrangement == "lattice" and periodic and ratio is None:
         width, height, positions = _tiled_lattice(n, area, sigma, rng)
+        _roomy(width, height, sigma, periodic)
     else:
         width = math.sqrt(area / (1.0 if ratio is None else ratio))
         height = width if ratio is None else ratio * width
+        _roomy(width, height, sigma, periodic)
         if arrangement == "lattice":
             positions = _lattice(n, width, height, sigma, periodic, rng)
         else:
@@ -172,6 +175,18 @@ def disk_gas(
 
     velocities *= math.sqrt(temperature / measured(velocities, masses, scene))
     return Gas(scene, positions, velocities, masses, radii)
+
+
+def _roomy(width, height, sigma, periodic):
+    """Refuse a box narrower than a disk, or a periodic cell narrower than two (a disk would touch
+    two images of another: see ``Scene(periodic=True)``)."""
+    least = 2.0 * sigma * (1.0 + LATTICE_SLACK) if periodic else sigma
+    if min(width, height) <= least:
+        kind = "periodic cell" if periodic else "box"
+        raise ValueError(
+            f"packing_fraction: at this area fraction the {kind} is {width:.6g} x {height:.6g}, too narrow for disks "
+            f"of diameter {sigma:g} (a side must exceed {least:.6g}); lower it, add disks, or make the shape squarer"
+        )
 
 
 def _ratio(aspect) -> float | None:

@@ -84,6 +84,8 @@ def test_the_same_seed_gives_the_same_gas():
         (dict(n=10, packing_fraction=0.3, diameters=(1.0, -1.0)), "diameters: expected positive"),
         (dict(n=10, packing_fraction=0.3, mass=0.0), "mass: must be positive"),
         (dict(n=10, packing_fraction=0.3, temperature=math.inf), "temperature: must be positive"),
+        (dict(n=2, packing_fraction=0.6, aspect=3.0), "box is .* too narrow"),
+        (dict(n=8, packing_fraction=0.3, periodic=True, aspect=20.0), "periodic cell is .* too narrow"),
     ],
 )
 def test_bad_input_is_refused(kwargs, message):
