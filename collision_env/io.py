@@ -155,7 +155,7 @@ def _same_run(path, reader, run: _Run) -> None:
 
 def write_gsd(
     path: str | os.PathLike,
-    frames,
+    frames: Any,
     scene: Scene,
     radii: ArrayLike,
     *,
@@ -266,7 +266,7 @@ def read_gsd(path: str | os.PathLike, frames: int | slice | None = None) -> Traj
     return Trajectory(scene, radii, masses, np.array(time), np.array(positions), np.array(velocities), np.array(images))
 
 
-def write_xyz(path: str | os.PathLike, frames, scene: Scene, radii: ArrayLike, *, append: bool = False) -> None:
+def write_xyz(path: str | os.PathLike, frames: Any, scene: Scene, radii: ArrayLike, *, append: bool = False) -> None:
     """Write a ``Simulator``'s ``frames`` to the extended XYZ file ``path`` (see the module), in the
     scene's own coordinates: ``Lattice`` holds the cell's sides (``Lz = 0``), ``Origin`` its
     corner, ``pbc`` its periodic axes, ``Time`` the frame's clock; each disk's line its species

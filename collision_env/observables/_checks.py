@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import numbers
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -12,7 +13,7 @@ from numpy.typing import ArrayLike
 from collision_env.engine.scene import Scene
 
 
-def records(impacts) -> np.ndarray:
+def records(impacts: Any) -> np.ndarray:
     """The structured array of ``impacts`` (an ``Impacts`` or an ``IMPACT_DTYPE`` array)."""
     array = getattr(impacts, "array", impacts)
     if not (isinstance(array, np.ndarray) and array.dtype.names and "impulse" in array.dtype.names):
@@ -20,7 +21,7 @@ def records(impacts) -> np.ndarray:
     return array
 
 
-def positive(value, name: str) -> float:
+def positive(value: Any, name: str) -> float:
     """``value`` as a finite float > 0."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
         raise ValueError(f"{name}: must be a finite number > 0, got {value!r}")
@@ -30,7 +31,7 @@ def positive(value, name: str) -> float:
     return value
 
 
-def whole(value, name: str, least: int) -> int:
+def whole(value: Any, name: str, least: int) -> int:
     """``value`` as an int of at least ``least`` (an integer, not a boolean or a float)."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral) or value < least:
         raise ValueError(f"{name}: must be a whole number of at least {least}, got {value!r}")
@@ -59,14 +60,14 @@ def masses(values: ArrayLike, n: int) -> np.ndarray:
     return m
 
 
-def scene(value) -> Scene:
+def scene(value: Any) -> Scene:
     """A :class:`~collision_env.engine.Scene`."""
     if not isinstance(value, Scene):
         raise TypeError(f"scene: expected a collision_env.engine.Scene, got {type(value).__name__}")
     return value
 
 
-def bounded_scene(value) -> Scene:
+def bounded_scene(value: Any) -> Scene:
     """A scene with bounds: a walled box or a periodic cell."""
     s = scene(value)
     if s.bounds is None:

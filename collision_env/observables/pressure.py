@@ -15,6 +15,7 @@ about it. At N = 72 the two differ by 1.4 %: :func:`temperature` takes the scene
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -246,7 +247,7 @@ class PressureAccumulator:
         """The ball-ball impacts counted so far."""
         return self._collisions
 
-    def add(self, frames) -> None:
+    def add(self, frames: Any) -> None:
         """Take the frames of one ``Simulator.frames`` call (``time (F,)``, ``velocities (F, N, 2)``
         and ``impacts``), which must follow the frames taken before. A refused call takes none."""
         times = np.asarray(frames.time, dtype=np.float64)

@@ -14,7 +14,10 @@ and N. D. Drummond, *Phys. Rev. E* 83, 066706 (2011), eq. 14) choose it: the sma
     B^3 > 2 n (SE_k / SE_0)^4
 
 ``n`` the number of samples: ``(SE_k / SE_0)^2`` estimates the correlation time in samples, and
-this ``B`` balances the bias of blocks too short against the noise of blocks too few.
+this ``B`` balances the bias of blocks too short against the noise of blocks too few. The criterion
+reads the correlation at the block size it tries, so correlations slower than that (which raise
+the estimates only at longer blocks) are missed: :attr:`BlockAverage.errors` is the whole blocking
+curve, whose plateau is the error (Flyvbjerg & Petersen's reading), to check it by.
 
 :class:`Blocking` takes the samples as they come (one, or an array at a time) and keeps only a few
 numbers per level, so a run of any length needs ``O(log n)`` memory; :func:`block_average` is the

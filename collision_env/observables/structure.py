@@ -9,6 +9,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -144,7 +145,7 @@ def radial_distribution(
     return 0.5 * (edges[1:] + edges[:-1]), g
 
 
-def unwrapped_positions(frames, scene: Scene) -> np.ndarray:
+def unwrapped_positions(frames: Any, scene: Scene) -> np.ndarray:
     """A run's centres as if the periodic cell did not wrap them: ``positions + images * period``
     (``Scene.period``; a walled box's positions as they are), for frames of a ``Simulator``
     (``(F, N, 2)``) or of a ``BatchSimulator`` (``(F, B, N, 2)``): any object with ``positions``
@@ -178,7 +179,7 @@ def _lags(lags, frames: int) -> np.ndarray:
 
 
 def mean_squared_displacement(
-    trajectory, lags: ArrayLike | None = None, *, scene: Scene | None = None
+    trajectory: Any, lags: ArrayLike | None = None, *, scene: Scene | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """The mean squared displacement over a run's equally spaced frames: ``(lags, msd)``, with
 
