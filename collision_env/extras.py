@@ -25,6 +25,7 @@ EXTRAS: dict[str, tuple[str, ...]] = {
     "video": ("imageio_ffmpeg",),
     "render": ("pygame",),
     "plot": ("matplotlib",),
+    "analysis": ("freud", "gsd"),
     "peers": ("billiards", "pymunk"),
     "test": ("pytest", "xdist", "hypothesis"),
     "dev": ("ruff", "mypy", "yaml-stubs", "build", "twine", "cffconvert"),  # (yaml-stubs: types-PyYAML)

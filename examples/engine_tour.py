@@ -99,7 +99,7 @@ def gas_pressure(n=400, radius=0.01, packing=0.3, seed=0):
     rec = sim.frames(1 / 60, 600)  # ten seconds, sampled at 60 Hz
     seconds = time.perf_counter() - start
     duration, energy = 600 / 60, sim.kinetic_energy()
-    z_virial = reduced_pressure(rec.impacts, sim.radii, duration, energy)
+    z_virial = reduced_pressure(rec.impacts, sim.radii, duration, energy, scene=box)
     z_walls = wall_pressure(rec.impacts, duration, box.bounds, radius) * (side - 2 * radius) ** 2 / energy
     henderson = (1 + packing**2 / 8) / (1 - packing) ** 2
     print(

@@ -15,8 +15,6 @@ tuples, into that form.
   :func:`~collision_env.observables.enskog_rate` (from :mod:`collision_env.observables`):
   statistical checks for long runs of an elastic gas (2D Maxwell-Boltzmann speeds, collision
   frequency).
-- :func:`kolafa_rottner_z`, :func:`henderson_z`: the hard-disk fluid's equation of state, the
-  compressibility factor ``Z = P A / (N kT)`` at area fraction ``eta``.
 """
 
 from __future__ import annotations
@@ -350,44 +348,3 @@ def ks_rayleigh(speeds: ArrayLike, masses: ArrayLike | None = None, kT: float | 
 def ks_critical(n_samples: int, alpha: float = 0.05) -> float:
     """Asymptotic critical KS distance for ``n_samples`` independent samples at level ``alpha``."""
     return math.sqrt(-0.5 * math.log(alpha / 2.0)) / math.sqrt(n_samples)
-
-
-#: Kolafa & Rottner's fit of the hard-disk compressibility factor, ``Z = sum_i C_i x^i`` with
-#: ``x = eta / (1 - eta)`` (their fit to densities up to ``rho sigma^2 = 0.90``, ``eta <= 0.707``):
-#: J. Kolafa and M. Rottner, Mol. Phys. 104, 3435 (2006). Expanded in ``eta`` it reproduces the
-#: exact virial coefficients of hard disks (Clisby & McCoy, J. Stat. Phys. 122, 15 (2006)).
-KOLAFA_ROTTNER = {
-    0: 1.0,
-    1: 2.0,
-    2: 1.12801775,
-    3: 0.00181895291,
-    4: -0.0526134737,
-    5: 0.0504960168,
-    6: -0.0325537792,
-    7: 0.0134578632,
-    8: 0.00140888182,
-    9: -0.00834273601,
-    10: 0.00694127367,
-    11: -0.00262254723,
-    12: 0.000355746352,
-    22: -5.24672938e-9,
-    57: 5.88054639e-23,
-}
-#: The fit holds up to here (the liquid-hexatic coexistence starts at about 0.700: Bernard & Krauth,
-#: Phys. Rev. Lett. 107, 155704 (2011)); above it its high powers run away.
-KOLAFA_ROTTNER_MAX = 0.70
-
-
-def kolafa_rottner_z(packing: float) -> float:
-    """The hard-disk fluid's ``Z = P A / (N kT)`` at area fraction ``packing`` (Kolafa & Rottner 2006,
-    :data:`KOLAFA_ROTTNER`); a ``ValueError`` above :data:`KOLAFA_ROTTNER_MAX`."""
-    if not 0.0 <= packing <= KOLAFA_ROTTNER_MAX:
-        raise ValueError(f"packing: the fit holds for 0 <= eta <= {KOLAFA_ROTTNER_MAX}, got {packing}")
-    x = packing / (1.0 - packing)
-    return math.fsum(c * x**i for i, c in KOLAFA_ROTTNER.items())
-
-
-def henderson_z(packing: float) -> float:
-    """Henderson's hard-disk ``Z = (1 + eta^2 / 8) / (1 - eta)^2``: D. Henderson, Mol. Phys. 30, 971
-    (1975). Within 0.5 % of :func:`kolafa_rottner_z` up to ``eta = 0.5``, above it too high."""
-    return (1.0 + packing * packing / 8.0) / (1.0 - packing) ** 2

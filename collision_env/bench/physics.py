@@ -41,10 +41,9 @@ import numpy as np
 
 from collision_env.engine import Simulator, compress, disk_gas, warm_up
 from collision_env.engine.compression import DEFAULT_RATE, DEFAULT_UNTIL_PRESSURE
-from collision_env.observables import collision_rate, reduced_pressure
+from collision_env.observables import collision_rate, henderson_z, kolafa_rottner_z, reduced_pressure
 
 from .machine import cpus, machine, timestamp, versions
-from .metrics import henderson_z, kolafa_rottner_z
 from .readme import write_block
 
 PACKINGS = (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.65, 0.68)
@@ -106,7 +105,7 @@ def equation_of_state(
         events = 0
         for _ in range(BLOCKS):
             impacts, duration = run_to_collisions(sim, BLOCK_COLLISIONS, omega_ref)
-            zs.append(reduced_pressure(impacts, gas.radii, duration, sim.kinetic_energy()))
+            zs.append(reduced_pressure(impacts, gas.radii, duration, sim.kinetic_energy(), scene=gas.scene))
             omegas.append(collision_rate(impacts, n, duration))
             events += len(impacts)
         wall = time.perf_counter() - started

@@ -1,5 +1,6 @@
-"""Starting states for hard-disk studies: ``N`` disks at a given area fraction, on a triangular lattice
-or at random, with Maxwell–Boltzmann velocities at a given temperature.
+"""Starting states for hard-disk studies: ``N`` disks at a given area fraction, on a triangular lattice,
+as a perfect triangular crystal, or at random, with Maxwell–Boltzmann velocities at a given temperature,
+in a box or periodic cell of a given shape.
 
 Units are the field's reduced ones by default: the (largest) diameter ``sigma = 1``, the mass ``m = 1``
 and ``kT = 1``, so that times are in ``sigma * sqrt(m / kT)`` (Allen & Tildesley, *Computer
@@ -10,6 +11,9 @@ fraction) is ``phi = sum(pi r_i^2) / A``, ``A`` the area of the box or periodic 
 >>> round(gas.packing_fraction, 12), gas.positions.shape, round(float(gas.kinetic_energy()), 12)
 (0.3, (100, 2), 100.0)
 >>> sim = gas.simulator()  # an exact-mode Simulator of the gas
+>>> crystal = disk_gas(72, 0.7, arrangement="crystal", periodic=True, aspect=(9, 8 * math.sqrt(3) / 2))
+>>> [round(side, 6) for side in crystal.scene.period]  # 9 disks a row, 8 rows: Li et al.'s N = 72 cell
+[10.244084, 7.885899]
 """
 
 from __future__ import annotations
@@ -32,6 +36,10 @@ RANDOM_MAX = 0.5
 RANDOM_TRIES_PER_DISK = 10_000
 #: Where every disk's lattice site is at least this far (relative) from overlapping its neighbours.
 LATTICE_SLACK = 1e-9
+#: How closely (relative) a periodic crystal's cell must match the shape asked for.
+CRYSTAL_SHAPE_RTOL = 1e-9
+#: The arrangements :func:`disk_gas` offers.
+ARRANGEMENTS = ("lattice", "crystal", "random")
 
 
 class Gas(NamedTuple):
@@ -56,7 +64,8 @@ class Gas(NamedTuple):
         return float(np.pi * np.sum(self.radii**2) / self.area)
 
     def kinetic_energy(self) -> float:
-        """``sum(m v^2) / 2``: ``N kT`` in two dimensions."""
+        """``sum(m v^2) / 2``: ``N kT`` in a box, ``(N - 1) kT`` in a periodic cell (whose centre of
+        mass is at rest: see :func:`~collision_env.observables.temperature`)."""
         return float(0.5 * np.sum(self.masses * np.sum(self.velocities**2, axis=1)))
 
     def simulator(self, **options: Any) -> Simulator:
@@ -70,12 +79,13 @@ def disk_gas(
     *,
     arrangement: str = "lattice",
     periodic: bool = False,
+    aspect: float | tuple[float, float] | None = None,
     diameters: tuple[float, ...] = (1.0,),
     mass: float = 1.0,
     temperature: float = 1.0,
     seed: int | np.random.Generator | None = None,
 ) -> Gas:
-    """``n`` disks at area fraction ``packing_fraction`` in a near-square box (walls) or periodic cell.
+    """``n`` disks at area fraction ``packing_fraction`` in a box (walls) or periodic cell.
 
     Parameters
     ----------
@@ -86,19 +96,33 @@ def disk_gas(
     arrangement:
         ``"lattice"``: a triangular lattice, each row shifted by half a spacing, the sites spread
         evenly over the box (vacant sites, if ``n`` fills no whole lattice, are picked at random), up
-        to close packing; or ``"random"``: random sequential addition, each disk placed uniformly
-        where it overlaps no other, up to :data:`RANDOM_MAX`.
+        to close packing; ``"crystal"``: a perfect triangular crystal of ``n = k * 2m`` disks, ``k``
+        to a row and ``2m`` rows, in the periodic cell it tiles, ``k a`` by ``2m a sqrt(3) / 2`` for a
+        spacing ``a`` (periodic only; the cell's shape follows from ``k`` and ``m``, see ``aspect``);
+        or ``"random"``: random sequential addition, each disk placed uniformly where it overlaps no
+        other, up to :data:`RANDOM_MAX`.
     periodic:
         The box is a periodic cell (``Scene(periodic=True)``): no walls, and disks meet across its
         edges (the lattice then fits the cell exactly, rows in even number).
+    aspect:
+        The shape of the box or cell: its height over its width (a number), or its sides in
+        proportion, ``(width, height)``: ``(1, sqrt(3) / 2)`` for the ``1 : sqrt(3)/2`` cells of the
+        hard-disk literature (e.g. Li, Nishikawa, Höllmer, Carillo, Maggs & Krauth, *J. Chem. Phys.*
+        157, 234111 (2022)). ``None`` (the default): a square box, or with ``periodic`` and the
+        lattice, the most nearly square cell that the lattice tiles; for a crystal, the most nearly
+        square of its cells. A crystal's cell must be the one asked for (to ``1e-9``): with ``n = 72``
+        at ``(9, 8 sqrt(3) / 2)``, say, 9 disks a row in 8 rows; any other shape raises a
+        ``ValueError`` that names the shapes ``n`` disks can tile.
     diameters:
         Diameters handed out in turn, disk ``i`` taking ``diameters[i % len(diameters)]``: ``(1.0,)``
         for a monodisperse gas, ``(1.0, 1.4)`` for the 50:50 bidisperse mixture of O'Hern et al.,
         Phys. Rev. E 68, 011306 (2003).
     mass, temperature:
         Every disk's mass, and ``kT``: velocities are drawn from the Maxwell–Boltzmann distribution,
-        the centre of mass set at rest, then scaled so that the kinetic energy is exactly ``n kT``
-        (two degrees of freedom per disk).
+        the centre of mass set at rest, then scaled so that the gas's
+        :func:`~collision_env.observables.temperature` is exactly ``kT``: a kinetic energy of
+        ``n kT`` in a box (two degrees of freedom per disk), ``(n - 1) kT`` in a periodic cell
+        (whose conserved momentum takes two).
     seed:
         For the random draws (numpy's ``default_rng``).
 
@@ -111,8 +135,11 @@ def disk_gas(
     sizes = np.asarray(diameters, dtype=np.float64)
     if sizes.ndim != 1 or not len(sizes) or not (np.isfinite(sizes) & (sizes > 0)).all():
         raise ValueError(f"diameters: expected positive finite numbers, got {diameters!r}")
-    if arrangement not in ("lattice", "random"):
-        raise ValueError(f"arrangement: must be 'lattice' or 'random', got {arrangement!r}")
+    if arrangement not in ARRANGEMENTS:
+        raise ValueError(f"arrangement: must be one of {ARRANGEMENTS}, got {arrangement!r}")
+    if arrangement == "crystal" and not periodic:
+        raise ValueError("arrangement: a perfect crystal needs periodic=True (walls do not fit a triangular lattice)")
+    ratio = _ratio(aspect)
     if not (is_real(mass) and math.isfinite(mass) and mass > 0):
         raise ValueError(f"mass: must be positive and finite, got {mass!r}")
     if not (is_real(temperature) and math.isfinite(temperature) and temperature > 0):
@@ -126,62 +153,147 @@ def disk_gas(
         )
     area = disk_area / packing_fraction
     sigma = 2.0 * radii.max()
-    if arrangement == "lattice":
-        width, height, positions = _lattice(n, area, sigma, periodic, rng)
+    if arrangement == "crystal":
+        width, height, positions = _crystal(n, area, sigma, ratio)
+        _roomy(width, height, sigma, periodic)
+    elif arrangement == "lattice" and periodic and ratio is None:
+        width, height, positions = _tiled_lattice(n, area, sigma, rng)
+        _roomy(width, height, sigma, periodic)
     else:
-        width = height = math.sqrt(area)
-        positions = _random(radii, width, height, periodic, rng)
+        width = math.sqrt(area / (1.0 if ratio is None else ratio))
+        height = width if ratio is None else ratio * width
+        _roomy(width, height, sigma, periodic)
+        if arrangement == "lattice":
+            positions = _lattice(n, width, height, sigma, periodic, rng)
+        else:
+            positions = _random(radii, width, height, periodic, rng)
     scene = Scene(bounds=(0.0, 0.0, width, height), periodic=periodic)
     masses = np.full(n, float(mass))
     velocities = rng.normal(0.0, math.sqrt(temperature / mass), (n, 2))
     velocities -= velocities.mean(axis=0)  # equal masses: the centre of mass at rest
-    velocities *= math.sqrt(n * temperature / (0.5 * np.sum(masses[:, None] * velocities**2)))
+    from collision_env.observables.pressure import temperature as measured  # (observables import the engine)
+
+    velocities *= math.sqrt(temperature / measured(velocities, masses, scene))
     return Gas(scene, positions, velocities, masses, radii)
 
 
-def _lattice(n, area, sigma, periodic, rng):
-    """``n`` sites of a triangular lattice (odd rows shifted by half a spacing) over a near-square
-    box of ``area``. Returns the box's width and height and the positions."""
-    row_height = math.sqrt(3.0) / 2.0
-    most_rows = 2 * math.isqrt(n) + 2
-    if periodic:
-        # the lattice tiles the cell (rows in even number, as the shift repeats every two rows): the
-        # most nearly square cell, then the fewest vacant sites
-        def cell_shape(rows):
-            cols = -(-n // rows)
-            return abs(math.log(cols / (rows * row_height))), rows * cols - n, rows, cols
+def _roomy(width, height, sigma, periodic):
+    """Refuse a box narrower than a disk, or a periodic cell narrower than two (a disk would touch
+    two images of another: see ``Scene(periodic=True)``)."""
+    least = 2.0 * sigma * (1.0 + LATTICE_SLACK) if periodic else sigma
+    if min(width, height) <= least:
+        kind = "periodic cell" if periodic else "box"
+        raise ValueError(
+            f"packing_fraction: at this area fraction the {kind} is {width:.6g} x {height:.6g}, too narrow for disks "
+            f"of diameter {sigma:g} (a side must exceed {least:.6g}); lower it, add disks, or make the shape squarer"
+        )
 
-        _, _, rows, cols = min(cell_shape(rows) for rows in range(2, most_rows + 1, 2))
-        dx = math.sqrt(area / (rows * cols * row_height))
-        dy = dx * row_height
-        width, height = cols * dx, rows * dy
-        x0 = y0 = 0.5 * dy
-    else:
-        # a square box; the sites spread over the room the walls leave a centre (sigma / 2 from
-        # each), in the rows and columns that keep neighbours furthest apart
-        width = height = math.sqrt(area)
-        room = width - sigma
 
-        def spacing(rows):
-            cols = -(-n // rows)
-            dx = room / (cols - 0.5) if cols > 1 else 0.0
-            dy = room / (rows - 1) if rows > 1 else 0.0
-            return _nearest(rows, cols, dx, dy), rows, cols, dx, dy
+def _ratio(aspect) -> float | None:
+    """``aspect`` as the height over the width (``None`` stays ``None``)."""
+    if aspect is None:
+        return None
+    values = aspect if isinstance(aspect, (tuple, list, np.ndarray)) else (aspect,)
+    if len(values) not in (1, 2) or not all(is_real(v) and math.isfinite(v) and v > 0 for v in values):
+        raise ValueError(f"aspect: a height over width, or (width, height), positive and finite, got {aspect!r}")
+    return float(values[0]) if len(values) == 1 else float(values[1]) / float(values[0])
 
-        _, rows, cols, dx, dy = max(spacing(rows) for rows in range(1, most_rows + 1))
-        x0 = y0 = 0.5 * sigma
+
+def _sites(rows, cols, dx, dy, x0, y0):
+    """A triangular lattice's sites, row by row, odd rows shifted by half a spacing."""
+    row, col = np.divmod(np.arange(rows * cols), cols)
+    return np.stack([x0 + (col + 0.5 * (row % 2)) * dx, y0 + row * dy], axis=1)
+
+
+def _fits(n, sigma, rows, cols, dx, dy):
+    """Refuse a lattice whose nearest sites are closer than a diameter."""
     nearest = _nearest(rows, cols, dx, dy)
     if nearest < sigma * (1.0 + LATTICE_SLACK):
         raise ValueError(
             f"packing_fraction: {n} disks of diameter up to {sigma:g} do not fit a triangular lattice at this "
             f"area fraction (site spacing {nearest:.6g}); lower it, or compress the gas"
         )
-    row, col = np.divmod(np.arange(rows * cols), cols)
-    sites = np.stack([x0 + (col + 0.5 * (row % 2)) * dx, y0 + row * dy], axis=1)
-    if not periodic:  # (the outermost sites, sigma / 2 from the walls, up to round-off)
-        sites = np.clip(sites, 0.5 * sigma, width - 0.5 * sigma)
+
+
+def _vacancies(sites, n, rng):
+    """``n`` of the ``sites``, the vacant ones picked at random."""
     keep = np.sort(rng.choice(len(sites), size=n, replace=False)) if len(sites) > n else np.arange(n)
-    return width, height, sites[keep]
+    return sites[keep]
+
+
+def _crystal(n, area, sigma, ratio):
+    """A perfect triangular crystal of ``n`` disks in the periodic cell it tiles (see ``disk_gas``).
+    Returns the cell's width and height and the positions."""
+    row_height = math.sqrt(3.0) / 2.0
+    shapes = [(rows * row_height / (n // rows), rows) for rows in range(2, n + 1, 2) if n % rows == 0]
+    if not shapes:
+        raise ValueError(f"n: a periodic triangular crystal has rows in even number, so n must be even, got {n}")
+    target = 1.0 if ratio is None else ratio
+    shape, rows = min(shapes, key=lambda s: (abs(math.log(s[0] / target)), s[1]))
+    if ratio is not None and abs(shape / ratio - 1.0) > CRYSTAL_SHAPE_RTOL:
+        near = sorted(shapes, key=lambda s: abs(math.log(s[0] / ratio)))[:3]
+        options = ", ".join(f"{n // r} x {r} rows (height / width {q:.6g})" for q, r in near)
+        raise ValueError(
+            f"aspect: {n} disks tile no periodic cell of height / width {ratio:.6g}; the nearest are {options}"
+        )
+    cols = n // rows
+    dx = math.sqrt(area / (n * row_height))
+    dy = dx * row_height
+    _fits(n, sigma, rows, cols, dx, dy)
+    return cols * dx, rows * dy, _sites(rows, cols, dx, dy, 0.25 * dx, 0.5 * dy)
+
+
+def _tiled_lattice(n, area, sigma, rng):
+    """``n`` sites of a triangular lattice in the most nearly square periodic cell it tiles (rows in
+    even number, as the shift repeats every two rows), then the fewest vacant sites. Returns the
+    cell's width and height and the positions."""
+    row_height = math.sqrt(3.0) / 2.0
+
+    def cell_shape(rows):
+        cols = -(-n // rows)
+        return abs(math.log(cols / (rows * row_height))), rows * cols - n, rows, cols
+
+    _, _, rows, cols = min(cell_shape(rows) for rows in range(2, 2 * math.isqrt(n) + 3, 2))
+    dx = math.sqrt(area / (rows * cols * row_height))
+    dy = dx * row_height
+    _fits(n, sigma, rows, cols, dx, dy)
+    return cols * dx, rows * dy, _vacancies(_sites(rows, cols, dx, dy, 0.5 * dy, 0.5 * dy), n, rng)
+
+
+def _lattice(n, width, height, sigma, periodic, rng):
+    """``n`` sites of a triangular lattice (odd rows shifted by half a spacing) spread over a
+    ``width`` x ``height`` box, in the rows and columns that keep neighbours furthest apart: over the
+    room the walls leave a centre (``sigma / 2`` from each), or the whole periodic cell (rows in even
+    number). Returns the positions."""
+    most_rows = 2 * math.isqrt(n) + 2
+    if periodic:
+        candidates = range(2, most_rows + 1, 2)
+
+        def spacing(rows):
+            cols = -(-n // rows)
+            dx, dy = width / cols, height / rows
+            return _nearest(rows, cols, dx, dy), rows, cols, dx, dy
+
+        x0, y0 = None, None
+    else:
+        candidates = range(1, most_rows + 1)
+        room_x, room_y = width - sigma, height - sigma
+
+        def spacing(rows):
+            cols = -(-n // rows)
+            dx = room_x / (cols - 0.5) if cols > 1 else 0.0
+            dy = room_y / (rows - 1) if rows > 1 else 0.0
+            return _nearest(rows, cols, dx, dy), rows, cols, dx, dy
+
+        x0 = y0 = 0.5 * sigma
+    _, rows, cols, dx, dy = max(spacing(rows) for rows in candidates)
+    _fits(n, sigma, rows, cols, dx, dy)
+    if periodic:
+        x0, y0 = 0.25 * dx, 0.5 * dy
+    sites = _sites(rows, cols, dx, dy, x0, y0)
+    if not periodic:  # (the outermost sites, sigma / 2 from the walls, up to round-off)
+        sites = np.clip(sites, 0.5 * sigma, (width - 0.5 * sigma, height - 0.5 * sigma))
+    return _vacancies(sites, n, rng)
 
 
 def _nearest(rows, cols, dx, dy):

@@ -6,7 +6,7 @@ import math
 import pytest
 
 from collision_env.bench import physics as P
-from collision_env.bench.metrics import kolafa_rottner_z
+from collision_env.observables import kolafa_rottner_z
 
 
 def test_enskog_from_z_is_the_contact_theorem_rate():
