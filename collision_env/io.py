@@ -32,6 +32,7 @@ from numpy.typing import ArrayLike
 
 from collision_env.engine.scene import Scene
 from collision_env.engine.simulator import Simulator
+from collision_env.engine.snapshot import SimulatorState
 from collision_env.extras import require
 from collision_env.observables import _checks
 
@@ -53,21 +54,21 @@ class Trajectory(NamedTuple):
     velocities: np.ndarray  #: (F, N, 2) velocities
     images: np.ndarray  #: (F, N, 2) int64 periodic cell lengths crossed
 
-    def state(self, frame: int = -1) -> dict[str, np.ndarray]:
+    def state(self, frame: int = -1) -> SimulatorState:
         """Frame ``frame`` as a state :meth:`Simulator.set_state <collision_env.engine.Simulator.set_state>`
         takes (every disk its own cluster, no spin, the clock without compensation)."""
         n = len(self.radii)
-        return {
-            "positions": self.positions[frame].copy(),
-            "velocities": self.velocities[frame].copy(),
-            "masses": self.masses.copy(),
-            "radii": self.radii.copy(),
-            "clusters": np.arange(n),
-            "omega": np.zeros(n),
-            "time": np.array(self.time[frame]),
-            "time_compensation": np.array(0.0),
-            "images": self.images[frame].copy(),
-        }
+        return SimulatorState(
+            positions=self.positions[frame].copy(),
+            velocities=self.velocities[frame].copy(),
+            masses=self.masses.copy(),
+            radii=self.radii.copy(),
+            clusters=np.arange(n),
+            omega=np.zeros(n),
+            time=np.array(self.time[frame]),
+            time_compensation=np.array(0.0),
+            images=self.images[frame].copy(),
+        )
 
     def simulator(self, frame: int = -1, **options: Any) -> Simulator:
         """A :class:`~collision_env.engine.Simulator` in frame ``frame``'s state (``options``: mode, ...)."""

@@ -55,7 +55,7 @@ class EngineRunner(Runner):
         self._capped = False
 
     def step(self, dt: float, record: bool = True) -> np.ndarray:
-        rows = self._sim.step(dt)
+        rows = self._sim.step(dt).array
         if self._sim._stepper.capped[0]:  # (the array itself: cap_reached copies it)
             self._capped = True
         return rows

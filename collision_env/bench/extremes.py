@@ -575,7 +575,7 @@ def _three_balls(e: float) -> Case:
 def _run_exact(case: Case, dt: float, duration: float) -> tuple[np.ndarray, Simulator]:
     """The impacts of ``case`` in exact mode over ``duration`` (steps of ``dt``) and the final simulator."""
     sim = Simulator(*case, mode="exact")
-    rows = [sim.batch.step(dt) for _ in range(max(1, int(round(duration / dt))))]
+    rows = [sim.batch.step(dt).array for _ in range(max(1, int(round(duration / dt))))]
     return np.concatenate(rows), sim
 
 
@@ -868,8 +868,7 @@ def _bad_state(field):
         "time compensation": dict(time_compensation=1.0),
         "spanning": dict(positions=[[-4 / 3, 0.0], [0.0, 0.0], [4 / 3, 0.0]], radii=[2 / 3] * 3),
     }
-    state.update({key: np.asarray(value) for key, value in bads[field].items()})
-    return sim, state
+    return sim, state.replace(**{key: np.asarray(value) for key, value in bads[field].items()})
 
 
 def _add_state_cells(add):
@@ -977,7 +976,7 @@ def run_cell(cell: Cell, mode: str, substeps: int, budget: float) -> dict:
         s0 = time.perf_counter()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", EventCapWarning)
-            rows = sim.batch.step(dt)
+            rows = sim.batch.step(dt).array
         spent = time.perf_counter() - s0
         engine_time += spent
         worst_step = max(worst_step, spent)

@@ -30,6 +30,7 @@ from .scene import (
     radius_from_mass,
 )
 from .simulator import Simulator, warm_up
+from .snapshot import SimulatorState
 from .stepper import EventCapWarning
 from .validation import MAX_SUBSTEPS
 
@@ -60,6 +61,7 @@ __all__ = [
     "Packing",
     "Scene",
     "Simulator",
+    "SimulatorState",
     "UnknownKeywordError",
     "compress",
     "disk_gas",

@@ -17,10 +17,13 @@ from typing import Any, NamedTuple, cast
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .impacts import Impacts
 from .keywords import check_keywords
 from .modes import MODES as MODE_REGISTRY
 from .physics.motion import apply_impulses
 from .scene import Scene
+from .snapshot import SimulatorState
+from .stepper import NO_IMPACTS as NO_RECORDS
 from .stepper import FrameArrays, LiveArrays, Stepper, default_event_cap
 from .validation import (
     Labels,
@@ -31,7 +34,11 @@ from .validation import (
     checked_state,
     periodic_slack,
     real_number,
+    state_record,
 )
+
+#: What a step without impacts returns (shared: an :class:`Impacts` is read-only).
+NO_IMPACTS = Impacts(NO_RECORDS)
 
 
 class Frames(NamedTuple):
@@ -41,7 +48,7 @@ class Frames(NamedTuple):
     time: np.ndarray  #: (F, B) each scene's clock after each step (s)
     positions: np.ndarray  #: (F, B, N, 2) centres after each step (m)
     velocities: np.ndarray  #: (F, B, N, 2) velocities after each step (m/s)
-    impacts: Any  #: the steps' impacts, step after step, each step's as ``step`` returns them
+    impacts: Impacts  #: the steps' impacts, step after step, each step's as ``step`` returns them
     #: (F, B, N, 2) int64 periodic cell lengths each ball has crossed, after each step (zeros unless
     #: the scene is periodic): ``positions + images * Scene.period`` is the unwrapped trajectory
     images: np.ndarray
@@ -113,7 +120,7 @@ def frames_of(stepper: Stepper, dt: Any, n: Any, out: Any, stacklevel: int) -> F
         images = images.reshape(positions.shape)
     record = FrameArrays(times, positions, velocities, images)
     impacts = stepper.frames(dt, record, stacklevel)
-    return Frames(times, positions, velocities, impacts, images)
+    return Frames(times, positions, velocities, Impacts(impacts), images)
 
 
 def _output_arrays(out: Any, shapes: tuple) -> tuple[np.ndarray, ...]:
@@ -227,11 +234,12 @@ class BatchSimulator:
         return new
 
     # ------------------------------------------------------------------ stepping
-    def step(self, dt: float) -> np.ndarray:
+    def step(self, dt: float) -> Impacts:
         """Advance every scene by ``dt`` seconds (``dt < 0`` runs time backwards).
 
-        Returns the impacts inside the step as an array of :data:`IMPACT_DTYPE`, ordered by scene
-        and then by the order in which they happened.
+        Returns the impacts inside the step as :class:`Impacts`, ordered by scene and then by the
+        order in which they happened (``.array``: the records, of :data:`IMPACT_DTYPE`, whose
+        ``scene`` field says whose; ``.for_scene(i)``: scene ``i``'s).
 
         ``dt`` is a real number (numpy scalars included) of at most 1e150 s; without a border, the
         step must also keep every ball within 1e150 m. The clocks are compensated sums: after any
@@ -240,7 +248,8 @@ class BatchSimulator:
         multiplies a speed by 1/e, and the bounces come ever faster: a past that reaches infinite
         speed within the step raises a ``ValueError`` naming the ball, and changes nothing.
         """
-        return self._stepper.step(real_number(dt, "dt"))
+        rows = self._stepper.step(real_number(dt, "dt"))
+        return NO_IMPACTS if rows is NO_RECORDS else Impacts(rows)
 
     def frames(self, dt: float, n: int, out: Frames | None = None) -> Frames:
         """Take ``n`` steps of ``dt`` seconds, recording every scene after each one.
@@ -261,7 +270,7 @@ class BatchSimulator:
         >>> rec = sim.frames(0.5, 4)
         >>> rec.positions.shape, rec.time[:, 0].tolist(), rec.positions[:, 0, 0, 0].tolist()
         ((4, 2, 1, 2), [0.5, 1.0, 1.5, 2.0], [0.5, 0.5, 0.0, -0.5])
-        >>> rec.impacts[["scene", "time", "wall"]].tolist()
+        >>> rec.impacts.array[["scene", "time", "wall"]].tolist()
         [(0, 0.75, 1)]
         """
         return frames_of(self._stepper, dt, n, out, stacklevel=5)
@@ -447,12 +456,14 @@ class BatchSimulator:
             )
         return idx
 
-    def get_state(self) -> dict[str, np.ndarray]:
-        """A dict of array copies that :meth:`set_state` restores exactly."""
+    def get_state(self) -> SimulatorState:
+        """The whole state, as copies of the arrays (each with the batch axis), that :meth:`set_state`
+        restores exactly."""
         return self._stepper.state()
 
-    def set_state(self, state: Mapping[str, ArrayLike]) -> None:
-        """Restore a state from :meth:`get_state`.
+    def set_state(self, state: SimulatorState) -> None:
+        """Restore a state from :meth:`get_state` (a dict of its fields is still taken, with a
+        ``DeprecationWarning``).
 
         Checked as the constructor checks its balls (shapes, number types, finite and representable
         values, balls inside the border and apart, none spanning the box), and beyond that: the
@@ -469,6 +480,10 @@ class BatchSimulator:
         (those a step leaves a round-off outside stay as they are, so that a state goes back bit
         for bit).
         """
+        self._restore(state_record(state, stacklevel=2))
+
+    def _restore(self, state: Mapping[str, Any]) -> None:
+        """:meth:`set_state` of a :class:`SimulatorState`, or of a mapping of its fields."""
         s = self._stepper
         checked = checked_state(state, s.scene, s.label, (s.n_scenes, s.n), s.spec.leaves_overlaps)
         s.put(

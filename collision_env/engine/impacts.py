@@ -35,6 +35,7 @@ from collections.abc import Iterator, Sequence
 from typing import NamedTuple, overload
 
 import numpy as np
+from numpy.typing import DTypeLike
 
 from .physics.walls import WALL_NAMES
 
@@ -72,7 +73,8 @@ class Impacts(Sequence):
       ball-ball impact);
     - ``impacts.array``: the structured array itself (``scene``, ``time``, ``ball``, ``other``
       (-1 for a wall), ``wall`` (index into ``WALL_NAMES``, -1 for a ball), ``x``, ``y``,
-      ``speed``, ``impulse``); ``impacts.to_list()``: every :class:`Impact` in a list;
+      ``speed``, ``impulse``), which is also what numpy makes of it (``np.asarray(impacts)``,
+      ``np.concatenate``); ``impacts.to_list()``: every :class:`Impact` in a list;
     - ``impacts.for_scene(i)``: the impacts of scene ``i`` of a batch (the sub-env of a vector env).
 
     Equality: with another :class:`Impacts`, the records compare (so env infos compare with
@@ -93,6 +95,13 @@ class Impacts(Sequence):
 
     def __len__(self) -> int:
         return len(self.array)
+
+    def __array__(self, dtype: DTypeLike | None = None, copy: bool | None = None) -> np.ndarray:
+        """The records (``np.asarray(impacts)`` is ``impacts.array``; numpy's functions take an
+        :class:`Impacts` as the structured array it holds)."""
+        if copy:
+            return np.array(self.array, dtype=dtype, copy=True)
+        return self.array if dtype is None else self.array.astype(dtype, copy=False)
 
     @overload
     def __getitem__(self, key: int) -> Impact: ...

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import copy
 import inspect
-from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -17,17 +16,16 @@ from numpy.typing import ArrayLike
 
 from ._jit import compile_for
 from .argpack import pack_arrays
-from .batch import BatchSimulator, Frames, frames_of, new_stepper, snapshot
+from .batch import NO_IMPACTS, BatchSimulator, Frames, frames_of, new_stepper, snapshot
 from .impacts import Impacts
 from .keywords import check_keywords
 from .modes import MODES
 from .scene import Scene
+from .snapshot import SimulatorState
 from .state import START_STEP
-from .stepper import NO_IMPACTS, Stepper
-from .validation import checked_balls, periodic_slack, real_number
-
-#: What a step without impacts returns (shared: an :class:`Impacts` is read-only).
-_NO_IMPACTS = Impacts(NO_IMPACTS)
+from .stepper import NO_IMPACTS as NO_RECORDS
+from .stepper import Stepper
+from .validation import checked_balls, periodic_slack, real_number, state_record
 
 
 class Simulator:
@@ -100,7 +98,7 @@ class Simulator:
         as :class:`Impacts` (a sequence of :class:`Impact` over their records); see
         :meth:`BatchSimulator.step` for what ``dt`` may be."""
         rows = self._stepper.step(real_number(dt, "dt"))
-        return _NO_IMPACTS if rows is NO_IMPACTS else Impacts(rows)
+        return NO_IMPACTS if rows is NO_RECORDS else Impacts(rows)
 
     def frames(self, dt: float, n: int, out: Frames | None = None) -> Frames:
         """``n`` steps of ``dt`` seconds in one call, recording the state after each:
@@ -113,7 +111,7 @@ class Simulator:
         ((120, 1, 2), 2.0, [('right', 0.75)])
         """
         rec = frames_of(self._stepper, dt, n, out, stacklevel=5)
-        return Frames(rec.time[:, 0], rec.positions[:, 0], rec.velocities[:, 0], Impacts(rec.impacts), rec.images[:, 0])
+        return Frames(rec.time[:, 0], rec.positions[:, 0], rec.velocities[:, 0], rec.impacts, rec.images[:, 0])
 
     # read-only snapshots, as BatchSimulator's: set_balls, nudge and set_state change the state
     @property
@@ -204,15 +202,16 @@ class Simulator:
         images = s.images[scene] if positions is None else None
         s.put(scene, pos, vel, mass, radius, time=s.time[scene], compensation=s.clock[scene, 1], images=images)
 
-    def get_state(self) -> dict[str, np.ndarray]:
-        """A dict of array copies (no batch axis) that :meth:`set_state` restores exactly."""
-        return {key: value[0] for key, value in self._stepper.state().items()}
+    def get_state(self) -> SimulatorState:
+        """The whole state, as copies of the arrays (no batch axis), that :meth:`set_state` restores
+        exactly."""
+        return self._stepper.state().single()
 
-    def set_state(self, state: Mapping[str, ArrayLike]) -> None:
-        """Restore a state from :meth:`get_state`, checked as :meth:`BatchSimulator.set_state` checks it."""
-        if not isinstance(state, Mapping):
-            raise TypeError(f"state: expected a dict, as get_state gives, got {type(state).__name__}")
-        self.batch.set_state({key: np.asarray(value)[None] for key, value in state.items()})
+    def set_state(self, state: SimulatorState) -> None:
+        """Restore a state from :meth:`get_state`, checked as :meth:`BatchSimulator.set_state` checks it
+        (a dict of its fields is still taken, with a ``DeprecationWarning``)."""
+        record = state_record(state, stacklevel=2)
+        self.batch._restore({key: np.asarray(value)[None] for key, value in record.items()})
 
     def copy(self) -> Simulator:
         """An independent copy (``copy.copy`` and ``copy.deepcopy`` give one too)."""

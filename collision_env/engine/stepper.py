@@ -49,6 +49,7 @@ from .layout import (
 from .modes import MODES, Mode
 from .physics.periodic import wrap_positions
 from .scene import Scene
+from .snapshot import SimulatorState
 from .state import (
     RESUME,
     RUN_FRAMES,
@@ -534,19 +535,19 @@ class Stepper:
         """The work counters, by name."""
         return {name: int(count) for name, count in zip(COUNTERS, self.counters, strict=True)}
 
-    def state(self) -> dict[str, np.ndarray]:
+    def state(self) -> SimulatorState:
         """Copies of every array a state is made of (see ``BatchSimulator.get_state``)."""
-        return {
-            "positions": self.pos.copy(),
-            "velocities": self.vel.copy(),
-            "masses": self.mass.copy(),
-            "radii": self.radius.copy(),
-            "clusters": self.body.copy(),
-            "omega": self.omega.copy(),
-            "time": self.time.copy(),
-            "time_compensation": self.clock[:, 1].copy(),
-            "images": self.images.copy(),
-        }
+        return SimulatorState(
+            positions=self.pos.copy(),
+            velocities=self.vel.copy(),
+            masses=self.mass.copy(),
+            radii=self.radius.copy(),
+            clusters=self.body.copy(),
+            omega=self.omega.copy(),
+            time=self.time.copy(),
+            time_compensation=self.clock[:, 1].copy(),
+            images=self.images.copy(),
+        )
 
     # ------------------------------------------------------------------ copies
     def load(self, other: Stepper) -> None:

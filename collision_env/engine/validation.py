@@ -12,6 +12,7 @@ that would fly a ball out of range).
 from __future__ import annotations
 
 import numbers
+import warnings
 from collections.abc import Callable, Mapping
 from typing import Any, NamedTuple
 
@@ -22,6 +23,8 @@ from .keywords import close_matches
 from .physics.periodic import MAX_IMAGES, periods, wrap_positions
 from .physics.tolerance import CONTACT_RTOL, EPS, roundoff
 from .scene import CONSTANT_RADIUS, MAX_MAGNITUDE, Scene, is_real, radius_from_mass
+from .snapshot import FIELDS as STATE_FIELDS
+from .snapshot import SimulatorState
 
 #: Relative tolerance for "touching" in the start-state checks: the engine's own contact tolerance,
 #: within which its steps leave touching balls and walls (exact mode's impacts leave pairs a few
@@ -394,15 +397,12 @@ def checked_balls(
 def check_reach(pos: np.ndarray, vel: np.ndarray, dt: float, label: Labels) -> None:
     """Without a border, a step of ``dt`` must keep every ball within the representable range."""
     reach = np.abs(pos).max(-1) + np.hypot(vel[..., 0], vel[..., 1]) * abs(dt)
-    refuse_first(
-        ~(reach <= MAX_MAGNITUDE),
-        label,
-        lambda s, i: (
-            f"a step of {dt:g} s would take this ball beyond {MAX_MAGNITUDE:g} m (no border), "
-            "where positions are no longer representable"
-        ),
-        field="dt",
-    )
+    if not (reach <= MAX_MAGNITUDE).all():
+        s, i = np.argwhere(~(reach <= MAX_MAGNITUDE))[0]
+        raise ValueError(
+            f"dt: a step of {dt:g} s would take {label(s, i).rstrip(': ')} beyond "
+            f"{MAX_MAGNITUDE:g} m (no border), where positions are no longer representable"
+        )
 
 
 #: Most times a step may take a ball round a periodic cell: exact mode wraps a ball at each crossing
@@ -566,9 +566,25 @@ def checked_settings(
     return Settings(mode, substeps, max_events, float(collapse_ratio), float(collapse_floor))
 
 
-#: The keys of a state (``get_state``), with the ones ``set_state`` may go without.
-STATE_KEYS = ("positions", "velocities", "masses", "radii", "clusters", "omega", "time", "time_compensation", "images")
+#: The state fields a dict given to ``set_state`` may go without (a :class:`SimulatorState` has all).
 OPTIONAL_STATE_KEYS = ("images",)
+
+
+def state_record(state: Any, stacklevel: int) -> SimulatorState | dict:
+    """``set_state``'s argument: a :class:`SimulatorState` as it is; a mapping (the dict earlier
+    versions gave) with a ``DeprecationWarning`` (``stacklevel`` names the caller), as a dict of its
+    keys, checked by :func:`checked_state`."""
+    if isinstance(state, SimulatorState):
+        return state
+    if not isinstance(state, Mapping):
+        raise TypeError(f"state: expected a SimulatorState, as get_state gives, got {type(state).__name__}")
+    warnings.warn(
+        "set_state: a dict of the state's arrays is deprecated; pass the SimulatorState that get_state "
+        "gives (its replace() changes fields)",
+        DeprecationWarning,
+        stacklevel=stacklevel + 1,
+    )
+    return dict(state)
 
 
 class CheckedState(NamedTuple):
@@ -588,7 +604,7 @@ class CheckedState(NamedTuple):
 def checked_state(
     state: Any, scene: Scene, label: Labels, shape: tuple[int, int], leaves_overlaps: bool
 ) -> CheckedState:
-    """A ``set_state`` state of ``shape = (B, N)`` balls, checked: its keys (:data:`STATE_KEYS`,
+    """A ``set_state`` state of ``shape = (B, N)`` balls, checked: its keys (:data:`STATE_FIELDS`,
     ``images`` optional, nothing else), shapes and number types, the balls as the constructor
     checks them (with ``leaves_overlaps``, a state of a cheap mode: overlaps and jammed networks
     accepted, stick clusters with gaps of a sub-step's error), clusters and spins
@@ -605,13 +621,13 @@ def checked_state(
         "time_compensation": (n_scenes,),
         "images": (n_scenes, n, 2),
     }
-    required = [key for key in STATE_KEYS if key not in OPTIONAL_STATE_KEYS]
+    required = [key for key in STATE_FIELDS if key not in OPTIONAL_STATE_KEYS]
     if not isinstance(state, Mapping):
-        raise TypeError(f"state: expected a dict with the keys {required}, got {type(state).__name__}")
+        raise TypeError(f"state: expected a SimulatorState, as get_state gives, got {type(state).__name__}")
     unknown = [key for key in state if key not in shapes]
     if unknown:
         raise ValueError(
-            f"state: unknown key(s) {close_matches(unknown, STATE_KEYS)} (a state has the keys {list(STATE_KEYS)})"
+            f"state: unknown key(s) {close_matches(unknown, STATE_FIELDS)} (a state has the keys {list(STATE_FIELDS)})"
         )
     missing = [key for key in required if key not in state]
     if missing:

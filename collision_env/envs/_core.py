@@ -381,7 +381,7 @@ class TaskCore:
         if bad >= 0:
             where = f"sub-env {bad}: " if self.num_scenes > 1 else ""
             raise ValueError(f"{where}action contains NaN: {actions[bad].tolist()}")
-        imp = self.batch.step(dt)
+        imp = self.batch.step(dt).array
         imp.flags.writeable = False  # (the kernels take the records read-only: one compiled version)
         return imp
 
@@ -405,7 +405,7 @@ class TaskCore:
         ahead.load(self.batch)  # (its calendar too: nothing is predicted afresh)
         with warnings.catch_warnings():  # a capped look-ahead only predicts less far
             warnings.simplefilter("ignore", EventCapWarning)
-            imp = ahead.step(self.cfg.lookahead)
+            imp = ahead.step(self.cfg.lookahead).array
         imp.flags.writeable = False
         predict_kernel(self._pack, flags, imp, obs)
 

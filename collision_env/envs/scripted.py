@@ -117,7 +117,7 @@ class AimingPolicy(ScriptedPolicy):
         nudge = np.zeros((1, core.cfg.n_balls, 2))
         nudge[0, ball] = dv
         sim.nudge(nudge)
-        r = first_wall_impact(sim.step(self.lookahead), ball=ball)
+        r = first_wall_impact(sim.step(self.lookahead).array, ball=ball)
         return r is not None and any(on_target(core, 0, k, r["wall"], r["x"], r["y"], r["time"]) for k in targets)
 
     def nudge(self, obs: np.ndarray | None = None) -> np.ndarray:

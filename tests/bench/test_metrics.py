@@ -92,9 +92,9 @@ def test_match_empty_and_identical():
 
 def test_as_impacts_accepts_engine_outputs():
     sim = Simulator(Scene(bounds=None), [[-1, 0], [1, 0]], [[1, 0], [-0.5, 0]], [0.5, 1.5])
-    batch = sim.copy().batch.step(2.0)
+    batch = sim.copy().batch.step(2.0).array
     assert batch.dtype == IMPACT_DTYPE
-    objects = sim.step(2.0)
+    objects = sim.step(2.0).to_list()
     a, b = M.as_impacts(batch), M.as_impacts(objects)
     assert len(a) == len(b) == 1
     assert a[0]["time"] == pytest.approx(1.088256, abs=1e-6)

@@ -239,8 +239,7 @@ def test_a_step_sees_a_change_made_since_the_last_step(change):
         sim.set_balls(velocities=sim.velocities + dv)
     elif change == "set_state":
         state = sim.get_state()
-        state["velocities"] = state["velocities"] + dv
-        sim.set_state(state)
+        sim.set_state(state.replace(velocities=state.velocities + dv))
     else:
         sim.batch.live_arrays().velocities[0] += dv
     fresh = Simulator(scene, sim.positions, sim.velocities, np.ones(60), radii)

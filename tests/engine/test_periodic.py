@@ -173,12 +173,12 @@ def test_set_state_takes_images_within_exact_counts(images, accepted):
     sim = Simulator(Scene(bounds=CELL, periodic=True), pos, np.ones((2, 2)), [1.0, 1.0], [0.1, 0.1])
     state = sim.get_state()
     if accepted:
-        sim.set_state({**state, "images": images})
+        sim.set_state(state.replace(images=images))
         np.testing.assert_array_equal(sim.images, images.astype(np.int64))
         assert sim.images.dtype == np.int64
         return
     with pytest.raises(ValueError, match=r"state images: ball 1: expected at most 2\*\*53 periods from the cell"):
-        sim.set_state({**state, "images": images})
+        sim.set_state(state.replace(images=images))
     for key, value in sim.get_state().items():
         np.testing.assert_array_equal(value, state[key])
 
@@ -188,11 +188,11 @@ def test_set_state_counts_the_periods_a_position_is_wrapped_by_into_its_images()
     sim = Simulator(Scene(bounds=CELL, periodic=True), pos, np.ones((2, 2)), [1.0, 1.0], [0.1, 0.1])
     state = sim.get_state()
     outside = np.array([[0.25, 0.5], [1.75, 0.5]])  # ball 1 one period to the right
-    sim.set_state({**state, "positions": outside, "images": np.array([[0, 0], [2**53 - 1, 0]])})
+    sim.set_state(state.replace(positions=outside, images=np.array([[0, 0], [2**53 - 1, 0]])))
     np.testing.assert_array_equal(sim.images, [[0, 0], [2**53, 0]])
     np.testing.assert_allclose(sim.positions, [[0.25, 0.5], [0.75, 0.5]])
     with pytest.raises(ValueError, match=r"state images: ball 1: expected at most 2\*\*53 periods"):
-        sim.set_state({**state, "positions": outside, "images": np.array([[0, 0], [2**53, 0]])})
+        sim.set_state(state.replace(positions=outside, images=np.array([[0, 0], [2**53, 0]])))
 
 
 # ---------------------------------------------------------------------------- the grid

@@ -483,7 +483,7 @@ def test_set_state_type_checks_its_fields():
         ("masses", np.array([1.0, math.nan])),
     ):
         with pytest.raises(ValueError, match=f"state {key}"):
-            sim.set_state({**state, key: bad})
+            sim.set_state(state.replace(**{key: bad}))
     for key, value in sim.get_state().items():
         np.testing.assert_array_equal(value, before[key])
 

@@ -130,6 +130,6 @@ def test_stepped_modes_accept_their_own_states_and_step_a_spanning_one():
         sim = Simulator(scene, pos, vel, mass, radii, mode=mode)
         state = sim.get_state()
         tight = spanning(4, 4, 0, 0.0)
-        sim.set_state({**state, "positions": tight[1], "radii": tight[4]})
+        sim.set_state(state.replace(positions=tight[1], radii=tight[4]))
         sim.step(0.1)
         assert sim.time == pytest.approx(0.1)

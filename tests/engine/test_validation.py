@@ -1,5 +1,6 @@
 """Bad input: a ValueError that names the ball and the field, and the state left as it was."""
 
+import dataclasses
 import math
 
 import numpy as np
@@ -7,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from collision_env.engine import BatchSimulator, Scene, Simulator
+from collision_env.engine import BatchSimulator, Scene, Simulator, SimulatorState
 
 GOOD = dict(positions=[[-1.0, 0.0], [1.0, 0.0]], velocities=[[1.0, 0.0], [-1.0, 0.0]], masses=[1.0, 2.0])
 
@@ -284,10 +285,10 @@ def test_set_state_checks_stick_clusters_and_names_missing_keys():
     assert state["clusters"].tolist() == [0, 0]
     stick.set_state(state)
     with pytest.raises(ValueError, match="state clusters: ball 0: expected a ball index whose cluster is its own"):
-        stick.set_state({**state, "clusters": np.array([1, 0])})
-    with pytest.raises(ValueError, match=r"state: missing \['omega'\]"):
+        stick.set_state(state.replace(clusters=np.array([1, 0])))
+    with pytest.raises(ValueError, match=r"state: missing \['omega'\]"), pytest.warns(DeprecationWarning):
         stick.set_state({k: v for k, v in state.items() if k != "omega"})
-    with pytest.raises(TypeError, match="state: expected a dict"):
+    with pytest.raises(TypeError, match="state: expected a SimulatorState"):
         stick.set_state([1, 2])
 
 
@@ -302,7 +303,7 @@ def test_set_state_takes_a_stick_cluster_only_as_one_rigid_body_of_touching_ball
 
     def refused(message, **changes):
         with pytest.raises(ValueError, match=message):
-            sim.set_state({**state, **changes})
+            sim.set_state(state.replace(**changes))
         for key, value in sim.get_state().items():
             np.testing.assert_array_equal(value, state[key])
 
@@ -350,7 +351,7 @@ def test_set_state_refuses_any_bad_value_and_changes_nothing(n, key, ball, value
             return
         bad[key][ball, 0] = value
     with pytest.raises(ValueError, match=f"ball {ball}|state {key}|{key}"):
-        sim.set_state(bad)
+        sim.set_state(SimulatorState(**bad))
     for k, v in sim.get_state().items():
         np.testing.assert_array_equal(v, state[k])
 
@@ -366,23 +367,24 @@ def test_set_state_names_the_scene_of_a_broken_stick_cluster():
     velocities = state["velocities"].copy()
     velocities[1, 1] *= 1.1
     with pytest.raises(ValueError, match="state velocities: scene 1, ball 0: moves apart from its stick cluster"):
-        batch.set_state({**state, "velocities": velocities})
+        batch.set_state(state.replace(velocities=velocities))
     clusters = state["clusters"].copy()
     clusters[1, 2] = 0
     velocities = np.broadcast_to([0.3, 0.0], (2, 3, 2))
     with pytest.raises(ValueError, match="state clusters: scene 1, ball 2: does not touch the rest of its stick"):
-        batch.set_state({**state, "velocities": velocities, "omega": np.zeros((2, 3)), "clusters": clusters})
+        batch.set_state(state.replace(velocities=velocities, omega=np.zeros((2, 3)), clusters=clusters))
 
 
 def test_set_state_refuses_an_unknown_key_naming_the_closest_and_changes_nothing():
     sim = Simulator(Scene(periodic=True), [[0.0, 0.0], [1.0, 0.0]], [[1.0, 0.0], [0.0, 0.0]], [1.0, 1.0])
     sim.step(3.0)  # (ball 1, hit by ball 0, crosses the cell)
-    state = sim.get_state()
+    state = dict(sim.get_state())  # (a dict, as earlier versions gave)
     images = state.pop("images")
     assert images.any()
     typo = {**state, "image": images}  # (with 'images' left out, they would be taken as zeros)
     with pytest.raises(ValueError, match=r"state: unknown key\(s\) 'image' \(did you mean 'images'"):
-        sim.set_state(typo)
+        with pytest.warns(DeprecationWarning, match="a dict of the state's arrays is deprecated"):
+            sim.set_state(typo)
     np.testing.assert_array_equal(sim.images, images)
 
 
@@ -416,3 +418,23 @@ def test_a_position_a_round_off_outside_a_periodic_cell_goes_back_bit_for_bit(pa
     sim.set_state(state)
     assert scene.bounds[0] <= sim.positions[0, 0] < scene.bounds[2]
     assert sim.images[0, 0] == np.sign(past)
+
+
+def test_get_state_is_a_typed_record_and_a_dict_is_still_taken_with_a_deprecation_warning():
+    sim = Simulator(Scene(), [[0.0, 0.0], [1.0, 0.0]], [[1.0, 0.0], [0.0, 0.5]], [1.0, 2.0])
+    state = sim.get_state()
+    assert isinstance(state, SimulatorState) and list(state) == list(SimulatorState.__dataclass_fields__)
+    assert state.positions.shape == (2, 2) and state["radii"] is state.radii and state.time == 0.0
+    batch = sim.batch.get_state()
+    assert batch.positions.shape == (1, 2, 2) and batch.time.shape == (1,)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        state.time = 1.0  # type: ignore[misc]
+    sim.step(0.3)
+    with pytest.warns(DeprecationWarning, match="a dict of the state's arrays is deprecated"):
+        sim.set_state(dict(state))
+    assert sim.time == 0.0
+    np.testing.assert_array_equal(sim.positions, state.positions)
+    moved = state.replace(positions=[[0.5, 0.0], [1.0, 0.0]])
+    sim.set_state(moved)
+    np.testing.assert_array_equal(sim.positions, [[0.5, 0.0], [1.0, 0.0]])
+    np.testing.assert_array_equal(state.positions, [[0.0, 0.0], [1.0, 0.0]])  # (the original is unchanged)
