@@ -306,7 +306,7 @@ class Stepper:
         )
         self._pack = pack(state, *self.mode_arrays, frames=True)
         self._sign = float(self.fparams[S_SIGN])  # the direction fparams are set for (see step)
-        self._shared = getattr(self, "_shared", False)  # (live_arrays handed out: see _reset_fast_path)
+        self._shared = getattr(self, "_shared", False)  # (live_arrays handed out: see live_arrays)
         self._reset_fast_path()
         self.live = LiveArrays(
             self.balls, self.pos, self.vel, self.mass, self.radius, self.time, self.body, self.capped
@@ -513,9 +513,10 @@ class Stepper:
         """The state arrays themselves; from now on every step compares each ball with the state
         the last step left it in, and checks a periodic cell's laps (whoever holds them may write
         them)."""
-        self.start = self._after_step = START_STEP
-        self._shared = True
-        self._reset_fast_path()
+        if not self._shared:  # (the envs ask at every step: once is enough)
+            self._shared = True
+            self.start = self._after_step = START_STEP
+            self._reset_fast_path()
         return self.live
 
     def models(self) -> dict[str, Any]:
@@ -577,7 +578,7 @@ class Stepper:
 
     #: What a copy or a pickle rebuilds rather than carries: work space, and what is bound to it.
     _REBUILT = (
-        "_imp", "_imp_bytes", "_n_imp", "_kernel", "_pack", "_sign", "_fast_dt", "live", "pos", "vel", "mass",
+        "_imp", "_imp_bytes", "_n_imp", "_kernel", "_pack", "_sign", "_fast_dt", "_shared", "live", "pos", "vel", "mass",
         "inv_mass", "radius", "omega", "spec", "start", "_after_step",
     )  # fmt: skip
 
