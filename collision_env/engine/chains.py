@@ -58,8 +58,9 @@ MAX_EVENTS = 2**53
 #: The longest chain, in periods of the cell's longer side.
 MAX_CHAIN_PERIODS = 2**20
 #: The default chain holds about this many times ``sqrt(N)`` liftings (see :func:`event_chain`): at
-#: ``N = 224``, ``phi = 0.68`` the events to an error bar were fewest, within their uncertainty, from 1
-#: to 16 times ``sqrt(N)`` liftings per chain, and grew beyond (``python -m collision_env.bench.chains``).
+#: ``N = 224``, ``phi = 0.68`` the liftings to an error bar were fewest, and the same within their
+#: uncertainty, from 1 to 8 times ``sqrt(N)`` liftings per chain, and grew beyond
+#: (``python -m collision_env.bench.chains``).
 LIFTINGS_PER_ROOT_N = 4.0
 #: Starting disks are drawn this many at a time.
 STARTS_BATCH = 4096
