@@ -81,7 +81,14 @@ def state_point(seed: int = 1) -> tuple[Scene, np.ndarray, np.ndarray]:
     return scene, melted.positions, radii
 
 
-def chain_statistics(scene, positions, radii, events: int, chain_length: float | None = None, seed: int = 2) -> dict:
+def chain_statistics(
+    scene: Scene,
+    positions: np.ndarray,
+    radii: np.ndarray,
+    events: int,
+    chain_length: float | None = None,
+    seed: int = 2,
+) -> dict:
     """``Z`` and its error from ``events`` liftings, and the liftings a relative error of ``TARGET``
     would take."""
     run = event_chain(scene, positions, radii, events=events, chain_length=chain_length, seed=seed, progress=False)
@@ -97,7 +104,7 @@ def chain_statistics(scene, positions, radii, events: int, chain_length: float |
     }
 
 
-def md_simulator(scene, positions, radii, seed: int = 3) -> Simulator:
+def md_simulator(scene: Scene, positions: np.ndarray, radii: np.ndarray, seed: int = 3) -> Simulator:
     """The exact engine at the state point, Maxwell velocities at ``kT = 1`` (``K = N kT``), settled."""
     rng = np.random.default_rng(seed)
     velocities = rng.normal(size=(N, 2))
@@ -122,7 +129,7 @@ def md_frames(sim: Simulator, radii: np.ndarray, frames: int) -> tuple[np.ndarra
     return zs, collisions
 
 
-def md_statistics(scene, positions, radii, frames: int) -> dict:
+def md_statistics(scene: Scene, positions: np.ndarray, radii: np.ndarray, frames: int) -> dict:
     """``Z`` and its error over ``frames`` frames, and the collisions a relative error of ``TARGET``
     would take."""
     zs, collisions = md_frames(md_simulator(scene, positions, radii), radii, frames)
@@ -138,7 +145,7 @@ def md_statistics(scene, positions, radii, frames: int) -> dict:
     }
 
 
-def rates(scene, positions, radii, rounds: int = RATE_ROUNDS) -> dict:
+def rates(scene: Scene, positions: np.ndarray, radii: np.ndarray, rounds: int = RATE_ROUNDS) -> dict:
     """Liftings and collisions per CPU second, in alternating rounds (the median of each)."""
     sim = md_simulator(scene, positions, radii)
     chains, md = [], []
