@@ -115,6 +115,7 @@ figures: $(STAMP)
 	$(PY) -m collision_env.bench.engine --markdown docs/bench/engine.md --readme README.md
 	$(PY) -m collision_env.bench.scale --markdown docs/bench/scale.md --readme README.md
 	$(PY) -m collision_env.bench.physics --json docs/bench/physics.json --markdown docs/bench/physics.md --readme README.md --plot docs/img
+	$(PY) -m collision_env.bench.chains --json docs/bench/chains.json --markdown docs/bench/chains.md
 	$(PY) -m collision_env.bench.envs --markdown docs/bench/envs_bench.md --readme README.md
 	$(PY) -m collision_env.bench.compile --markdown docs/bench/compile.md --readme README.md
 	$(PY) scripts/render_presets.py

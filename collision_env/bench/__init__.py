@@ -17,6 +17,8 @@ Every section is a module with a ``main(argv)``, runnable on its own
   through a model of one cache (where the cost per event of a large gas comes from).
 - :mod:`.physics`: a periodic hard-disk fluid against the published equation of state and
   Enskog's collision rate; events per second through the public API.
+- :mod:`.chains`: event-chain Monte Carlo against exact-mode MD on one dense hard-disk state: events
+  per CPU second and the CPU time to an error bar on the pressure.
 - :mod:`.compile`: the CPU seconds numba takes with empty caches: a first step, a first env step,
   every kernel.
 
@@ -39,4 +41,5 @@ SECTIONS: dict[str, tuple[str, str]] = {
     "misses": ("collision_env.bench.misses", "cache lines missed per event of a gas, by array (a cache model)"),
     "compile": ("collision_env.bench.compile", "CPU seconds numba takes with empty caches, per kernel family"),
     "physics": ("collision_env.bench.physics", "a periodic hard-disk fluid against the published equation of state"),
+    "chains": ("collision_env.bench.chains", "event-chain Monte Carlo against MD: CPU time to an error bar"),
 }

@@ -10,6 +10,7 @@ See :class:`Simulator` (one scene) and :class:`BatchSimulator` (many scenes at o
 
 from ._jit import BACKEND
 from .batch import BatchSimulator, Frames
+from .chains import EventChains, EventChainWarning, event_chain
 from .compression import CompressionWarning, Packing, compress
 from .gas import Gas, disk_gas
 from .impacts import Impact, Impacts
@@ -54,6 +55,8 @@ __all__ = [
     "BatchSimulator",
     "CompressionWarning",
     "EventCapWarning",
+    "EventChainWarning",
+    "EventChains",
     "Frames",
     "Gas",
     "Impact",
@@ -65,6 +68,7 @@ __all__ = [
     "UnknownKeywordError",
     "compress",
     "disk_gas",
+    "event_chain",
     "radius_from_mass",
     "warm_up",
 ]

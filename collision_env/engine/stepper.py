@@ -578,8 +578,8 @@ class Stepper:
 
     #: What a copy or a pickle rebuilds rather than carries: work space, and what is bound to it.
     _REBUILT = (
-        "_imp", "_imp_bytes", "_n_imp", "_kernel", "_pack", "_sign", "_fast_dt", "_shared", "live", "pos", "vel", "mass",
-        "inv_mass", "radius", "omega", "spec", "start", "_after_step",
+        "_imp", "_imp_bytes", "_n_imp", "_kernel", "_pack", "_sign", "_fast_dt", "_shared", "live", "pos", "vel",
+        "mass", "inv_mass", "radius", "omega", "spec", "start", "_after_step",
     )  # fmt: skip
 
     def __getstate__(self) -> dict[str, Any]:

@@ -68,18 +68,14 @@ def toi_growing_wall(x, v, r, r_dot, lo, hi):
 
 
 @njit(forceinline=True)
-def bounce_growing_pair(vel, i, j, nx, ny, sigma_dot, mass_i, mass_j):
-    """Bounce disks ``i`` and ``j`` (``vel``: (N, 2)) in contact along the unit normal ``(nx, ny)``
-    from ``i`` to ``j`` about the growth speed ``sigma_dot``. Returns the normal impulse on ``j``
-    (N s, >= 0)."""
-    u = (vel[j, 0] - vel[i, 0]) * nx + (vel[j, 1] - vel[i, 1]) * ny
-    impulse = 2.0 * (sigma_dot - u) * mass_i * mass_j / (mass_i + mass_j)
+def growing_pair_impulse(u, sigma_dot, inv_mass_i, inv_mass_j):
+    """The normal impulse (N s, >= 0) that bounces two disks in contact, closing at normal speed
+    ``-u`` (``u = (v_j - v_i) . n``, ``n`` from ``i`` to ``j``), about the growth speed ``sigma_dot``
+    of their contact distance: ``u' = 2 sigma_dot - u``, so ``J = 2 (sigma_dot - u) / (w_i + w_j)``
+    with ``w`` the inverse masses. Disk ``j`` takes ``+J n``, disk ``i`` ``-J n``."""
+    impulse = 2.0 * (sigma_dot - u) / (inv_mass_i + inv_mass_j)
     if not impulse > 0.0:  # (receding faster than the growth: a round-off contact, no impulse)
         return 0.0
-    vel[i, 0] -= impulse / mass_i * nx
-    vel[i, 1] -= impulse / mass_i * ny
-    vel[j, 0] += impulse / mass_j * nx
-    vel[j, 1] += impulse / mass_j * ny
     return impulse
 
 
