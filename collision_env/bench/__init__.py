@@ -19,6 +19,7 @@ Every section is a module with a ``main(argv)``, runnable on its own
   Enskog's collision rate; events per second through the public API.
 - :mod:`.compile`: the CPU seconds numba takes with empty caches: a first step, a first env step,
   every kernel.
+- :mod:`.backend`: compiled kernels against plain Python (numba missing) on a gas and an env.
 
 What they share:
 
@@ -38,5 +39,6 @@ SECTIONS: dict[str, tuple[str, str]] = {
     "scale": ("collision_env.bench.scale", "exact mode on gases of 10^2 to 10^5 disks: events/s, memory, validity"),
     "misses": ("collision_env.bench.misses", "cache lines missed per event of a gas, by array (a cache model)"),
     "compile": ("collision_env.bench.compile", "CPU seconds numba takes with empty caches, per kernel family"),
+    "backend": ("collision_env.bench.backend", "compiled kernels against plain Python: a 1000-disk gas, an env"),
     "physics": ("collision_env.bench.physics", "a periodic hard-disk fluid against the published equation of state"),
 }

@@ -45,7 +45,8 @@ from typing import Any
 
 import numpy as np
 
-from collision_env.engine import PLAY_AREA_2D, BatchSimulator, Scene, Simulator, warm_up
+from collision_env.engine import PLAY_AREA_2D, BatchSimulator, Scene, Simulator
+from collision_env.precompile import precompile
 
 from .machine import cpus, machine, timestamp, versions
 from .metrics import as_impacts
@@ -442,7 +443,7 @@ def run(
     """Run the benchmark; returns the raw figures as a JSON-ready dict."""
     t0 = time.perf_counter()
     log("warming up the kernels (numba compile or cache load) ...")
-    warm_up()
+    precompile(envs=False)
     results: dict[str, Any] = {}
     if "gas" in parts:
         results["gas"] = []

@@ -39,9 +39,10 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from collision_env.engine import Simulator, compress, disk_gas, warm_up
+from collision_env.engine import Simulator, compress, disk_gas
 from collision_env.engine.compression import DEFAULT_RATE, DEFAULT_UNTIL_PRESSURE
 from collision_env.observables import collision_rate, henderson_z, kolafa_rottner_z, reduced_pressure
+from collision_env.precompile import precompile
 
 from .machine import cpus, machine, timestamp, versions
 from .readme import write_block
@@ -217,7 +218,7 @@ def jamming_summary(rows: Sequence[dict]) -> list[dict]:
 def run(quick: bool, log: Callable[[str], None] = print) -> dict:
     n = QUICK_SIZE if quick else SIZE
     started = time.perf_counter()
-    warm_up()
+    precompile(envs=False)
     log(f"equation of state, N = {n}:")
     eos = equation_of_state(n, log=log)
     log(f"speed, N = {n}:")

@@ -49,9 +49,10 @@ from collections.abc import Callable, Iterable
 
 import numpy as np
 
-from collision_env.engine import BatchSimulator, Scene, Simulator, warm_up
+from collision_env.engine import BatchSimulator, Scene, Simulator
 from collision_env.engine.broadphase import first_overlap
 from collision_env.engine.state import RESUME, START_STEP
+from collision_env.precompile import precompile
 
 from .machine import cpus, machine, timestamp, versions
 from .metrics import enskog_rate
@@ -323,7 +324,7 @@ def _area(scene: Scene) -> float:
 
 def run(quick: bool = False, log: Callable[[str], None] = print) -> dict:
     t0 = time.perf_counter()
-    warm_up()
+    precompile(envs=False)
     first_call_s = time.perf_counter() - t0
     log(f"kernels ready in {first_call_s:.1f} s (compile or cache load, not timed below)")
     rows = bench_sizes(QUICK_SIZES if quick else SIZES, log)
