@@ -7,16 +7,22 @@ what the code or the README already says:
 * ``<!-- extras-table -->`` stands for the table of the optional extras, from pyproject.toml;
 * ``<!-- readme-block NAME -->`` stands for the README's generated block ``NAME`` (between
   ``<!-- NAME:start -->`` and ``<!-- NAME:end -->``), its ``docs/`` links made relative to the page;
-* Sphinx roles in docstrings (``:class:`~a.b.C` ``) are shown as plain code (``C``).
+* Sphinx roles in docstrings (``:class:`~a.b.C` ``) are shown as plain code (``C``);
+* an entry of the API reference without a description (an object with no docstring) is a warning,
+  which fails ``mkdocs build --strict``;
+* the API pages rank first in the site search for API names (a search boost), the generated
+  benchmark tables last.
 """
 
 from __future__ import annotations
 
 import inspect
+import logging
 import os
 import re
 import sys
 import tomllib
+from html.parser import HTMLParser
 from pathlib import Path
 
 from mkdocs.structure.files import File
@@ -31,6 +37,9 @@ ENV_SECTION = "Environments"
 ENV_TABLE = "<!-- env-table -->"
 EXTRAS_TABLE = "<!-- extras-table -->"
 README_BLOCK = re.compile(r"^<!-- readme-block (?P<name>[\w:-]+) -->$", re.M)
+#: Search boost by page: an API name finds its reference entry before the pages that mention it.
+SEARCH_BOOST = {"api/": 4.0, "bench/": 0.5, "agents/": 0.5}
+LOG = logging.getLogger("mkdocs.plugins.collision_env")
 ROLE = re.compile(r":(?:py:)?(?:class|func|meth|mod|attr|data|obj|exc):<code>(?P<tilde>~?)(?P<target>[^<]*)</code>")
 
 
@@ -105,6 +114,52 @@ def readme_block(name: str, page_path: str) -> str:
     return re.sub(r"\]\(docs/([^)]*)\)", lambda m: f"]({relative(m[1], page_path)})", match.group(1))
 
 
+class _Entries(HTMLParser):
+    """The API reference's entries (mkdocstrings' ``div.doc-object``): each one's id and the text of
+    its own description (its ``div.doc-contents``, without the entries nested in it)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.entries: list[dict] = []
+        self._stack: list[tuple[str, dict | None]] = []
+
+    def handle_starttag(self, tag: str, attrs: list) -> None:
+        attributes = dict(attrs)
+        classes = (attributes.get("class") or "").split()
+        if tag == "div":
+            if "doc-object" in classes:
+                entry = {"id": None, "text": ""}
+                self.entries.append(entry)
+                self._stack.append(("object", entry))
+            elif "doc-contents" in classes:
+                owner = next((e for kind, e in reversed(self._stack) if kind == "object"), None)
+                self._stack.append(("contents", owner))
+            else:
+                self._stack.append(("other", None))
+        elif re.fullmatch(r"h[1-6]", tag) and attributes.get("id"):
+            owner = next((e for kind, e in reversed(self._stack) if kind == "object"), None)
+            if owner is not None and owner["id"] is None:
+                owner["id"] = attributes["id"]
+
+    def handle_endtag(self, tag: str) -> None:
+        if tag == "div" and self._stack:
+            self._stack.pop()
+
+    def handle_data(self, data: str) -> None:
+        for kind, entry in reversed(self._stack):
+            if kind == "contents" and entry is not None:
+                entry["text"] += data
+            if kind in ("contents", "object"):
+                return
+
+
+def empty_entries(html: str) -> list[str]:
+    """The ids of the API reference entries in ``html`` that have no description."""
+    parser = _Entries()
+    parser.feed(html)
+    return [str(e["id"]) for e in parser.entries if not e["text"].strip()]
+
+
 # ------------------------------------------------------------------------------------------ hooks
 def on_config(config):
     pages = [{env_id: f"envs/{env_slug(env_id)}.md"} for env_id in collision_env.ENV_IDS]
@@ -122,9 +177,14 @@ def on_files(files, config):
 
 
 def on_page_markdown(markdown, page, config, files):
+    for prefix, boost in SEARCH_BOOST.items():
+        if page.file.src_uri.startswith(prefix):
+            page.meta.setdefault("search", {}).setdefault("boost", boost)
     markdown = markdown.replace(ENV_TABLE, env_table(page.file.src_uri)).replace(EXTRAS_TABLE, extras_table())
     return README_BLOCK.sub(lambda m: readme_block(m["name"], page.file.src_uri), markdown)
 
 
 def on_page_content(html, page, config, files):
+    if page.file.src_uri.startswith("api/") and (empty := empty_entries(html)):
+        LOG.warning(f"{page.file.src_uri}: {len(empty)} API entries without a description: {', '.join(empty)}")
     return ROLE.sub(lambda m: f"<code>{m['target'].rsplit('.', 1)[-1] if m['tilde'] else m['target']}</code>", html)
