@@ -115,27 +115,29 @@ rllib-two-nodes: $(RAY_STAMP)
 	$(RAY_PY) -m agents.train_rllib --address $(HEAD_IP):$(RAY_PORT) --node-ip-address $(HEAD_IP) \
 		--env-runners 2 --run-name rllib-two-nodes --overwrite; status=$$?; $(RAY_VENV)/bin/ray stop; exit $$status
 
-# Re-measure the README's RLlib block (throughput, a training run, the two-node run's placement).
+# Re-measure the agents page's RLlib block (throughput, a training run, the two-node run's placement).
 rllib-report: $(RAY_STAMP)
-	$(RAY_PY) -m agents.rllib_report --readme README.md --cluster runs/rllib-two-nodes
+	$(RAY_PY) -m agents.rllib_report --markdown docs/agents.md --cluster runs/rllib-two-nodes
 
 # A quick look at the engine's speed against its peers (~30 s; writes nothing).
 bench: $(STAMP)
 	$(PY) -m collision_env.bench.engine --quick
 
-# Re-measure every figure of the README and docs/ (a few minutes; the agents study is separate).
+# Re-measure every figure of the README and docs/ (the README holds the study's headline table and the
+# env table; every other page is docs/bench/*.md; the agents study is separate). About half an hour.
 figures: $(STAMP)
 	$(PY) -m collision_env.bench --readme README.md
-	$(PY) -m collision_env.bench.engine --markdown docs/bench/engine.md --readme README.md
-	$(PY) -m collision_env.bench.scale --markdown docs/bench/scale.md --readme README.md
-	$(PY) -m collision_env.bench.physics --json docs/bench/physics.json --markdown docs/bench/physics.md --readme README.md --plot docs/img
-	$(PY) -m collision_env.bench.envs --markdown docs/bench/envs_bench.md --readme README.md
-	$(PY) -m collision_env.bench.compile --markdown docs/bench/compile.md --readme README.md
-	$(PY) scripts/render_presets.py
+	$(PY) -m collision_env.bench.engine --markdown docs/bench/engine.md
+	$(PY) -m collision_env.bench.scale --markdown docs/bench/scale.md
+	$(PY) -m collision_env.bench.physics --json docs/bench/physics.json --markdown docs/bench/physics.md --plot docs/img
+	$(PY) -m collision_env.bench.envs --markdown docs/bench/envs_bench.md
+	$(PY) -m collision_env.bench.compile --markdown docs/bench/compile.md --estimates collision_env/engine/compile_seconds.json
+	$(PY) -m collision_env.bench.backend --markdown docs/bench/backend.md
+	$(PY) scripts/render_presets.py --readme README.md
 
 # Train cheap, evaluate exact: PPO under every engine mode and seed, then every preset (long).
 agents-study: $(STAMP)
-	$(PY) -m agents.study --jobs 2 --readme README.md
+	$(PY) -m agents.study --jobs 2
 
 # The compiled kernels live in a folder named by a hash of their sources, so an edit never runs
 # stale code; this only frees the disk space (numba's own per-file caches included).

@@ -5,8 +5,10 @@ what the code or the README already says:
   entry and its GIF in ``docs/img/`` (added to the nav under "Environments"), and the table of ids
   that ``<!-- env-table -->`` stands for;
 * ``<!-- extras-table -->`` stands for the table of the optional extras, from pyproject.toml;
-* ``<!-- readme-block NAME -->`` stands for the README's generated block ``NAME`` (between
-  ``<!-- NAME:start -->`` and ``<!-- NAME:end -->``), its ``docs/`` links made relative to the page;
+* ``<!-- readme-block NAME -->`` stands for the README's block ``NAME`` (between
+  ``<!-- NAME:start -->`` and ``<!-- NAME:end -->``: the introduction, the install commands, the first
+  example, the modes table), its ``docs/`` links made relative to the page, so that a page shows
+  what the README says without a second copy;
 * Sphinx roles in docstrings (``:class:`~a.b.C` ``) are shown as plain code (``C``);
 * an entry of the API reference without a description (an object with no docstring) is a warning,
   which fails ``mkdocs build --strict``;
@@ -89,6 +91,17 @@ def relative(path: str, page_path: str) -> str:
     return Path(os.path.relpath(Path("docs", path), Path("docs", page_path).parent)).as_posix()
 
 
+def readme_env_table() -> str:
+    """The README's table of ids (its ``envs:table`` block, written by ``scripts/render_presets.py
+    --readme``): each id's task and its GIF."""
+    rows = ["| id | the task | |", "|---|---|---|"]
+    for env_id in collision_env.ENV_IDS:
+        path = gif(env_id)
+        picture = f'<img src="docs/{path}" width="200">' if path else ""
+        rows.append(f"| `{env_id}` | {summary(env_id)} | {picture} |")
+    return "\n".join(rows)
+
+
 def env_table(page_path: str) -> str:
     rows = ["| id | the task | |", "|---|---|---|"]
     for env_id in collision_env.ENV_IDS:
@@ -100,9 +113,18 @@ def env_table(page_path: str) -> str:
 
 
 def extras_table() -> str:
-    extras = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["optional-dependencies"]
-    rows = ["| extra | installs |", "|---|---|"]
-    rows += [f"| `{name}` | {', '.join(f'`{r}`' for r in requirements)} |" for name, requirements in extras.items()]
+    """The optional extras: what each is for (the comment above it in pyproject.toml) and installs."""
+    text = (ROOT / "pyproject.toml").read_text()
+    extras = tomllib.loads(text)["project"]["optional-dependencies"]
+    lines = text.splitlines()
+    rows = ["| extra | what for | installs |", "|---|---|---|"]
+    for name, requirements in extras.items():
+        at = next(i for i, line in enumerate(lines) if line.startswith(f"{name} = ["))
+        comment: list[str] = []
+        while at > 0 and lines[at - 1].startswith("#"):
+            at -= 1
+            comment.insert(0, lines[at].lstrip("# "))
+        rows.append(f"| `{name}` | {' '.join(comment)} | {', '.join(f'`{r}`' for r in requirements)} |")
     return "\n".join(rows)
 
 

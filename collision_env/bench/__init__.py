@@ -27,7 +27,7 @@ What they share:
   :mod:`.engines` adds this engine's modes to it.
 - :mod:`.scenes` (the benchmark cases), :mod:`.metrics` (impact matching, conservation and
   validity checks), :mod:`.timing` (repeated timers), :mod:`.machine` (what a run ran on),
-  :mod:`.readme` (the README's generated blocks).
+  :mod:`.readme` (the generated blocks of the README and the docs pages).
 """
 
 #: section name -> (module, what it measures)

@@ -30,7 +30,6 @@ import time
 from collections.abc import Callable
 
 from .machine import cpus, machine, timestamp, versions
-from .readme import write_block
 
 _STEP = """
 from collision_env.engine import Scene, Simulator
@@ -149,7 +148,6 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeats", type=int, default=1, help="runs per row (the fewest CPU seconds count)")
     parser.add_argument("--json", help="write the raw figures here")
     parser.add_argument("--markdown", help="write the table here")
-    parser.add_argument("--readme", help="rewrite this README's bench:compile block")
     parser.add_argument("--estimates", help="write the precompile row's seconds per kernel here (JSON)")
     args = parser.parse_args(argv)
     results = run(args.repeats)
@@ -161,8 +159,6 @@ def main(argv: list[str] | None = None) -> int:
     if args.markdown:
         with open(args.markdown, "w") as f:
             f.write("# Compile time\n\n" + table)
-    if args.readme:
-        write_block(args.readme, "bench:compile", table)
     if args.estimates:
         with open(args.estimates, "w") as f:
             estimates = {"measured_by": "python -m collision_env.bench.compile", "machine": results["machine"]}
