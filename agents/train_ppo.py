@@ -312,12 +312,16 @@ def _build(
     settings: _Settings,
     seed: int,
     vec_env: str,
+    threads: int,
     monitor_dir: Path | None = None,
     tensorboard_log: str | None = None,
     verbose: int = 0,
 ) -> PPO:
     """PPO on the env's vector env (VecNormalize'd as the entry says), as :func:`tuned_ppo` builds it."""
+    import torch
     from stable_baselines3 import PPO
+
+    torch.set_num_threads(threads)
 
     gamma = float(settings.ppo.get("gamma", 0.99))
     venv = _wrap_normalize(
@@ -350,6 +354,7 @@ def tuned_ppo(
     env_kwargs: dict | None = None,
     hyperparams: str | Path = HYPERPARAMS,
     vec_env: str = "native",
+    threads: int = 1,
     tensorboard_log: str | None = None,
     verbose: int = 0,
 ) -> Tuned:
@@ -360,7 +365,9 @@ def tuned_ppo(
     :func:`agents.config.hyperparams_for` for the fallbacks) gives the number of sub-envs, the env
     keywords (``env_kwargs`` override them), the VecNormalize settings, the policy and every PPO
     keyword; the envs are the native vector env through the SB3 adapter (``vec_env="dummy"`` or
-    ``"subproc"``: SB3's own, over ``gym.make``), sub-env i seeded ``seed + i``, on the CPU.
+    ``"subproc"``: SB3's own, over ``gym.make``), sub-env i seeded ``seed + i``, on the CPU, with
+    ``threads`` torch threads for the process (``torch.set_num_threads``; 1, as the command: the
+    small networks gain nothing from more, and on a busy machine more threads wait on each other).
     Returns the model and the steps to train it for:
 
     >>> model, timesteps = tuned_ppo("CollisionEnv/Billiards-v0", seed=0)  # doctest: +SKIP
@@ -373,7 +380,8 @@ def tuned_ppo(
         raise UsageError(f"vec_env: expected one of {VEC_ENVS}, got {vec_env!r}")
     settings = _settings(env_id, hyperparams, n_envs, timesteps, env_kwargs or {})
     seed = as_int("seed", seed, low=0)
-    model = _build(env_id, settings, seed, vec_env, tensorboard_log=tensorboard_log, verbose=verbose)
+    threads = as_int("threads", threads)
+    model = _build(env_id, settings, seed, vec_env, threads, tensorboard_log=tensorboard_log, verbose=verbose)
     return Tuned(model, settings.timesteps)
 
 
@@ -433,9 +441,6 @@ def train(
         shutil.rmtree(run_dir)  # nothing of an earlier run may survive into this one
     run_dir.mkdir(parents=True, exist_ok=True)
 
-    import torch
-
-    torch.set_num_threads(threads)
     callbacks_cfg = {"eval_freq": eval_freq, "eval_episodes": eval_episodes, "save_freq": save_freq}
     config = {
         "env_id": env_id,
@@ -454,7 +459,7 @@ def train(
     write_yaml(run_dir / CONFIG_FILE, config)
 
     try:
-        model = _build(env_id, settings, seed, vec_env, run_dir, str(run_dir / "tb"), verbose)
+        model = _build(env_id, settings, seed, vec_env, threads, run_dir, str(run_dir / "tb"), verbose)
     except UsageError:
         shutil.rmtree(run_dir)
         raise

@@ -17,7 +17,11 @@ def test_tuned_ppo_builds_what_the_cli_trains(tmp_path):
 
     env_id = "CollisionEnv/Billiards-v0"
     hp = config.hyperparams_for(env_id)
+    import torch
+
+    torch.set_num_threads(2)
     model, timesteps = train_ppo.tuned_ppo(env_id, seed=3)
+    assert torch.get_num_threads() == 1  # as the command trains
     venv = model.get_env()
     assert isinstance(venv, VecNormalize) and venv.num_envs == hp["n_envs"]
     assert isinstance(venv.venv.unwrapped, CollisionSB3VecEnv)
