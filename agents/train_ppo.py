@@ -457,6 +457,15 @@ def train(
         "versions": versions(["gymnasium", "stable_baselines3", "torch"]),
     }
     write_yaml(run_dir / CONFIG_FILE, config)
+    log(
+        f"training PPO on {env_id} (mode={mode}, substeps={substeps}) for {timesteps:,} steps, "
+        f"{n_envs} envs ({vec_env}), seed {seed} -> {run_dir}"
+    )
+    if timesteps != settings.asked:
+        log(
+            f"(PPO updates after whole rollouts of {n_envs} envs x {settings.rollout // n_envs} steps = "
+            f"{settings.rollout:,} env steps: {settings.asked:,} steps asked, rounded up to {timesteps:,})"
+        )
 
     try:
         model = _build(env_id, settings, seed, vec_env, threads, run_dir, str(run_dir / "tb"), verbose)
@@ -479,15 +488,6 @@ def train(
 
     timer = time_split(venv)
     callbacks.append(timer)
-    log(
-        f"training PPO on {env_id} (mode={mode}, substeps={substeps}) for {timesteps:,} steps, "
-        f"{n_envs} envs ({vec_env}), seed {seed} -> {run_dir}"
-    )
-    if timesteps != settings.asked:
-        log(
-            f"(PPO updates after whole rollouts of {n_envs} envs x {settings.rollout // n_envs} steps = "
-            f"{settings.rollout:,} env steps: {settings.asked:,} steps asked, rounded up to {timesteps:,})"
-        )
     start = time.perf_counter()
     log_file = None
     if not progress:  # no bar: progress lines in the log instead (and in train.log)
