@@ -60,6 +60,7 @@ $(OLD_STAMP): pyproject.toml
 
 # Train PPO on the default env and evaluate it (prints where the model, logs and GIF went).
 main: $(STAMP)
+	$(SAY) "training PPO on the default env, then evaluating it beside two baselines (a few minutes)"
 	$(PY) -m agents.main
 
 test: $(STAMP)

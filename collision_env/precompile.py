@@ -25,17 +25,24 @@ from typing import Any
 OPTIONS: tuple[dict[str, Any], ...] = ({}, {"observe": "predicted", "aim": "predicted", "control": "velocity"})
 
 
+#: What the compile notice calls the engine's kernels that Python calls itself (compiled together).
+HELPERS = "the engine's checks, nudges and frames"
+
+
 def plan(envs: bool = True) -> list[str]:
     """What :func:`precompile` compiles, in order, as the compile notice calls each kernel: every
-    engine mode's kernel for each kind of scene, then (``envs``) the environments' kernels."""
+    engine mode's kernel for each kind of scene, the engine's helpers, then (``envs``) the
+    environments' kernels."""
     from collision_env.engine.modes import MODES
 
     kernels: list[Any] = [kernel for spec in MODES.values() for kernel in spec.kernels()]
+    labels = [getattr(kernel, "label", None) for kernel in kernels] + [HELPERS]
     if envs:
         from collision_env.envs.task import episodes, finish, nudge, predict
 
-        kernels += [episodes.build_episodes, finish.task_kernel, nudge.nudge_kernel, predict.predict_kernel]
-    return [label for kernel in kernels if (label := getattr(kernel, "label", None))]
+        kernels = [episodes.build_episodes, finish.task_kernel, nudge.nudge_kernel, predict.predict_kernel]
+        labels += [getattr(kernel, "label", None) for kernel in kernels]
+    return [label for label in labels if label]  # (without numba, kernels have no label)
 
 
 def precompile(envs: bool = True) -> float:
@@ -49,14 +56,34 @@ def precompile(envs: bool = True) -> float:
     :data:`OPTIONS`. Without numba there is nothing to compile: it only runs those steps.
     """
     from collision_env.engine._jit import compile_plan
-    from collision_env.engine.simulator import warm_up
 
     start = time.perf_counter()
     with compile_plan(plan(envs)):
-        warm_up()
+        _compile_engine()
         if envs:
             _step_every_env()
     return time.perf_counter() - start
+
+
+def _compile_engine() -> None:
+    """Every mode's stepping kernel by its signature (none is run), then a tiny scene that reaches
+    the kernels Python calls itself: the start-state checks, a nudge, frames, a backward step."""
+    import numpy as np
+
+    from collision_env.engine import Scene, Simulator
+    from collision_env.engine._jit import compile_for, compile_phase
+    from collision_env.engine.argpack import pack_arrays
+    from collision_env.engine.modes import MODES
+    from collision_env.engine.state import START_STEP
+
+    for spec in MODES.values():
+        for kernel in spec.kernels():
+            compile_for(kernel, pack_arrays([np.zeros(1)]), 1.0, START_STEP)
+    with compile_phase(HELPERS):
+        sim = Simulator(Scene(), [[-0.5, 0.0], [0.5, 0.0]], [[1.0, 0.0], [-1.0, 0.0]], [1.0, 2.0])
+        sim.nudge([[0.1, 0.0], [0.0, 0.0]])
+        sim.frames(0.3, 2)
+        sim.step(-0.3)
 
 
 def _step_every_env() -> None:

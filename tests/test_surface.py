@@ -96,3 +96,35 @@ def test_the_shipped_estimates_cover_the_precompile_plan():
 
     assert set(plan()) <= set(_jit.EXPECTED_SECONDS), "rerun python -m collision_env.bench.compile --estimates"
     assert all(0 < seconds < 120 for seconds in _jit.EXPECTED_SECONDS.values())
+
+
+def test_kernels_without_a_label_are_announced_once_as_their_phase(monkeypatch, capsys):
+    notice = _jit._CompileNotice
+    monkeypatch.setattr(notice, "shown", True)
+    monkeypatch.setattr(notice, "seconds", {})
+    monkeypatch.setattr(notice, "cpu_seconds", {})
+    monkeypatch.setattr(notice, "labels", [])
+    monkeypatch.setattr(_jit, "EXPECTED_SECONDS", {"the helpers": 4.0, "b mode": 6.0})
+    with _jit.compile_plan(["the helpers", "b mode"]):
+        with _jit.compile_phase("the helpers"):
+            notice.miss(None)
+            notice.miss(None)  # (the same phase: no second line)
+            notice.miss("b mode")  # a labelled kernel inside the phase closes the phase's line first
+            notice.done("b mode")
+    lines = capsys.readouterr().err.splitlines()
+    assert [line.split(" ...")[0] for line in lines] == [
+        "collision_env: compiling the helpers (1 of 2 kernels, ~10 s left)",
+        "collision_env: compiling b mode (2 of 2 kernels, ~0 s left)",  # (the helpers took no time here)
+    ]
+    assert set(_jit.compile_seconds()) == {"the helpers", "b mode"} and notice.phase is None
+
+
+def test_a_misspelt_keyword_names_at_most_three_fields_in_one_short_line():
+    import gymnasium as gym
+
+    for typo in ("n_target", "zzz"):
+        with pytest.raises(ValueError) as err:
+            gym.make("CollisionEnv/OneBallTarget-v0", **{typo: 2})
+        message = str(err.value)
+        assert "\n" not in message and len(message) < 300
+        assert message.count("'") <= 2 * 4 + 2  # the typo and at most three suggestions (and gym's kwargs)

@@ -197,6 +197,7 @@ class _CompileNotice:
     shown = False
     labels: list = []  # (label, wall and CPU clocks at its start) of the kernels being compiled, innermost last
     plan: tuple[str, ...] = ()  # the labels compile_plan expects, in order
+    phase: str | None = None  # what compile_phase calls the kernels compiled without a label of their own
     seconds: dict[str, float] = {}  # label -> wall seconds it took to compile in this process
     cpu_seconds: dict[str, float] = {}  # label -> CPU seconds of the same
 
@@ -209,13 +210,13 @@ class _CompileNotice:
 
     @classmethod
     def describe(cls, label: str) -> str:
-        """``exact mode for elastic scenes (3 of 9 kernels, ~40 s left)``, or outside a plan
-        ``exact mode for elastic scenes (about 14 s)``; without an estimate, the label alone."""
+        """``exact mode for elastic scenes (3 of 9 kernels, ~40 s left)`` (the time left of the kernels
+        with an estimate), or outside a plan ``exact mode for elastic scenes (about 14 s)``;
+        without an estimate, the label alone."""
         if label in cls.plan:
             index = cls.plan.index(label)
-            known = all(k in EXPECTED_SECONDS for k in cls.plan[index:])
-            left = cls.speed() * sum(EXPECTED_SECONDS.get(k, 0.0) for k in cls.plan[index:])
-            estimate = f", ~{left:.0f} s left" if known else ""
+            known = [EXPECTED_SECONDS[k] for k in cls.plan[index:] if k in EXPECTED_SECONDS]
+            estimate = f", ~{cls.speed() * sum(known):.0f} s left" if known else ""
             return f"{label} ({index + 1} of {len(cls.plan)} kernels{estimate})"
         if label in EXPECTED_SECONDS:
             return f"{label} (about {cls.speed() * EXPECTED_SECONDS[label]:.0f} s)"
@@ -223,10 +224,16 @@ class _CompileNotice:
 
     @classmethod
     def miss(cls, label: str | None) -> None:
-        """A kernel (with ``label``, or None) is compiled now."""
+        """A kernel (with ``label``, or None) is compiled now. An unlabelled kernel compiled within a
+        :func:`compile_phase`, outside any labelled one, announces the phase (once)."""
         if not cls.shown:
             cls.shown = True
             print(COMPILE_NOTICE, file=sys.stderr, flush=True)
+        phase = cls.phase
+        if phase is not None and label is not None and cls.labels and cls.labels[-1][0] == phase:
+            cls.done(phase)  # (a labelled kernel inside the phase gets a line of its own)
+        if phase is not None and label is None and not cls.labels and phase not in cls.seconds:
+            label = phase
         if label is not None:
             print(f"collision_env: compiling {cls.describe(label)} ...", end="", file=sys.stderr, flush=True)
             cls.labels.append((label, time.perf_counter(), time.process_time()))
@@ -252,6 +259,18 @@ def compile_plan(labels: Sequence[str]) -> Iterator[None]:
         yield
     finally:
         _CompileNotice.plan = before
+
+
+@contextlib.contextmanager
+def compile_phase(label: str) -> Iterator[None]:
+    """Within the block, kernels compiled without a label of their own (helpers that Python calls
+    directly) are announced together as ``label``, on one line with their time."""
+    _CompileNotice.phase = label
+    try:
+        yield
+    finally:
+        _CompileNotice.phase = None
+        _CompileNotice.done(label)
 
 
 def compile_seconds() -> dict[str, float]:
