@@ -26,6 +26,7 @@ import os
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 
 from .machine import cpus, machine, timestamp, versions
 
@@ -76,7 +77,7 @@ def measure(python: bool, seconds: float) -> dict:
     return json.loads(done.stdout)
 
 
-def run(seconds: float = 5.0, rounds: int = 2, log=print) -> dict:
+def run(seconds: float = 5.0, rounds: int = 2, log: Callable[[str], None] = print) -> dict:
     """Both backends, alternating, ``rounds`` times; the best figure of each."""
     started = time.perf_counter()
     best: dict[str, dict] = {}
