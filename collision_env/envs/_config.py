@@ -23,6 +23,7 @@ import numpy as np
 from collision_env.engine import MAX_SUBSTEPS, MODES
 from collision_env.engine.keywords import check_keywords
 from collision_env.engine.scene import PLAY_AREA_1D, PLAY_AREA_2D, WALL_NAMES, radius_from_mass
+from collision_env.engine.validation import MAX_EVENT_CAP
 from collision_env.envs.task.layout import BALL_OBS, GLOBAL_OBS, PREDICTED_OBS, TARGET_OBS
 
 OBSERVATIONS = ("plain", "predicted")
@@ -55,6 +56,10 @@ def _pair(name, value, *, low=None, allow_equal=True):
     if low is not None and lo < low:
         raise ValueError(f"{name}: values must be >= {low}, got {value!r}")
     return (lo, hi)
+
+
+#: The most control steps an episode may have: its step counter is exact in float64 and int64 alike.
+MAX_EPISODE_STEPS = 2**53
 
 
 def _number(name, value, *, low=None, high=None, strict_low=False, integer=False):
@@ -298,8 +303,14 @@ class TaskConfig:
         if self.mode not in MODES:
             raise ValueError(f"mode: expected one of {tuple(MODES)}, got {self.mode!r}")
         s("substeps", _number("substeps", self.substeps, low=1, high=MAX_SUBSTEPS, integer=True))
-        s("max_events", _number("max_events", self.max_events, low=1, integer=True))
-        s("n_steps", max(1, int(round(self.time_limit / self.dt))))
+        s("max_events", _number("max_events", self.max_events, low=1, high=MAX_EVENT_CAP, integer=True))
+        steps = self.time_limit / self.dt
+        if not steps <= MAX_EPISODE_STEPS:
+            raise ValueError(
+                f"time_limit: {self.time_limit:g} s in control steps of dt = {self.dt:g} s is {steps:.3g} steps, "
+                f"more than an episode counts exactly (2**53); take a shorter time_limit or a longer dt"
+            )
+        s("n_steps", max(1, int(round(steps))))
         # geometric feasibility: every ball must fit, and the balls must be placeable
         extremes = np.array([*self.mass_range, *others])
         r_big = float(self.radius_of(extremes).max())

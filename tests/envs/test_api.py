@@ -309,3 +309,17 @@ def test_engine_models_only_what_each_preset_needs():
             env.step(env.action_space.sample())
         if not pairs:
             assert env.simulator.stats["pair_tests"] == 0, env_id
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        (dict(dt=1e-300), r"time_limit: 10 s in control steps of dt = 1e-300 s is 1e\+301 steps"),
+        (dict(time_limit=1e300), r"time_limit: 1e\+300 s in control steps of dt = 0.05 s"),
+        (dict(max_events=10**20), r"max_events: must be <= 9223372036854775807"),
+    ],
+)
+def test_episode_lengths_and_event_caps_beyond_what_is_counted_exactly_are_refused_by_name(kwargs, message):
+    # (these raised OverflowError, naming no field, when the step counter or the cap was stored)
+    with pytest.raises(ValueError, match=message):
+        gym.make("CollisionEnv/OneBallTarget-v0", **kwargs)
