@@ -20,32 +20,47 @@ RAY_PORT ?= 6390
 
 .PHONY: main test lint docs wheel-check test-compat test-rllib rllib-two-nodes rllib-report bench figures agents-study clean-cache
 
+# Each set-up step says what it does before it starts (pip itself runs quietly).
+SAY := @echo "==>"
+
 $(STAMP): pyproject.toml
+	$(SAY) "setting up $(VENV), once: a virtual environment with the package and every extra but the distributed one"
 	$(PYTHON) -m venv $(VENV)
+	$(SAY) "upgrading pip in $(VENV)"
 	$(PY) -m pip install --quiet --upgrade pip
+	$(SAY) "installing torch's CPU build ($(TORCH), about 200 MB to download; a minute or two)"
 	$(PY) -m pip install --quiet $(TORCH)
+	$(SAY) "installing collision_env and its extras (pip install -e \".[all]\": numba, stable-baselines3, pygame, mkdocs, ...; about a minute)"
 	$(PY) -m pip install --quiet -e ".[all]"
-	# compile the kernels once now, not in the first run (nor in every test worker at once)
+	$(SAY) "compiling the engine's kernels once now, not at the first run (about a minute; one line per kernel)"
 	$(PY) -m collision_env.precompile
 	touch $(STAMP)
 
 $(RAY_STAMP): pyproject.toml
+	$(SAY) "setting up $(RAY_VENV), once: Ray with RLlib, which pins its own gymnasium"
 	$(PYTHON) -m venv $(RAY_VENV)
 	$(RAY_PY) -m pip install --quiet --upgrade pip
+	$(SAY) "installing torch's CPU build ($(TORCH)) in $(RAY_VENV)"
 	$(RAY_PY) -m pip install --quiet $(TORCH)
-	$(RAY_PY) -m pip install --quiet -e ".[fast,render,test,distributed]"
+	$(SAY) "installing collision_env with Ray RLlib in $(RAY_VENV) (a few minutes)"
+	$(RAY_PY) -m pip install --quiet -e ".[render,test,distributed]"
+	$(SAY) "compiling the engine's kernels for $(RAY_VENV)"
 	$(RAY_PY) -m collision_env.precompile
 	touch $(RAY_STAMP)
 
 $(OLD_STAMP): pyproject.toml
+	$(SAY) "setting up $(OLD_VENV), once: the oldest gymnasium the package allows ($(OLDEST_GYMNASIUM))"
 	$(PYTHON) -m venv $(OLD_VENV)
 	$(OLD_PY) -m pip install --quiet --upgrade pip
-	$(OLD_PY) -m pip install --quiet -e ".[fast,render,test]" "$(OLDEST_GYMNASIUM)"
+	$(SAY) "installing collision_env with $(OLDEST_GYMNASIUM) in $(OLD_VENV)"
+	$(OLD_PY) -m pip install --quiet -e ".[render,test]" "$(OLDEST_GYMNASIUM)"
+	$(SAY) "compiling the engine's kernels for $(OLD_VENV)"
 	$(OLD_PY) -m collision_env.precompile
 	touch $(OLD_STAMP)
 
 # Train PPO on the default env and evaluate it (prints where the model, logs and GIF went).
 main: $(STAMP)
+	$(SAY) "training PPO on the default env, then evaluating it beside two baselines (a few minutes)"
 	$(PY) -m agents.main
 
 test: $(STAMP)
@@ -65,7 +80,7 @@ docs: $(STAMP)
 	NO_MKDOCS_2_WARNING=1 $(PY) -m mkdocs build --strict
 
 # The package as an index would get it: build the sdist and the wheel, check their metadata
-# (twine), then install the wheel with [fast] in a clean venv, outside the checkout, and make, reset
+# (twine), then install the wheel (numba comes with it) in a clean venv, outside the checkout, and make, reset
 # and step the default env there (the first step compiles the kernels, once).
 WHEEL_DIST ?= build/dist
 WHEEL_VENV ?= build/wheel-venv
@@ -74,7 +89,7 @@ wheel-check: $(STAMP)
 	$(PY) -m build --quiet --outdir $(WHEEL_DIST) .
 	$(PY) -m twine check --strict $(WHEEL_DIST)/*
 	$(PYTHON) -m venv $(WHEEL_VENV)
-	$(WHEEL_VENV)/bin/python -m pip install --quiet "$$(ls $(WHEEL_DIST)/*.whl)[fast]"
+	$(WHEEL_VENV)/bin/python -m pip install --quiet "$$(ls $(WHEEL_DIST)/*.whl)"
 	cd $(WHEEL_VENV) && bin/python $(CURDIR)/scripts/wheel_smoke.py
 
 # The env API under the oldest allowed gymnasium and under Ray's (1.2.2), with the RLlib smoke test and
@@ -103,31 +118,34 @@ rllib-two-nodes: $(RAY_STAMP)
 	$(RAY_PY) -m agents.train_rllib --address $(HEAD_IP):$(RAY_PORT) --node-ip-address $(HEAD_IP) \
 		--env-runners 2 --run-name rllib-two-nodes --overwrite; status=$$?; $(RAY_VENV)/bin/ray stop; exit $$status
 
-# Re-measure the README's RLlib block (throughput, a training run, the two-node run's placement).
+# Re-measure the agents page's RLlib block (throughput, a training run, the two-node run's placement).
 rllib-report: $(RAY_STAMP)
-	$(RAY_PY) -m agents.rllib_report --readme README.md --cluster runs/rllib-two-nodes
+	$(RAY_PY) -m agents.rllib_report --markdown docs/agents.md --cluster runs/rllib-two-nodes
 
 # A quick look at the engine's speed against its peers (~30 s; writes nothing).
 bench: $(STAMP)
 	$(PY) -m collision_env.bench.engine --quick
 
-# Re-measure every figure of the README and docs/ (about an hour, most of it the physics benchmark's
-# literature section on two processes; the agents study is separate).
+# Re-measure every figure of the README and docs/ (the README holds the study's headline table and the
+# env table; every other page is docs/bench/*.md; the agents study is separate). About an hour and a half, an
+# hour of it the physics benchmark's literature section on two processes.
 figures: $(STAMP)
 	$(PY) -m collision_env.bench --readme README.md
-	$(PY) -m collision_env.bench.engine --markdown docs/bench/engine.md --readme README.md
-	$(PY) -m collision_env.bench.scale --markdown docs/bench/scale.md --readme README.md
-	$(PY) -m collision_env.bench.physics --json docs/bench/physics.json --markdown docs/bench/physics.md --readme README.md --plot docs/img
+	$(PY) -m collision_env.bench.engine --markdown docs/bench/engine.md
+	$(PY) -m collision_env.bench.scale --markdown docs/bench/scale.md
+	$(PY) -m collision_env.bench.physics --json docs/bench/physics.json --markdown docs/bench/physics.md --plot docs/img
 	$(PY) -m collision_env.bench.physics --section literature --jobs 2 --json docs/bench/literature.json \
 		--markdown docs/bench/physics.md --plot docs/img
 	$(PY) -m collision_env.bench.chains --json docs/bench/chains.json --markdown docs/bench/chains.md
-	$(PY) -m collision_env.bench.envs --markdown docs/bench/envs_bench.md --readme README.md
-	$(PY) -m collision_env.bench.compile --markdown docs/bench/compile.md --readme README.md
-	$(PY) scripts/render_presets.py
+	$(PY) -m collision_env.bench.peer --json docs/bench/peer.json --markdown docs/bench/peer.md
+	$(PY) -m collision_env.bench.envs --markdown docs/bench/envs_bench.md
+	$(PY) -m collision_env.bench.compile --markdown docs/bench/compile.md --estimates collision_env/engine/compile_seconds.json
+	$(PY) -m collision_env.bench.backend --markdown docs/bench/backend.md
+	$(PY) scripts/render_presets.py --readme README.md
 
 # Train cheap, evaluate exact: PPO under every engine mode and seed, then every preset (long).
 agents-study: $(STAMP)
-	$(PY) -m agents.study --jobs 2 --readme README.md
+	$(PY) -m agents.study --jobs 2
 
 # The compiled kernels live in a folder named by a hash of their sources, so an edit never runs
 # stale code; this only frees the disk space (numba's own per-file caches included).

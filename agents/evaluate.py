@@ -41,6 +41,7 @@ from agents.config import (
     MODEL_FILE,
     VECNORMALIZE_FILE,
     UsageError,
+    add_progress_flags,
     as_int,
     check_env_id,
     episode_steps,
@@ -49,6 +50,7 @@ from agents.config import (
     normalize_settings,
     read_run,
     run_cli,
+    track,
 )
 from agents.train_rllib import ALGORITHM, CHECKPOINT_DIR, quiet_ray_logs
 from collision_env.engine import MODES
@@ -178,15 +180,24 @@ def scripted_baseline(env: gym.Env) -> PolicyFactory | None:
 
 
 # ---------------------------------------------------------------------------------------- play
-def play(env: gym.Env, factory: PolicyFactory, episodes: int, seed: int, frames: list | None = None) -> dict:
+def play(
+    env: gym.Env,
+    factory: PolicyFactory,
+    episodes: int,
+    seed: int,
+    frames: list | None = None,
+    desc: str = "episodes",
+    progress: bool | None = None,
+) -> dict:
     """Play ``episodes`` episodes (episode i from ``reset(seed=seed + i)``); return the summary.
 
     With ``frames`` (a list) the env must render ``rgb_array``; every frame is appended to it.
+    Progress is shown as :func:`agents.config.track` shows it, headed ``desc``.
     """
     cost_per = cast("CollisionTargetEnv", env.unwrapped).config.action_cost
     rows = []
     start = time.perf_counter()
-    for i in range(episodes):
+    for i in track(range(episodes), episodes, desc, progress):
         obs, info = env.reset(seed=seed + i)
         act = factory(env.unwrapped, i)
         if frames is not None:
@@ -243,8 +254,12 @@ def evaluate(
     seed: int = EVAL_SEED,
     baselines: tuple = BASELINES,
     model: str = "final",
+    progress: bool | None = None,
 ) -> dict:
-    """Evaluate the run (and the baselines) on the same episodes; returns the results dict."""
+    """Evaluate the run (and the baselines) on the same episodes; returns the results dict.
+
+    Each policy shows its progress (a bar in a terminal, else a line each 10 %; ``progress``
+    forces the bar on or off)."""
     run = read_any_run(run_dir)
     env_id = check_env_id(run["env_id"])
     episodes = as_int("episodes", episodes)
@@ -270,8 +285,13 @@ def evaluate(
         "seed": seed,
         "policies": {},
     }
+    labels = {"ppo": "PPO", "random": "random", "scripted": "scripted"}
     for name, factory in policies.items():
-        results["policies"][name] = None if factory is None else play(env, factory, episodes, seed)
+        if factory is not None:
+            desc = f"evaluating {labels.get(name, name)}"
+            results["policies"][name] = play(env, factory, episodes, seed, desc=desc, progress=progress)
+        else:
+            results["policies"][name] = None
     env.close()
     return results
 
@@ -295,6 +315,7 @@ def record(
     substeps: int | None = None,
     seed: int = EVAL_SEED,
     model: str = "final",
+    progress: bool | None = None,
 ) -> Path:
     """Record the trained policy's first ``episodes`` evaluation episodes as a GIF or MP4 (by suffix)."""
     import imageio.v2 as imageio
@@ -304,7 +325,7 @@ def record(
     episodes = as_int("record episodes", episodes)
     env = make_env(check_env_id(run["env_id"]), eval_kwargs(run, mode, substeps), render_mode="rgb_array")
     frames: list = []
-    play(env, run_policy(run_dir, run, model), episodes, seed, frames=frames)
+    play(env, run_policy(run_dir, run, model), episodes, seed, frames=frames, desc="recording", progress=progress)
     fps = env.unwrapped.metadata["render_fps"]
     env.close()
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -392,6 +413,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--gif", nargs="?", const="", metavar="PATH", help="record a GIF (default: <run>/episodes.gif)")
     p.add_argument("--video", metavar="PATH.mp4|PATH.gif", help="record a video (MP4 needs imageio-ffmpeg)")
     p.add_argument("--record-episodes", type=int, default=1, help="episodes to record (default 1)")
+    add_progress_flags(p)
     return p
 
 
@@ -413,6 +435,7 @@ def main(argv: list[str] | None = None) -> dict:
         seed=args.seed,
         baselines=() if args.no_baselines else BASELINES,
         model=args.model,
+        progress=args.progress,
     )
     print(markdown(results))
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -427,6 +450,7 @@ def main(argv: list[str] | None = None) -> dict:
             substeps=args.substeps,
             seed=args.seed,
             model=args.model,
+            progress=args.progress,
         )
         print(f"video:   {path}")
     return results

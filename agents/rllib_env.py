@@ -29,7 +29,7 @@ class ListFriendlyInfos(VectorWrapper):
 
     RLlib splits a vector env's info dict into one dict per sub-env (Gymnasium's
     ``DictInfoToList``), which needs an array per key; the native env reports every sub-env's
-    impacts in one :class:`~collision_env.envs.Impacts` record array instead.
+    impacts in one :class:`~collision_env.engine.Impacts` record array instead.
     """
 
     @staticmethod

@@ -1,7 +1,7 @@
-"""Measure the RLlib trainer and write the README's RLlib block (every figure there comes from here).
+"""Measure the RLlib trainer and write the agents page's RLlib block (every figure there comes from here).
 
-    python -m agents.rllib_report --readme README.md                         # throughput + a training run
-    python -m agents.rllib_report --readme README.md --cluster runs/<two-node run>
+    python -m agents.rllib_report --markdown docs/agents.md                  # throughput + a training run
+    python -m agents.rllib_report --markdown docs/agents.md --cluster runs/<two-node run>
 
 1. **Throughput**: env steps per second of one RLlib env runner sampling with its policy, with the
    project's native vector env against RLlib's default ``sync`` vectorisation (one ``gym.make``
@@ -144,7 +144,7 @@ def main(argv: list[str] | None = None) -> str:
     )
     p.add_argument("--steps", type=int, default=8192, help="env steps per throughput repeat")
     p.add_argument("--cluster", help="a run folder of train_rllib --address on a multi-node cluster")
-    p.add_argument("--readme", help="write the block into this README (between its agents:rllib markers)")
+    p.add_argument("--markdown", help="write the block into this page (between its agents:rllib markers)")
     args = p.parse_args(argv)
     start = time.perf_counter()
     rates = {}
@@ -159,10 +159,10 @@ def main(argv: list[str] | None = None) -> str:
     cluster = load_yaml(Path(args.cluster) / CONFIG_FILE) if args.cluster else None
     text = block(args.env, rates, run, results, cluster, time.perf_counter() - start)
     print(text)
-    if args.readme:
+    if args.markdown:
         from collision_env.bench.readme import write_block
 
-        write_block(args.readme, BLOCK, text)
+        write_block(args.markdown, BLOCK, text)
     return text
 
 

@@ -1,8 +1,8 @@
 """Train cheap, evaluate exact: what the engine's fidelity mode costs and buys a PPO agent.
 
-    python -m agents.study --jobs 2 --readme README.md   # both parts, 3 seeds each (hours on 2 cores)
+    python -m agents.study --jobs 2                      # both parts, 3 seeds each (hours on 2 cores)
     python -m agents.study --part modes --envs CollisionEnv/Line1D-v0 --modes naive:1 exact:1 --seeds 0
-    python -m agents.study --part presets --presets CollisionEnv/Billiards-v0 --add --readme README.md
+    python -m agents.study --part presets --presets CollisionEnv/Billiards-v0 --add
 
 Part **modes**: each preset of ``--envs`` (default ``Crowd``, the preset where the engine does most of
 a training step's work: a cheaper mode can only save the engine's share of the time) is trained
@@ -23,9 +23,9 @@ and the closing rule says when a cheaper engine mode can pay. ``--add`` adds run
 study's ``study.json`` (a cell run again replaces its figures), so a study can be run in parts.
 
 Writes ``study.json`` (every figure), ``modes.md``, ``presets.md``, ``time_split.md`` and ``modes.png`` into
-``--docs`` (default ``docs/agents``), and with ``--readme`` the tables into the README's
-``agents:study`` block. Training runs go to ``--output`` (default ``runs/study``). With ``--jobs 2``
-two runs train at once (one core each), as every figure in the README was measured.
+``--docs`` (default ``docs/agents``: the site's agents pages), and with ``--readme`` the tables into a
+page's ``agents:study`` block too. Training runs go to ``--output`` (default ``runs/study``). With
+``--jobs 2`` two runs train at once (one core each), as every figure on those pages was measured.
 """
 
 from __future__ import annotations

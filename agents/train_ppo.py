@@ -38,7 +38,7 @@ import shutil
 import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 from agents.config import (
     CONFIG_FILE,
@@ -67,6 +67,7 @@ from collision_env.engine import MODES
 from collision_env.extras import MissingExtra
 
 if TYPE_CHECKING:
+    from stable_baselines3 import PPO
     from stable_baselines3.common.vec_env import VecEnv
 
 DEFAULT_ENV = "CollisionEnv/OneBallTarget-v0"
@@ -253,6 +254,137 @@ def default_run_name(env_id: str, mode: str, substeps: int, seed: int) -> str:
     return f"{run_label(env_id, mode, substeps, seed)}-{time.strftime('%Y%m%d-%H%M%S')}"
 
 
+class Tuned(NamedTuple):
+    """What :func:`tuned_ppo` returns: the model, and the steps its entry trains for."""
+
+    model: PPO
+    """stable-baselines3's ``PPO`` on the env's vector env (``model.get_env()``), ready to ``learn``."""
+    timesteps: int
+    """The entry's ``n_timesteps`` (or the ``timesteps`` asked for), rounded up to whole rollouts:
+    PPO updates after every ``n_envs * n_steps`` env steps, so ``model.learn(timesteps)`` stops
+    exactly there."""
+
+
+class _Settings(NamedTuple):
+    """A hyperparameter entry resolved and checked (see :func:`_settings`)."""
+
+    entry: dict  # the file's entry, as read
+    env_kwargs: dict
+    episode_steps: int
+    n_envs: int
+    asked: int  # the timesteps asked for
+    timesteps: int  # rounded up to whole rollouts
+    rollout: int  # env steps per PPO update (n_envs * n_steps)
+    normalize: dict | None
+    policy: str
+    ppo: dict  # PPO's keywords
+
+
+def _settings(
+    env_id: str, hyperparams: str | Path, n_envs: int | None, timesteps: float | None, env_kwargs: dict
+) -> _Settings:
+    """The entry of ``env_id`` in ``hyperparams``, with the given overrides, every value checked
+    (a UsageError names the first bad one) before anything is built."""
+    check_env_id(env_id)
+    hp = hyperparams_for(env_id, hyperparams)
+    n_envs = as_int("n_envs", n_envs if n_envs is not None else hp.get("n_envs", 8))
+    asked = as_int("timesteps", timesteps if timesteps is not None else hp.get("n_timesteps", 1e6))
+    kwargs = {**check_env_kwargs(hp.get("env_kwargs") or {}), **check_env_kwargs(env_kwargs)}
+    steps = episode_steps(env_id, kwargs)  # validates every env kwarg
+    algo_kwargs = ppo_kwargs(hp)  # validates every PPO keyword
+    rollout = n_envs * as_int("n_steps", algo_kwargs.get("n_steps", 2048))
+    return _Settings(
+        entry=hp,
+        env_kwargs=kwargs,
+        episode_steps=steps,
+        n_envs=n_envs,
+        asked=asked,
+        timesteps=-(-asked // rollout) * rollout,
+        rollout=rollout,
+        normalize=normalize_settings(hp.get("normalize")),
+        policy=hp.get("policy", "MlpPolicy"),
+        ppo=algo_kwargs,
+    )
+
+
+def _build(
+    env_id: str,
+    settings: _Settings,
+    seed: int,
+    vec_env: str,
+    threads: int,
+    monitor_dir: Path | None = None,
+    tensorboard_log: str | None = None,
+    verbose: int = 0,
+) -> PPO:
+    """PPO on the env's vector env (VecNormalize'd as the entry says), as :func:`tuned_ppo` builds it."""
+    import torch
+    from stable_baselines3 import PPO
+
+    torch.set_num_threads(threads)
+
+    gamma = float(settings.ppo.get("gamma", 0.99))
+    venv = _wrap_normalize(
+        make_vec_env(env_id, settings.n_envs, seed, settings.env_kwargs, vec_env, monitor_dir=monitor_dir),
+        settings.normalize,
+        gamma,
+        training=True,
+    )
+    try:
+        return PPO(
+            settings.policy,
+            venv,
+            seed=seed,
+            device="cpu",
+            tensorboard_log=tensorboard_log,
+            verbose=verbose,
+            **settings.ppo,
+        )
+    except (TypeError, ValueError, AssertionError) as err:  # a bad value in the hyperparameter file
+        venv.close()
+        raise UsageError(f"PPO rejected the hyperparameters for {env_id}: {err}") from None
+
+
+def tuned_ppo(
+    env_id: str = DEFAULT_ENV,
+    *,
+    seed: int = 0,
+    n_envs: int | None = None,
+    timesteps: float | None = None,
+    env_kwargs: dict | None = None,
+    hyperparams: str | Path = HYPERPARAMS,
+    vec_env: str = "native",
+    threads: int = 1,
+    tensorboard_log: str | None = None,
+    verbose: int = 0,
+) -> Tuned:
+    """stable-baselines3's PPO with the shipped hyperparameters of ``env_id``, in one call: what
+    ``python -m agents.train_ppo`` trains, without its run folder, callbacks and logs.
+
+    The entry of ``env_id`` in ``hyperparams`` (``agents/hyperparams/ppo.yml``; see
+    :func:`agents.config.hyperparams_for` for the fallbacks) gives the number of sub-envs, the env
+    keywords (``env_kwargs`` override them), the VecNormalize settings, the policy and every PPO
+    keyword; the envs are the native vector env through the SB3 adapter (``vec_env="dummy"`` or
+    ``"subproc"``: SB3's own, over ``gym.make``), sub-env i seeded ``seed + i``, on the CPU, with
+    ``threads`` torch threads for the process (``torch.set_num_threads``; 1, as the command: the
+    small networks gain nothing from more, and on a busy machine more threads wait on each other).
+    Returns the model and the steps to train it for:
+
+    >>> model, timesteps = tuned_ppo("CollisionEnv/Billiards-v0", seed=0)  # doctest: +SKIP
+    >>> model.learn(timesteps)  # doctest: +SKIP
+
+    A bad entry or keyword is a :class:`~agents.config.UsageError` naming it. A model trained with
+    normalised observations needs its ``model.get_vec_normalize_env()`` statistics to act later.
+    """
+    if vec_env not in VEC_ENVS:
+        raise UsageError(f"vec_env: expected one of {VEC_ENVS}, got {vec_env!r}")
+    settings = _settings(env_id, hyperparams, n_envs, timesteps, env_kwargs or {})
+    seed = as_int("seed", seed, low=0)
+    threads = as_int("threads", threads)
+    model = _build(env_id, settings, seed, vec_env, threads, tensorboard_log=tensorboard_log, verbose=verbose)
+    return Tuned(model, settings.timesteps)
+
+
 def train(
     env_id: str = DEFAULT_ENV,
     *,
@@ -280,31 +412,27 @@ def train(
     ``mode``/``substeps`` set the engine's fidelity (they override ``env_kwargs``, which override
     the hyperparameter entry's ``env_kwargs``). ``eval_freq`` / ``save_freq`` are in env steps;
     0 turns the EvalCallback / CheckpointCallback off. Everything is validated before the run
-    folder is made, so a mistake costs no half-written folder.
+    folder is made, so a mistake costs no half-written folder. PPO updates after whole rollouts
+    (``n_envs * n_steps`` env steps), so ``timesteps`` is rounded up to a whole number of them,
+    and the log says so.
     """
     log = log or _print
-    check_env_id(env_id)
     if vec_env not in VEC_ENVS:
         raise UsageError(f"--vec-env: expected one of {VEC_ENVS}, got {vec_env!r}")
-    hp = hyperparams_for(env_id, hyperparams)
-    n_envs = as_int("n_envs", n_envs if n_envs is not None else hp.get("n_envs", 8))
-    timesteps = as_int("timesteps", timesteps if timesteps is not None else hp.get("n_timesteps", 1e6))
+    kwargs = dict(check_env_kwargs(env_kwargs or {}))
+    if mode is not None:
+        kwargs["mode"] = mode
+    if substeps is not None:
+        kwargs["substeps"] = substeps
+    settings = _settings(env_id, hyperparams, n_envs, timesteps, kwargs)
     seed = as_int("seed", seed, low=0)
     eval_freq = as_int("eval_freq", eval_freq, low=0)
     save_freq = as_int("save_freq", save_freq, low=0)
     eval_episodes = as_int("eval_episodes", eval_episodes)
     threads = as_int("threads", threads)
-    kwargs = {**check_env_kwargs(hp.get("env_kwargs") or {}), **check_env_kwargs(env_kwargs or {})}
-    if mode is not None:
-        kwargs["mode"] = mode
-    if substeps is not None:
-        kwargs["substeps"] = substeps
-    steps = episode_steps(env_id, kwargs)  # validates every env kwarg
+    kwargs, n_envs, timesteps, norm = settings.env_kwargs, settings.n_envs, settings.timesteps, settings.normalize
     mode = kwargs.get("mode", "exact")
     substeps = int(kwargs.get("substeps", 1))
-    norm = normalize_settings(hp.get("normalize"))
-    algo_kwargs = ppo_kwargs(hp)  # validates every PPO keyword
-    policy = hp.get("policy", "MlpPolicy")
 
     run_dir = Path(output) / (run_name or default_run_name(env_id, mode, substeps, seed))
     if run_dir.exists() and any(run_dir.iterdir()):
@@ -313,56 +441,53 @@ def train(
         shutil.rmtree(run_dir)  # nothing of an earlier run may survive into this one
     run_dir.mkdir(parents=True, exist_ok=True)
 
-    import torch
-    from stable_baselines3 import PPO
-
-    torch.set_num_threads(threads)
     callbacks_cfg = {"eval_freq": eval_freq, "eval_episodes": eval_episodes, "save_freq": save_freq}
     config = {
         "env_id": env_id,
         "env_kwargs": kwargs,
-        "episode_steps": steps,
+        "episode_steps": settings.episode_steps,
         "seed": seed,
         "n_envs": n_envs,
         "n_timesteps": timesteps,
         "vec_env": vec_env,
         "callbacks": callbacks_cfg,
         "threads": threads,
-        "hyperparams": {**hp, "n_envs": n_envs, "n_timesteps": timesteps, "env_kwargs": dict(kwargs)},
+        "hyperparams": {**settings.entry, "n_envs": n_envs, "n_timesteps": timesteps, "env_kwargs": dict(kwargs)},
         "hyperparams_file": str(hyperparams),
         "versions": versions(["gymnasium", "stable_baselines3", "torch"]),
     }
     write_yaml(run_dir / CONFIG_FILE, config)
-
-    gamma = float(algo_kwargs.get("gamma", 0.99))
-    venv = _wrap_normalize(
-        make_vec_env(env_id, n_envs, seed, kwargs, vec_env, monitor_dir=run_dir), norm, gamma, training=True
+    log(
+        f"training PPO on {env_id} (mode={mode}, substeps={substeps}) for {timesteps:,} steps, "
+        f"{n_envs} envs ({vec_env}), seed {seed} -> {run_dir}"
     )
+    if timesteps != settings.asked:
+        log(
+            f"(PPO updates after whole rollouts of {n_envs} envs x {settings.rollout // n_envs} steps = "
+            f"{settings.rollout:,} env steps: {settings.asked:,} steps asked, rounded up to {timesteps:,})"
+        )
+
+    try:
+        model = _build(env_id, settings, seed, vec_env, threads, run_dir, str(run_dir / "tb"), verbose)
+    except UsageError:
+        shutil.rmtree(run_dir)
+        raise
+    venv = model.get_env()
+    assert venv is not None  # (given to the model above)
     eval_env = None
     if eval_freq:
         eval_seed = seed + EVAL_SEED_OFFSET
+        gamma = float(settings.ppo.get("gamma", 0.99))
         eval_env = _wrap_normalize(
             make_vec_env(env_id, min(eval_episodes, 4), eval_seed, kwargs, vec_env), norm, gamma, training=False
         )
     callbacks = _callbacks(
         run_dir, eval_env, seed + EVAL_SEED_OFFSET, n_envs, eval_freq, eval_episodes, save_freq, norm is not None
     )
-    try:
-        model = PPO(
-            policy, venv, seed=seed, device="cpu", tensorboard_log=str(run_dir / "tb"), verbose=verbose, **algo_kwargs
-        )
-    except (TypeError, ValueError, AssertionError) as err:  # a bad value in the hyperparameter file
-        venv.close()
-        shutil.rmtree(run_dir)
-        raise UsageError(f"PPO rejected the hyperparameters for {env_id}: {err}") from None
     from agents.timing import time_split
 
     timer = time_split(venv)
     callbacks.append(timer)
-    log(
-        f"training PPO on {env_id} (mode={mode}, substeps={substeps}) for {timesteps:,} steps, "
-        f"{n_envs} envs ({vec_env}), seed {seed} -> {run_dir}"
-    )
     start = time.perf_counter()
     log_file = None
     if not progress:  # no bar: progress lines in the log instead (and in train.log)
@@ -380,7 +505,7 @@ def train(
         log_file.close()
     model.save(run_dir / MODEL_FILE)
     if norm is not None:
-        venv.save(str(run_dir / VECNORMALIZE_FILE))
+        venv.save(str(run_dir / VECNORMALIZE_FILE))  # type: ignore[attr-defined]
     config["train_seconds"] = round(seconds, 2)
     config["time_split"] = {k: None if v is None else round(v, 4) for k, v in timer.split(seconds).items()}
     config["timesteps_done"] = int(model.num_timesteps)

@@ -11,6 +11,7 @@ tools that take a bare id, such as SB3's ``make_vec_env``). ``collision_env.ENV_
 each comes from one entry of the task registry (``collision_env.envs.registry``).
 """
 
+#: The package's version.
 __version__ = "0.1.0"
 
 from collision_env.envs import REGISTERED as _REGISTERED  # importing the envs registers them

@@ -1,9 +1,9 @@
 """The optional extras (``pip install "collision_env[render]"``) and the modules each one brings.
 
-The core package needs only numpy and gymnasium. A part that needs more checks for its extra with
-:func:`require`, which raises :class:`MissingExtra`: a ``ModuleNotFoundError`` whose message names
-the extra and the command that installs it, in one line. The command-line entry points print that
-line alone (no traceback) and exit with status 1.
+The core package needs numpy, gymnasium and numba (which compiles the engine's kernels). A part
+that needs more checks for its extra with :func:`require`, which raises :class:`MissingExtra`: a
+``ModuleNotFoundError`` whose message names the extra and the command that installs it, in one
+line. The command-line entry points print that line alone (no traceback) and exit with status 1.
 
 >>> EXTRAS["render"]
 ('pygame',)
@@ -20,7 +20,6 @@ from typing import Any
 
 #: Extra -> the top-level modules it installs (the import names of its requirements in pyproject.toml).
 EXTRAS: dict[str, tuple[str, ...]] = {
-    "fast": ("numba",),
     "train": ("stable_baselines3", "torch", "tqdm", "rich", "tensorboard", "yaml", "imageio"),
     "video": ("imageio_ffmpeg",),
     "render": ("pygame",),
@@ -45,7 +44,9 @@ class MissingExtra(ModuleNotFoundError):
         torch = " (torch's CPU build first on a machine without a GPU: see the README)" if extra in TORCH_EXTRAS else ""
         super().__init__(f"{who} needs the '{extra}' extra ({module} is missing): pip install {target}{torch}")
         self.name = module
+        """The missing module (as ``ModuleNotFoundError.name``)."""
         self.extra = extra
+        """The extra that installs it."""
 
 
 def _missing(module: str) -> bool:

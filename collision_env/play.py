@@ -2,6 +2,10 @@
 
     python -m collision_env.play CollisionEnv/Billiards-v0
     python -m collision_env.play CollisionEnv/Line1D-v0 --seed 3 --trails
+    python -m collision_env.play CollisionEnv/Billiards-v0 --mode naive --dt 0.1 --n-targets 2
+
+Any ``TaskConfig`` field is an option (``--n-targets 2`` sets ``n_targets``), read as a Python
+literal (``--bounds "(-1, -1, 1, 1)"``) or else as a string (``--mode naive``).
 
 The env runs in real time (its control step ``dt`` per frame). You steer one of the controlled
 balls (ringed in white) at a time:
@@ -27,7 +31,11 @@ Needs pygame (the ``render`` extra).
 from __future__ import annotations
 
 import argparse
+import ast
+import dataclasses
 import difflib
+import inspect
+import re
 from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
@@ -55,20 +63,32 @@ class Player:
         from collision_env.envs.scripted import as_env_action, towards
 
         self.pg = pygame
+        """The pygame module (imported when a player is made: the ``render`` extra)."""
         self._as_action, self._towards = as_env_action, towards
         self.env = env
+        """The env played, made with ``render_mode="human"``."""
         self._bare = cast("CollisionTargetEnv", env.unwrapped)  # the task env under the wrappers
         self.cfg = self._bare.config
-        self.held: set[str] = set()  # arrow keys held down
-        self.ball = 0  # index into cfg.controlled of the steered ball
-        self.aim: np.ndarray | None = None  # the velocity the steered ball is being nudged to
+        """The env's ``TaskConfig``."""
+        self.held: set[str] = set()
+        """The arrow keys held down, by pygame key name."""
+        self.ball = 0
+        """Index into ``cfg.controlled`` of the steered ball."""
+        self.aim: np.ndarray | None = None
+        """The velocity the steered ball is being nudged to (after a drag), or ``None``."""
         self._press: np.ndarray | None = None  # world point of a mouse press, until it is released
         self.paused = False
-        self.pending = 0  # single steps asked for while paused
+        """Whether the game is paused."""
+        self.pending = 0
+        """Single steps asked for while paused."""
         self.quit = False
+        """Set by Esc or by closing the window."""
         self.steps = 0
+        """Steps taken in the current episode."""
         self.episode_return = 0.0
+        """The current episode's return so far."""
         self.episodes: list[dict] = []
+        """One summary per finished episode: its ``return``, ``success`` and ``targets`` hit."""
         env.reset(seed=seed)
 
     # ------------------------------------------------------------------------------------ input
@@ -145,11 +165,13 @@ class Player:
         self.pg.display.set_caption(self.caption())
 
     def reset(self) -> None:
+        """Start a new episode (R, or when one ends)."""
         self.env.reset()
         self.episode_return = 0.0
         self.aim = None
 
     def caption(self) -> str:
+        """The window's title: the id, the steered ball, running or paused, the episode's return."""
         ball = self.cfg.controlled[self.ball]
         state = "paused" if self.paused else "running"
         env_id = self.env.spec.id if self.env.spec is not None else "..."
@@ -176,30 +198,84 @@ def play(env_id: str, seed: int | None = None, trails: bool = False, **env_kwarg
     return player
 
 
+def plain(text: str) -> str:
+    """reStructuredText markup as plain text, for the terminal: ````code```` and
+    ``:class:`~a.B``` lose their markup (the role's target keeps its last part with ``~``)."""
+    text = re.sub(r":\w+:`~[\w.]*?(\w+)`", r"\1", text)
+    text = re.sub(r":\w+:`([^`]*)`", r"\1", text)
+    return re.sub(r"``([^`]*)``", r"\1", text)
+
+
+def field_help() -> dict[str, str]:
+    """Each ``TaskConfig`` field's first sentence, from its docstring in the source (plain text)."""
+    from collision_env.envs import TaskConfig
+
+    tree = ast.parse(inspect.cleandoc("\n" + inspect.getsource(TaskConfig)))
+    body = tree.body[0].body  # type: ignore[attr-defined]
+    out = {}
+    for node, after in zip(body, body[1:], strict=False):
+        doc = getattr(getattr(after, "value", None), "value", None)
+        if isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name) and isinstance(doc, str):
+            first = " ".join(inspect.cleandoc(doc).split("\n\n")[0].split())
+            out[node.target.id] = plain(first.split(". ")[0].rstrip("."))
+    return out
+
+
+def env_value(text: str) -> Any:
+    """An option's value: a Python literal (``0.1``, ``(1, 2)``, ``None``, ``True``), else the string."""
+    try:
+        return ast.literal_eval(text)
+    except (ValueError, SyntaxError):
+        return text
+
+
 def build_parser() -> argparse.ArgumentParser:
+    """The command line of ``python -m collision_env.play``: the id, ``--seed``, ``--trails`` and one
+    option per ``TaskConfig`` field."""
+    from collision_env.envs import TaskConfig
+
     p = argparse.ArgumentParser(
         prog="python -m collision_env.play",
-        description=__doc__.split("\n\n")[0],
+        usage="%(prog)s [env_id] [--seed SEED] [--trails] [--FIELD VALUE ...]",
+        description=plain(__doc__.split("\n\n")[0]),
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog=CONTROLS,
     )
     p.add_argument("env_id", nargs="?", default="CollisionEnv/OneBallTarget-v0", help="default: %(default)s")
     p.add_argument("--seed", type=int, help="the first episode's seed (default: random)")
     p.add_argument("--trails", action="store_true", help="draw the balls' trails")
+    fields = p.add_argument_group("env keywords (any TaskConfig field; default: the id's)")
+    helps = field_help()
+    for f in dataclasses.fields(TaskConfig):
+        if f.init:
+            flag = "--" + f.name.replace("_", "-")
+            text = helps.get(f.name, "").replace("%", "%%")  # (argparse formats help with %)
+            fields.add_argument(
+                flag, dest=f.name, type=env_value, metavar="VALUE", help=text, default=argparse.SUPPRESS
+            )
     return p
 
 
 def main(argv: list[str] | None = None) -> Player:
+    """``python -m collision_env.play``: check the id and the env keywords (a mistake is one line),
+    then :func:`play`; returns the final state."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    import gymnasium as gym
+
     import collision_env
 
     if args.env_id not in collision_env.ENV_IDS:
         close = difflib.get_close_matches(args.env_id, collision_env.ENV_IDS, n=1, cutoff=0.4)
         hint = f"; did you mean {close[0]!r}?" if close else ""
         parser.error(f"unknown env id {args.env_id!r}{hint} (registered: {', '.join(collision_env.ENV_IDS)})")
+    env_kwargs = {k: v for k, v in vars(args).items() if k not in ("env_id", "seed", "trails")}  # (those given)
+    try:  # a bad keyword value is one line, before the window opens
+        gym.make(args.env_id, **env_kwargs).close()
+    except (TypeError, ValueError) as err:
+        parser.error(f"{args.env_id}: {err}")
     print(CONTROLS)
-    return play(args.env_id, seed=args.seed, trails=args.trails)
+    return play(args.env_id, seed=args.seed, trails=args.trails, **env_kwargs)
 
 
 if __name__ == "__main__":

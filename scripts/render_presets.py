@@ -1,6 +1,10 @@
 """Render a PNG frame and a short GIF of every preset into docs/img/ (for the README's env table).
 
     python scripts/render_presets.py [--out docs/img] [--seed 0] [--ppm 100] [--fps 10] [--ids ID ...]
+    python scripts/render_presets.py --readme README.md     # also rewrite the README's env table
+
+The README's table (its ``envs:table`` block) gives each id's task, the first line of its env
+module's docstring, beside its GIF (``docs_hooks.readme_env_table``).
 
 Each preset runs one episode under its scripted policy (``collision_env.envs.scripted``, which aims
 with the engine's exact prediction), with trails on. The PNG is the frame just after the first
@@ -22,6 +26,7 @@ import imageio.v3 as iio
 import numpy as np
 
 import collision_env  # noqa: F401
+from collision_env.bench.readme import write_block
 from collision_env.envs import PRESET_IDS, CollisionTargetEnv
 from collision_env.envs.rendering import Renderer
 from collision_env.envs.scripted import scripted_policy
@@ -61,6 +66,7 @@ def main(argv=None) -> None:
     parser.add_argument("--ppm", type=float, default=100.0, help="pixels per metre")
     parser.add_argument("--fps", type=int, default=10, help="GIF frame rate (the episode runs at 20 steps/s)")
     parser.add_argument("--ids", nargs="+", default=list(PRESET_IDS.values()), help="presets (default: all)")
+    parser.add_argument("--readme", metavar="PATH", help="rewrite the env table between PATH's envs:table markers")
     args = parser.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -74,6 +80,10 @@ def main(argv=None) -> None:
             f"{env_id:36s} {len(frames):4d} frames, targets hit {info['targets_hit']}, "
             f"success {info['is_success']} -> {out / name}.png/.gif"
         )
+    if args.readme:
+        from docs_hooks import readme_env_table  # (scripts/ is this script's folder)
+
+        write_block(args.readme, "envs:table", readme_env_table())
 
 
 if __name__ == "__main__":

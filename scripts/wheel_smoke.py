@@ -1,5 +1,6 @@
-"""Run by ``make wheel-check`` in a clean venv holding only the built wheel and its ``[fast]`` extra:
-the wheel installs ``collision_env`` alone, and the default env makes, resets and steps."""
+"""Run by ``make wheel-check`` in a clean venv holding only the built wheel and its dependencies
+(numba among them): the wheel installs ``collision_env`` alone, and the default env makes, resets
+and steps."""
 
 import importlib.util
 import sysconfig

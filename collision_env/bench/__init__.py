@@ -21,6 +21,7 @@ Every section is a module with a ``main(argv)``, runnable on its own
   per CPU second and the CPU time to an error bar on the pressure.
 - :mod:`.compile`: the CPU seconds numba takes with empty caches: a first step, a first env step,
   every kernel.
+- :mod:`.backend`: compiled kernels against plain Python (numba missing) on a gas and an env.
 
 What they share:
 
@@ -28,7 +29,7 @@ What they share:
   :mod:`.engines` adds this engine's modes to it.
 - :mod:`.scenes` (the benchmark cases), :mod:`.metrics` (impact matching, conservation and
   validity checks), :mod:`.timing` (repeated timers), :mod:`.machine` (what a run ran on),
-  :mod:`.readme` (the README's generated blocks).
+  :mod:`.readme` (the generated blocks of the README and the docs pages).
 """
 
 #: section name -> (module, what it measures)
@@ -40,6 +41,7 @@ SECTIONS: dict[str, tuple[str, str]] = {
     "scale": ("collision_env.bench.scale", "exact mode on gases of 10^2 to 10^5 disks: events/s, memory, validity"),
     "misses": ("collision_env.bench.misses", "cache lines missed per event of a gas, by array (a cache model)"),
     "compile": ("collision_env.bench.compile", "CPU seconds numba takes with empty caches, per kernel family"),
+    "backend": ("collision_env.bench.backend", "compiled kernels against plain Python: a 1000-disk gas, an env"),
     "physics": ("collision_env.bench.physics", "a periodic hard-disk fluid against the published equation of state"),
     "chains": ("collision_env.bench.chains", "event-chain Monte Carlo against MD: CPU time to an error bar"),
 }

@@ -1,6 +1,6 @@
 """Compile time: the CPU seconds a user waits for numba, with empty kernel caches.
 
-    python -m collision_env.bench.compile [--repeats 1] [--markdown PATH] [--readme README.md]
+    python -m collision_env.bench.compile [--repeats 1] [--markdown PATH] [--estimates PATH]
 
 Each row is a fresh Python process with a new, empty kernel cache (``NUMBA_CACHE_DIR`` and
 ``XDG_CACHE_HOME`` in a temporary folder): its CPU seconds (user and system, of the whole process:
@@ -11,6 +11,10 @@ then each kernel family compiled alone: every stepping kernel of the engine (one
 of scene, see :mod:`collision_env.engine.modes`) and the environments' kernels. A family's row
 includes what its kernels call that no other row has compiled before, since each starts empty.
 Without numba there is nothing to compile and the rows measure plain Python.
+
+``--estimates collision_env/engine/compile_seconds.json`` also writes the seconds each labelled
+kernel took in the precompile row: the compile notice's guide to the wait
+(``collision_env.engine._jit.EXPECTED_SECONDS``).
 """
 
 from __future__ import annotations
@@ -26,7 +30,6 @@ import time
 from collections.abc import Callable
 
 from .machine import cpus, machine, timestamp, versions
-from .readme import write_block
 
 _STEP = """
 from collision_env.engine import Scene, Simulator
@@ -39,7 +42,13 @@ env = gym.make("CollisionEnv/OneBallTarget-v0")
 env.reset(seed=0)
 env.step(env.action_space.sample())
 """
-_PRECOMPILE = "from collision_env.precompile import precompile\nprecompile()\n"
+_PRECOMPILE = """
+import json
+from collision_env.engine._jit import compile_seconds
+from collision_env.precompile import precompile
+precompile()
+print(json.dumps(compile_seconds()))
+"""
 _KERNEL = """
 import numpy as np
 from collision_env.engine._jit import compile_for
@@ -79,7 +88,7 @@ def rows() -> list[tuple[str, str, float | None]]:
 
 
 def cpu_seconds(code: str) -> tuple[float, float, str]:
-    """Run ``code`` in a fresh interpreter with empty kernel caches: ``(CPU s, wall s, stderr)``."""
+    """Run ``code`` in a fresh interpreter with empty kernel caches: ``(CPU s, wall s, stdout)``."""
     with tempfile.TemporaryDirectory(prefix="collision-env-compile-") as cache:
         env = {**os.environ, "NUMBA_CACHE_DIR": cache, "XDG_CACHE_HOME": cache}
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -90,17 +99,20 @@ def cpu_seconds(code: str) -> tuple[float, float, str]:
     if done.returncode:
         raise RuntimeError(f"compile benchmark: the run failed:\n{done.stderr[-2000:]}")
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    return cpu, wall, done.stderr
+    return cpu, wall, done.stdout
 
 
 def run(repeats: int = 1, log: Callable[[str], None] = print) -> dict:
     """Every row, each the fewest CPU seconds of ``repeats`` runs."""
     started = time.perf_counter()
     results = []
+    kernels: dict[str, float] = {}
     for what, code, goal in rows():
         runs = [cpu_seconds(code) for _ in range(repeats)]
-        cpu, wall, _ = min(runs)
+        cpu, wall, out = min(runs)
         results.append({"what": what, "cpu_s": cpu, "wall_s": wall, "goal_s": goal})
+        if code == _PRECOMPILE:
+            kernels = json.loads(out.strip().splitlines()[-1])
         log(f"  {what}: {cpu:.1f} s CPU ({wall:.1f} s wall)")
     return {
         "machine": machine(),
@@ -110,6 +122,7 @@ def run(repeats: int = 1, log: Callable[[str], None] = print) -> dict:
         "repeats": repeats,
         "seconds": time.perf_counter() - started,
         "rows": results,
+        "kernel_seconds": kernels,
     }
 
 
@@ -135,7 +148,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeats", type=int, default=1, help="runs per row (the fewest CPU seconds count)")
     parser.add_argument("--json", help="write the raw figures here")
     parser.add_argument("--markdown", help="write the table here")
-    parser.add_argument("--readme", help="rewrite this README's bench:compile block")
+    parser.add_argument("--estimates", help="write the precompile row's seconds per kernel here (JSON)")
     args = parser.parse_args(argv)
     results = run(args.repeats)
     table = render_markdown(results)
@@ -146,8 +159,19 @@ def main(argv: list[str] | None = None) -> int:
     if args.markdown:
         with open(args.markdown, "w") as f:
             f.write("# Compile time\n\n" + table)
-    if args.readme:
-        write_block(args.readme, "bench:compile", table)
+    if args.estimates:
+        with open(args.estimates, "w") as f:
+            estimates = {"measured_by": "python -m collision_env.bench.compile", "machine": results["machine"]}
+            json.dump(
+                {
+                    **estimates,
+                    "timestamp": results["timestamp"],
+                    "seconds": {k: round(v, 1) for k, v in results["kernel_seconds"].items()},
+                },
+                f,
+                indent=1,
+            )
+            f.write("\n")
     return 0
 
 

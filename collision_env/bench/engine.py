@@ -45,12 +45,12 @@ from typing import Any
 
 import numpy as np
 
-from collision_env.engine import PLAY_AREA_2D, BatchSimulator, Scene, Simulator, warm_up
+from collision_env.engine import PLAY_AREA_2D, BatchSimulator, Scene, Simulator
+from collision_env.precompile import precompile
 
 from .machine import cpus, machine, timestamp, versions
 from .metrics import as_impacts
 from .peers import make_peer
-from .readme import write_block
 from .scenes import Case
 from .timing import repeat, summary
 
@@ -442,7 +442,7 @@ def run(
     """Run the benchmark; returns the raw figures as a JSON-ready dict."""
     t0 = time.perf_counter()
     log("warming up the kernels (numba compile or cache load) ...")
-    warm_up()
+    precompile(envs=False)
     results: dict[str, Any] = {}
     if "gas" in parts:
         results["gas"] = []
@@ -487,7 +487,6 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="fewer repeats: about 30 s instead of a few minutes")
     parser.add_argument("--json", metavar="PATH", help="write the raw figures to PATH")
     parser.add_argument("--markdown", metavar="PATH", help="write the tables to PATH")
-    parser.add_argument("--readme", metavar="PATH", help="replace the README block between the bench:engine markers")
     parser.add_argument("--render", metavar="JSON", help="do not measure: render the tables of a --json file")
     parser.add_argument(
         "--only", choices=("gas", "per_step", "batch"), action="append", help="run only this part (repeatable)"
@@ -513,10 +512,6 @@ def main(argv: list[str] | None = None) -> int:
     if args.markdown:
         with open(args.markdown, "w") as fh:
             fh.write(text + "\n")
-    if args.readme:
-        # the README has its own section heading: drop ours, nest the tables under it
-        body = text.split("\n", 2)[2].replace("\n### ", "\n#### ")
-        write_block(args.readme, "bench:engine", body)
     return 0
 
 

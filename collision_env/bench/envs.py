@@ -2,8 +2,8 @@
 
     python -m collision_env.bench.envs [--seconds 1.0] [--num-envs 1024] [--modes exact naive posteriori]
 
-Prints two Markdown tables (ratios, not pass/fail tests); ``--readme README.md`` also puts them in the
-README's ``bench:envs`` block:
+Prints two Markdown tables (ratios, not pass/fail tests); ``--markdown`` also writes them to a page
+(``docs/bench/envs_bench.md``):
 
 * single env via ``gym.make`` (all default wrappers, random actions, resets included), in us per
   step and as a multiple of ``CartPole-v1`` via ``gym.make``;
@@ -30,7 +30,6 @@ from collision_env.engine import MODES
 from collision_env.envs import CollisionTargetEnv, CollisionTargetVectorEnv
 
 from .machine import cpus, machine, timestamp, versions
-from .readme import write_block
 from .timing import add_timer, best_rate
 
 REPEATS = 5  # each figure is the best of this many equal slices of --seconds (robust to a busy machine)
@@ -120,7 +119,6 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--modes", nargs="+", default=["exact"], choices=MODES, help="engine modes to time the envs in")
     parser.add_argument("--ids", nargs="+", default=list(collision_env.ENV_IDS), help="env ids")
     parser.add_argument("--markdown", metavar="PATH", help="also write the tables to PATH")
-    parser.add_argument("--readme", metavar="PATH", help="replace the README block between the bench:envs markers")
     args = parser.parse_args(argv)
 
     started = time.perf_counter()
@@ -176,8 +174,6 @@ def main(argv: list[str] | None = None) -> None:
     if args.markdown:
         with open(args.markdown, "w") as fh:
             fh.write(text + "\n")
-    if args.readme:
-        write_block(args.readme, "bench:envs", text)
 
 
 if __name__ == "__main__":

@@ -45,7 +45,6 @@ import tempfile
 from pathlib import Path
 
 from .machine import machine, timestamp, versions
-from .readme import write_block
 
 SIZES = (1_000, 10_000, 100_000, 1_000_000)
 PHIS = (0.3, 0.7)
@@ -250,7 +249,6 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--peer-source", type=Path, default=DEFAULT_PEER_SOURCE)
     parser.add_argument("--json", type=Path, help="write the results as JSON")
     parser.add_argument("--markdown", type=Path, help="write the table as Markdown")
-    parser.add_argument("--readme", type=Path, help="update the README's 'peer' block")
     args = parser.parse_args(argv)
     os.environ.setdefault("PYTHONHASHSEED", "0")
     result = measure(tuple(args.sizes), tuple(args.phis), args.rounds, args.peer_source)
@@ -260,8 +258,6 @@ def main(argv: list[str] | None = None) -> None:
         args.json.write_text(json.dumps(result, indent=2) + "\n")
     if args.markdown:
         args.markdown.write_text("# The exact engine against EDMD\n\n" + table)
-    if args.readme:
-        write_block(args.readme, "peer", table)
 
 
 if __name__ == "__main__":

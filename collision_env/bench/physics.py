@@ -4,7 +4,7 @@ Run it as::
 
     python -m collision_env.bench.physics                 # N = 4096, jamming at N = 1024 and 4096
     python -m collision_env.bench.physics --quick         # N = 1024, fewer jamming runs
-    python -m collision_env.bench.physics --markdown docs/bench/physics.md --readme README.md --plot docs/img
+    python -m collision_env.bench.physics --markdown docs/bench/physics.md --plot docs/img
     python -m collision_env.bench.physics --section literature --jobs 2 --markdown docs/bench/physics.md --plot docs/img
 
 **Against Li et al. (2022)** (``--section literature``, :mod:`~collision_env.bench.literature`): small
@@ -44,13 +44,13 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from collision_env.engine import Simulator, compress, disk_gas, warm_up
+from collision_env.engine import Simulator, compress, disk_gas
 from collision_env.engine.compression import DEFAULT_RATE, DEFAULT_UNTIL_PRESSURE
 from collision_env.observables import collision_rate, henderson_z, kolafa_rottner_z, reduced_pressure
+from collision_env.precompile import precompile
 
 from . import literature
 from .machine import cpus, machine, timestamp, versions
-from .readme import write_block
 
 PACKINGS = (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.65, 0.68)
 SIZE, QUICK_SIZE = 4096, 1024
@@ -223,7 +223,7 @@ def jamming_summary(rows: Sequence[dict]) -> list[dict]:
 def run(quick: bool, log: Callable[[str], None] = print) -> dict:
     n = QUICK_SIZE if quick else SIZE
     started = time.perf_counter()
-    warm_up()
+    precompile(envs=False)
     log(f"equation of state, N = {n}:")
     eos = equation_of_state(n, log=log)
     log(f"speed, N = {n}:")
@@ -365,7 +365,6 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--markdown", help="write the tables into this page's bench:physics (or bench:literature) block"
     )
-    parser.add_argument("--readme", help="rewrite this README's bench:physics block (fluid)")
     parser.add_argument(
         "--plot", help="write physics_eos.png and physics_jamming.png (literature: physics_li2022.png) into this folder"
     )
@@ -381,8 +380,6 @@ def main(argv: list[str] | None = None) -> int:
             json.dump(results, fh, indent=1)
     if args.markdown:  # (its block of the page: the literature section writes another)
         literature.write_page_block(args.markdown, "bench:physics", text)
-    if args.readme:
-        write_block(args.readme, "bench:physics", text)
     if args.plot:
         print(plot(results, args.plot))
         print(plot_jamming(results, args.plot))

@@ -1,4 +1,5 @@
-"""Generated blocks in the README: every figure there is written by a script, between markers.
+"""Generated blocks in the README and the docs pages: every figure there is written by a script,
+between markers.
 
 A block named ``name`` sits between ``<!-- name:start -->`` and ``<!-- name:end -->``; the
 benchmark and study scripts rewrite only what lies between their own markers.

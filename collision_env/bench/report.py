@@ -118,7 +118,15 @@ def _err(r):
 
 
 # --------------------------------------------------------------------------- tables
-def results_markdown(rows: list[dict], missing: dict, env_rows: list[dict] | str | None, quick: bool, meta: str) -> str:
+def results_markdown(
+    rows: list[dict],
+    missing: dict,
+    env_rows: list[dict] | str | None,
+    quick: bool,
+    meta: str,
+    plots: Sequence[str] = (),
+) -> str:
+    """The sweep's page: its tables, with ``plots`` (file names beside the page) after the intro."""
     ok = ok_rows(rows)
     fams = family_order(ok)
     mid_dt = 0.01 if any(r["dt"] == 0.01 for r in ok) else sorted({r["dt"] for r in ok})[0]
@@ -129,6 +137,8 @@ def results_markdown(rows: list[dict], missing: dict, env_rows: list[dict] | str
         "exact mode's reference over a short horizon (≤ 5 collisions per ball for chaotic scenes). Cost is the best "
         "of the timed repeats; compare ratios within one run. Error = final-state position error in radii.",
         "",
+        *(f"![{p}]({p})" for p in plots),
+        *([""] if plots else []),
         f"### At control step dt = {mid_dt:g} s",
         "",
         "| scene | n | engine / mode | µs/step | wall s per sim s | error (radii) | impact time err max (s) "
@@ -682,15 +692,15 @@ def summary_markdown(rows: list[dict], extreme_rows: list[dict], stat_rows: list
     return "\n".join(lines)
 
 
-def readme_block(rows: list[dict], plots: list[str], out_rel: str, quick: bool) -> str:
-    """The short table and the plot links for the README."""
+def readme_block(rows: list[dict], out_rel: str, quick: bool) -> str:
+    """The README's headline table: each engine and mode's cost and error (the plots are on the results page)."""
     ok = ok_rows(rows)
     fams = family_order(ok)
     dt = 0.01
     lines = [
         f"Measured by `python -m collision_env.bench{' --quick' if quick else ''} --readme README.md` "
-        f"(full figures: [{out_rel}/results.md]({out_rel}/results.md), rules: [{out_rel}/summary.md]"
-        f"({out_rel}/summary.md), extremes: [{out_rel}/extremes.md]({out_rel}/extremes.md)).",
+        f"(every figure and the plots: [{out_rel}/results.md]({out_rel}/results.md); which mode when: "
+        f"[{out_rel}/summary.md]({out_rel}/summary.md)).",
         "",
         f"| engine / mode | µs per step, 4 balls | µs per step, 64 balls | median error (radii), dt = {dt:g} s "
         "| worst error (radii), dt = 0.01 s | runs missing impacts |",
@@ -707,5 +717,4 @@ def readme_block(rows: list[dict], plots: list[str], out_rel: str, quick: bool) 
             f"| {_fmt(max((_err(r) for r in at), default=math.nan))} "
             f"| {sum(r['missed'] > 0 for r in allr)} / {len(allr)} |"
         )
-    lines += [""] + [f"![{p}]({out_rel}/{p})" for p in plots] + [""]
     return "\n".join(lines)

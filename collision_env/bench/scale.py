@@ -4,7 +4,7 @@ Run it as::
 
     python -m collision_env.bench.scale                   # N = 1e2, 1e3, 1e4, 1e5 (about a minute)
     python -m collision_env.bench.scale --quick           # N = 1e2, 1e3, 1e4
-    python -m collision_env.bench.scale --markdown docs/bench/scale.md --readme README.md
+    python -m collision_env.bench.scale --markdown docs/bench/scale.md
 
 The gas: elastic disks of radius 0.01 m at area fraction 0.3 in a square box, started on a square
 lattice with Maxwell-Boltzmann velocities (unit mean square speed). For each size it reports
@@ -49,13 +49,13 @@ from collections.abc import Callable, Iterable
 
 import numpy as np
 
-from collision_env.engine import BatchSimulator, Scene, Simulator, warm_up
+from collision_env.engine import BatchSimulator, Scene, Simulator
 from collision_env.engine.broadphase import first_overlap
 from collision_env.engine.state import RESUME, START_STEP
+from collision_env.precompile import precompile
 
 from .machine import cpus, machine, timestamp, versions
 from .metrics import enskog_rate
-from .readme import write_block
 
 SIZES = (100, 1_000, 10_000, 100_000)
 QUICK_SIZES = (100, 1_000, 10_000)
@@ -323,7 +323,7 @@ def _area(scene: Scene) -> float:
 
 def run(quick: bool = False, log: Callable[[str], None] = print) -> dict:
     t0 = time.perf_counter()
-    warm_up()
+    precompile(envs=False)
     first_call_s = time.perf_counter() - t0
     log(f"kernels ready in {first_call_s:.1f} s (compile or cache load, not timed below)")
     rows = bench_sizes(QUICK_SIZES if quick else SIZES, log)
@@ -412,7 +412,6 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="sizes up to 10^4 only")
     parser.add_argument("--json", help="write the raw figures here")
     parser.add_argument("--markdown", help="write the table here")
-    parser.add_argument("--readme", help="rewrite this README's bench:scale block")
     args = parser.parse_args(argv)
     results = run(args.quick)
     text = render_markdown(results)
@@ -423,8 +422,6 @@ def main(argv: list[str] | None = None) -> int:
     if args.markdown:
         with open(args.markdown, "w") as fh:
             fh.write("# Exact mode at scale\n\n" + text + "\n")
-    if args.readme:
-        write_block(args.readme, "bench:scale", text)
     return 0
 
 

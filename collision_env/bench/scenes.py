@@ -315,7 +315,3 @@ SCENES: dict[str, SceneSpec] = {
         ),
     )
 }
-
-
-def scene_names() -> list[str]:
-    return list(SCENES)

@@ -2,7 +2,7 @@
 
     python -m collision_env.bench --quick               # about a minute
     python -m collision_env.bench                       # full: every mode, dt, ball count, scene
-    python -m collision_env.bench --readme README.md    # also refresh the README's study block
+    python -m collision_env.bench --readme README.md    # also refresh the README's headline table
     python -m collision_env.bench --render              # re-make tables, plots and summary from the CSVs
 
 Writes into ``--out`` (default ``docs/bench/``): ``sweep.csv`` and ``results.md`` (the sweep),
@@ -107,8 +107,8 @@ def main(argv: list[str] | None = None) -> int:
         (out / "meta.json").write_text(json.dumps(meta, indent=1))
 
     meta_text = _meta_text(meta)
-    (out / "results.md").write_text(report.results_markdown(rows, missing, env_rows, quick, meta_text))
     plots = report.plot_all(rows, out)
+    (out / "results.md").write_text(report.results_markdown(rows, missing, env_rows, quick, meta_text, plots))
     summary = report.summary_markdown(rows, extreme_rows, stat_rows, quick, meta_text)
     (out / "summary.md").write_text(summary)
     if extreme_rows:
@@ -124,7 +124,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"Wrote {', '.join(sorted(p.name for p in out.iterdir()))} to {out}/")
     if args.readme:
         rel = os.path.relpath(out.resolve(), Path(args.readme).resolve().parent)
-        block = report.readme_block(rows, plots, rel.replace(os.sep, "/"), quick)
+        block = report.readme_block(rows, rel.replace(os.sep, "/"), quick)
         write_block(args.readme, report.README_BLOCK, block)
     exact_fail = [r for r in extreme_rows if r["mode"] == "exact" and r["status"] != "pass"]
     return 1 if exact_fail else 0

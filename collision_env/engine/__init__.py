@@ -6,6 +6,8 @@
 [1.088256]
 
 See :class:`Simulator` (one scene) and :class:`BatchSimulator` (many scenes at once, one engine).
+numba compiles the kernels at their first call and caches them on disk; ``python -m
+collision_env.precompile`` compiles them all ahead (:func:`collision_env.precompile.precompile`).
 """
 
 from ._jit import BACKEND
@@ -16,27 +18,12 @@ from .gas import Gas, disk_gas
 from .impacts import Impact, Impacts
 from .keywords import UnknownKeywordError
 from .layout import IMPACT_DTYPE
-from .modes import MODES as _MODE_REGISTRY
-from .scene import (
-    BALL_DENSITY,
-    CONSTANT_RADIUS,
-    PLAY_AREA_1D,
-    PLAY_AREA_2D,
-    WALL_BOTTOM,
-    WALL_LEFT,
-    WALL_NAMES,
-    WALL_RIGHT,
-    WALL_TOP,
-    Scene,
-    radius_from_mass,
-)
-from .simulator import Simulator, warm_up
+from .modes import MODES
+from .scene import BALL_DENSITY, CONSTANT_RADIUS, PLAY_AREA_1D, PLAY_AREA_2D, WALL_NAMES, Scene, radius_from_mass
+from .simulator import Simulator
 from .snapshot import SimulatorState
 from .stepper import EventCapWarning
 from .validation import MAX_SUBSTEPS
-
-#: The engine's mode names, cheapest first.
-MODES = tuple(_MODE_REGISTRY)
 
 __all__ = [
     "BACKEND",
@@ -47,11 +34,7 @@ __all__ = [
     "MODES",
     "PLAY_AREA_1D",
     "PLAY_AREA_2D",
-    "WALL_BOTTOM",
-    "WALL_LEFT",
     "WALL_NAMES",
-    "WALL_RIGHT",
-    "WALL_TOP",
     "BatchSimulator",
     "CompressionWarning",
     "EventCapWarning",
@@ -70,5 +53,4 @@ __all__ = [
     "disk_gas",
     "event_chain",
     "radius_from_mass",
-    "warm_up",
 ]

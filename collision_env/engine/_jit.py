@@ -1,9 +1,11 @@
-"""Optional just-in-time compilation of the engine kernels.
+"""Just-in-time compilation of the engine kernels.
 
-The kernels are plain Python loops over numpy arrays. With numba installed (the ``fast`` extra)
-they are compiled once and cached on disk; without it they run as ordinary Python, with the same
-results and a much higher cost per event. ``NUMBA_DISABLE_JIT=1`` forces the Python path, which is
-how the tests check that both paths agree.
+The kernels are plain Python loops over numpy arrays. numba (a dependency of the package, on every
+platform it publishes wheels for) compiles them once and caches them on disk; without it they run
+as ordinary Python, with the same results and a cost per event some :data:`PYTHON_SLOWDOWN` times
+higher, and importing the engine issues one :class:`SlowBackendWarning` that says so.
+``NUMBA_DISABLE_JIT=1`` forces the Python path without the warning, which is how the tests check
+that both paths agree.
 
 Every kernel of the package goes through :func:`njit`, which differs from ``numba.njit`` in three
 ways:
@@ -27,10 +29,14 @@ ways:
   that a scene never compiles the paths it cannot take. numba keys a closure's cache entry on its
   cells' pickled values; a cell that holds another kernel would pickle differently in every
   process, so here such a cell is keyed on the kernel's name and its own cells instead.
-* **It says what it compiles.** The first compilation in a process (a fresh install, or edited
-  sources) prints :data:`COMPILE_NOTICE` on stderr; a kernel given a ``label`` (each mode's
-  stepping kernel for a kind of scene, each env kernel) then prints its label, the kernels it
-  compiles along with it as they come, and its time.
+* **It says what it compiles, and how long it will take.** The first compilation in a process (a
+  fresh install, or edited sources) prints :data:`COMPILE_NOTICE` on stderr; a kernel given a
+  ``label`` (each mode's stepping kernel for a kind of scene, each env kernel: words a user knows,
+  such as "exact mode for elastic scenes") then prints one line: its label, the seconds it is
+  expected to take (:data:`EXPECTED_SECONDS`), and when done the seconds it took. Inside
+  :func:`compile_plan` (``python -m collision_env.precompile``), the line also counts the kernels of
+  the plan and estimates the time left: ``compiling exact mode for elastic scenes (3 of 9 kernels,
+  ~40 s left) ... 14.1 s``.
 
 Compile time: numba compiles every kernel once (then cached) and LLVM inlines the small ones where
 they are called. ``inline="always"`` (numba's inlining of its own IR into every call site) is kept
@@ -53,30 +59,73 @@ counting, since every other kernel is compiled with it explicitly.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
+import json
 import os
 import pickle
 import shutil
 import sys
 import time
-from collections.abc import Callable
+import warnings
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     import numpy as np
 
-try:  # numba is an optional accelerator, not a requirement of the core install
+#: How many times slower a collision costs in plain Python than compiled: a 1000-disk gas in frames
+#: of 1/60 s, as ``python -m collision_env.bench.backend`` measures it (``docs/bench/backend.md``).
+PYTHON_SLOWDOWN = 500
+
+
+class SlowBackendWarning(RuntimeWarning):
+    """numba is missing, so the engine runs as plain Python (issued once, when the engine is imported)."""
+
+
+def slow_backend_message() -> str:
+    """What :class:`SlowBackendWarning` says: how much slower, and what to install."""
+    return (
+        "collision_env: numba is not installed, so the engine's kernels run as plain Python: the same "
+        f"results, about {PYTHON_SLOWDOWN} times slower per collision (a 1000-disk gas). "
+        "Install numba to compile them: pip install numba"
+    )
+
+
+try:  # a dependency of the package, where numba has wheels; without it the kernels run as Python
     import numba as _numba
-except ImportError:  # pragma: no cover - numba is installed wherever the suite runs
+except ImportError:
     _numba = None
+    # (line 0: the message alone, without a line of this file's source under it)
+    warnings.warn_explicit(slow_backend_message(), SlowBackendWarning, __file__, 0, module=__name__)
 
 HAVE_NUMBA = _numba is not None and not _numba.config.DISABLE_JIT
 BACKEND = "numba" if HAVE_NUMBA else "python"
+"""``"numba"`` when the kernels are compiled, ``"python"`` when they run as plain Python (numba
+missing, or ``NUMBA_DISABLE_JIT=1``)."""
 
 PACKAGE_DIR = Path(__file__).resolve().parent.parent
 CACHE_PREFIX = "kernels-"
-COMPILE_NOTICE = "collision_env: compiling the engine's kernels with numba (once per install or source edit) ..."
+COMPILE_NOTICE = (
+    "collision_env: numba compiles the engine's kernels once per install or source edit "
+    "(python -m collision_env.precompile compiles them all ahead)"
+)
+#: Where :data:`EXPECTED_SECONDS` is read from: written by ``python -m collision_env.bench.compile
+#: --estimates`` from a run of ``python -m collision_env.precompile`` with empty caches.
+ESTIMATES_FILE = Path(__file__).with_name("compile_seconds.json")
+
+
+def _expected_seconds() -> dict[str, float]:
+    try:
+        return {str(k): float(v) for k, v in json.loads(ESTIMATES_FILE.read_text())["seconds"].items()}
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return {}
+
+
+#: Label of a kernel -> the CPU seconds its compilation took in the run that measured them (a guide
+#: to the wait, scaled by this machine's speed once a kernel is compiled here; see :class:`_CompileNotice`).
+EXPECTED_SECONDS = _expected_seconds()
 
 
 def kernel_sources(package_dir: Path = PACKAGE_DIR) -> list[Path]:
@@ -140,30 +189,95 @@ def remove_stale_caches(root: Path, keep: Path) -> None:
 
 class _CompileNotice:
     """What the compiler is doing, on stderr: :data:`COMPILE_NOTICE` once, at the first kernel that
-    misses the cache; then, for each labelled kernel compiled, its label, the names of the kernels
-    compiled with it as they come, and its time."""
+    misses the cache; then one line per labelled kernel compiled: its label and the expected wait,
+    completed by the seconds it took. Within a :func:`compile_plan`, the line counts the plan's
+    kernels and estimates the time left from :data:`EXPECTED_SECONDS`, scaled by how this machine
+    compared with them on the kernels compiled so far."""
 
     shown = False
-    labels: list = []  # (label, start time) of the labelled kernels being compiled, innermost last
+    labels: list = []  # (label, wall and CPU clocks at its start) of the kernels being compiled, innermost last
+    plan: tuple[str, ...] = ()  # the labels compile_plan expects, in order
+    phase: str | None = None  # what compile_phase calls the kernels compiled without a label of their own
+    seconds: dict[str, float] = {}  # label -> wall seconds it took to compile in this process
+    cpu_seconds: dict[str, float] = {}  # label -> CPU seconds of the same
 
     @classmethod
-    def miss(cls, name: str, label: str | None) -> None:
-        """Kernel ``name`` (with ``label``, or None) is compiled now."""
+    def speed(cls) -> float:
+        """The wall seconds compiling took here over the expected (CPU) seconds, for the kernels
+        compiled so far (1: none yet)."""
+        done = [(s, EXPECTED_SECONDS[k]) for k, s in cls.seconds.items() if EXPECTED_SECONDS.get(k)]
+        return sum(s for s, _ in done) / sum(e for _, e in done) if done else 1.0
+
+    @classmethod
+    def describe(cls, label: str) -> str:
+        """``exact mode for elastic scenes (3 of 9 kernels, ~40 s left)`` (the time left of the kernels
+        with an estimate), or outside a plan ``exact mode for elastic scenes (about 14 s)``;
+        without an estimate, the label alone."""
+        if label in cls.plan:
+            index = cls.plan.index(label)
+            known = [EXPECTED_SECONDS[k] for k in cls.plan[index:] if k in EXPECTED_SECONDS]
+            estimate = f", ~{cls.speed() * sum(known):.0f} s left" if known else ""
+            return f"{label} ({index + 1} of {len(cls.plan)} kernels{estimate})"
+        if label in EXPECTED_SECONDS:
+            return f"{label} (about {cls.speed() * EXPECTED_SECONDS[label]:.0f} s)"
+        return label
+
+    @classmethod
+    def miss(cls, label: str | None) -> None:
+        """A kernel (with ``label``, or None) is compiled now. An unlabelled kernel compiled within a
+        :func:`compile_phase`, outside any labelled one, announces the phase (once)."""
         if not cls.shown:
             cls.shown = True
             print(COMPILE_NOTICE, file=sys.stderr, flush=True)
+        phase = cls.phase
+        if phase is not None and label is not None and cls.labels and cls.labels[-1][0] == phase:
+            cls.done(phase)  # (a labelled kernel inside the phase gets a line of its own)
+        if phase is not None and label is None and not cls.labels and phase not in cls.seconds:
+            label = phase
         if label is not None:
-            print(f"collision_env: compiling {label}:", end="", file=sys.stderr, flush=True)
-            cls.labels.append((label, time.perf_counter()))
-        elif cls.labels:
-            print(f" {name}", end="", file=sys.stderr, flush=True)
+            print(f"collision_env: compiling {cls.describe(label)} ...", end="", file=sys.stderr, flush=True)
+            cls.labels.append((label, time.perf_counter(), time.process_time()))
 
     @classmethod
     def done(cls, label: str) -> None:
         """The labelled kernel whose compilation :meth:`miss` announced is compiled."""
         if cls.labels and cls.labels[-1][0] == label:
-            start = cls.labels.pop()[1]
-            print(f" ... {time.perf_counter() - start:.1f} s", file=sys.stderr, flush=True)
+            _, wall, cpu = cls.labels.pop()
+            seconds = time.perf_counter() - wall
+            cls.seconds[label] = seconds
+            cls.cpu_seconds[label] = time.process_time() - cpu
+            print(f" {seconds:.1f} s", file=sys.stderr, flush=True)
+
+
+@contextlib.contextmanager
+def compile_plan(labels: Sequence[str]) -> Iterator[None]:
+    """Within the block, the kernels of ``labels`` (in the order they will be compiled) are counted
+    in the compile notice, with an estimate of the time left."""
+    before = _CompileNotice.plan
+    _CompileNotice.plan = tuple(labels)
+    try:
+        yield
+    finally:
+        _CompileNotice.plan = before
+
+
+@contextlib.contextmanager
+def compile_phase(label: str) -> Iterator[None]:
+    """Within the block, kernels compiled without a label of their own (helpers that Python calls
+    directly) are announced together as ``label``, on one line with their time."""
+    _CompileNotice.phase = label
+    try:
+        yield
+    finally:
+        _CompileNotice.phase = None
+        _CompileNotice.done(label)
+
+
+def compile_seconds() -> dict[str, float]:
+    """Label -> CPU seconds of every labelled kernel compiled (not loaded from the cache) in this
+    process: what :data:`EXPECTED_SECONDS` is made of (CPU seconds, not wall: a busy machine's wait
+    would mislead another's estimate)."""
+    return dict(_CompileNotice.cpu_seconds)
 
 
 if HAVE_NUMBA:
@@ -241,7 +355,7 @@ if HAVE_NUMBA:
         def load_overload(self, sig, target_context):
             loaded = super().load_overload(sig, target_context)
             if loaded is None:  # a miss: numba compiles this signature now
-                _CompileNotice.miss(self._py_func.__name__, self._label)
+                _CompileNotice.miss(self._label)
             return loaded
 
         def _index_key(self, sig, codegen):
@@ -254,7 +368,7 @@ if HAVE_NUMBA:
     class _KernelDispatcher(CPUDispatcher):
         """A CPU dispatcher compiled for plain (non-literal) argument types, cached by source hash."""
 
-        label: str | None = None  #: what :class:`_CompileNotice` calls it (None: named only inside a labelled one)
+        label: str | None = None  #: what :class:`_CompileNotice` calls it (None: not announced)
 
         def get_call_template(self, args, kws):
             args = tuple(_plain(a) for a in args)

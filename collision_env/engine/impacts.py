@@ -92,6 +92,7 @@ class Impacts(Sequence):
 
     def __init__(self, array: np.ndarray) -> None:
         self.array = array
+        """The records, a structured array of ``IMPACT_DTYPE`` (a view: no copy is made)."""
 
     def __len__(self) -> int:
         return len(self.array)

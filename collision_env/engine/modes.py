@@ -4,13 +4,14 @@ A :class:`Mode` says how to build the mode's stepping kernel for a scene, which 
 takes besides the shared ``state.State`` (and so how a simulator packs them), how its grid is laid
 out, how many impact rows one call may write, and whether its impact times need sorting. The
 simulator looks its mode up here once, when it is built, and never tests a mode's name again; a new
-mode is one entry of :data:`MODES` (and its kernel), and code above the engine takes the names from
-``tuple(MODES)`` (``collision_env.engine.MODES``).
+mode is one entry of :data:`MODES` (and its kernel). The same object is ``collision_env.engine.MODES``,
+where code above the engine takes the names from (``mode in MODES``, ``for name in MODES``).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
+from types import MappingProxyType
 from typing import NamedTuple
 
 import numpy as np
@@ -23,20 +24,32 @@ from .stepped import cells, substep
 
 
 class Mode(NamedTuple):
-    """What a simulator needs of a mode."""
+    """What a simulator needs of a mode: an entry of :data:`MODES`."""
 
     name: str
-    summary: str  #: one line: what the mode does
-    substeps: bool  #: takes sub-steps (its speed knob); exact mode takes only 1
-    kernel: Callable  #: ``kernel(scene, n)``: the compiled stepping kernel for scenes of n balls
-    arrays: Callable  #: ``arrays(scene, n_scenes, n)``: the bundles the kernel takes after the state
-    persistent: bool  #: the first of them persists from step to step (exact mode's calendar)
-    frames_slot: int  #: where a pack holds a frames run's bundle (``state.FramesOut``)
-    grid: dict  #: how ``broadphase.grid_geometry`` lays out its grid
-    impact_rows: Callable  #: ``impact_rows(scene, n, uses_grid)``: rows of the impact buffer
-    sorted_impacts: bool  #: its impacts come in time order within each scene
-    leaves_overlaps: bool  #: its steps may end with balls overlapping (which its ``set_state`` accepts)
-    kernels: Callable  #: ``kernels()``: every kernel it can build (for scenes of any kind but periodic)
+    """The mode's name, its key in :data:`MODES` (``mode=`` of a simulator or an env)."""
+    summary: str
+    """One line: how the mode finds collisions."""
+    substeps: bool
+    """Whether it takes sub-steps (``substeps=k``, its speed knob); exact mode takes only 1."""
+    kernel: Callable
+    """``kernel(scene, n)``: the compiled stepping kernel for scenes of n balls."""
+    arrays: Callable
+    """``arrays(scene, n_scenes, n)``: the bundles the kernel takes after the state."""
+    persistent: bool
+    """Whether the first of those bundles persists from step to step (exact mode's calendar)."""
+    frames_slot: int
+    """Where a pack holds a frames run's bundle (``state.FramesOut``)."""
+    grid: dict
+    """How ``broadphase.grid_geometry`` lays out the mode's grid."""
+    impact_rows: Callable
+    """``impact_rows(scene, n, uses_grid)``: rows of the impact buffer."""
+    sorted_impacts: bool
+    """Whether its impacts come in time order within each scene."""
+    leaves_overlaps: bool
+    """Whether its steps may end with balls overlapping (which its ``set_state`` accepts)."""
+    kernels: Callable
+    """``kernels()``: every kernel it can build (for scenes of any kind but periodic)."""
 
 
 def _exact_kind(scene: Scene, n: int) -> scheduler.Kind:
@@ -78,8 +91,7 @@ def _cheap(name: str, summary: str) -> Mode:
     )
 
 
-#: Every mode by name, cheapest first.
-MODES: dict[str, Mode] = {
+_MODES: dict[str, Mode] = {
     "naive": _cheap("naive", "move, then reflect the overlaps found (no time of impact)"),
     "posteriori": _cheap("posteriori", "move, then reconstruct when each overlap began (PhET's first engine)"),
     "exact": Mode(
@@ -97,3 +109,9 @@ MODES: dict[str, Mode] = {
         kernels=lambda: [scheduler.step_kernel(kind) for kind in scheduler.KINDS],
     ),
 }
+
+MODES: Mapping[str, Mode] = MappingProxyType(_MODES)
+"""The engine's fidelity modes by name, cheapest first: ``"naive"``, ``"posteriori"``, ``"exact"``.
+
+A read-only mapping: iterating it gives the names (``mode in MODES``, ``for mode in MODES``), and
+``MODES[name].summary`` says in one line how that mode finds collisions."""

@@ -72,46 +72,36 @@ def radius_from_mass(mass: ArrayLike) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Scene:
-    """The static description of a scene.
-
-    Parameters
-    ----------
-    bounds:
-        ``(xmin, ymin, xmax, ymax)`` of the reflecting border in metres (of the periodic cell with
-        ``periodic=True``), or ``None`` for no border (balls leave the area and fly on).
-    elasticity:
-        Coefficient of restitution ``e`` in [0, 1], for ball-ball and ball-wall collisions alike.
-    dimension:
-        2, or 1 for motion along x only (y and vy stay 0).
-    inelastic:
-        ``"slip"`` or ``"stick"``. Only meaningful at elasticity 0: with ``"stick"``, colliding
-        balls join a rigid cluster that rotates about its centre of mass, and a ball or cluster
-        that touches a wall stops dead (PhET's Inelastic screen).
-    ball_collisions:
-        ``False`` lets balls pass through each other (no pair work at all).
-    periodic:
-        ``True`` makes ``bounds`` a periodic cell in both axes (x only in 1D) instead of a
-        reflecting border: there are no walls and no wall impacts; a ball that leaves the cell
-        through one side comes back through the opposite one, and two balls meet through the
-        boundary by the minimum-image convention (Allen & Tildesley, *Computer Simulation of
-        Liquids*, 2nd ed., 2017, section 1.6.4): a pair interacts through its nearest periodic
-        images. Positions are reported wrapped into the cell, ``[xmin, xmax) x [ymin, ymax)`` up to
-        round-off; each ball's count of cell lengths crossed is kept (``images``), so that
-        ``positions + images * (xmax - xmin, ymax - ymin)`` are the unwrapped positions
-        (``Simulator.unwrapped_positions``), for diffusion. Every ball's diameter must be less than
-        half the cell's width (and height, in 2D), so that a ball never touches two images of
-        another at once; positions outside the cell are wrapped into it (their images counted).
-        Stick clusters (``inelastic="stick"`` at elasticity 0) are not supported in a periodic
-        cell, and at elasticity below 1 the balls of a touching group collide pairwise, one event
-        after another, rather than as one contact group. Works in every mode.
-    """
+    """The static description of a scene: its border, restitution, dimension and collision model,
+    shared by every ball (and, in a batch, by every scene). Each field is a keyword argument."""
 
     bounds: tuple[float, float, float, float] | None = PLAY_AREA_2D
+    """``(xmin, ymin, xmax, ymax)`` of the reflecting border in metres (of the periodic cell with
+    ``periodic=True``), or ``None`` for no border (balls leave the area and fly on)."""
     elasticity: float = 1.0
+    """Coefficient of restitution ``e`` in [0, 1], for ball-ball and ball-wall collisions alike."""
     dimension: int = 2
+    """2, or 1 for motion along x only (y and vy stay 0)."""
     inelastic: str = "slip"
+    """``"slip"`` or ``"stick"``. Only meaningful at elasticity 0: with ``"stick"``, colliding balls
+    join a rigid cluster that rotates about its centre of mass, and a ball or cluster that touches a
+    wall stops dead (PhET's Inelastic screen)."""
     ball_collisions: bool = True
+    """``False`` lets balls pass through each other (no pair work at all)."""
     periodic: bool = False
+    """``True`` makes ``bounds`` a periodic cell in both axes (x only in 1D) instead of a reflecting
+    border: there are no walls and no wall impacts; a ball that leaves the cell through one side
+    comes back through the opposite one, and two balls meet through the boundary by the
+    minimum-image convention (Allen & Tildesley, *Computer Simulation of Liquids*, 2nd ed., 2017,
+    section 1.6.4): a pair interacts through its nearest periodic images. Positions are reported
+    wrapped into the cell, ``[xmin, xmax) x [ymin, ymax)`` up to round-off; each ball's count of
+    cell lengths crossed is kept (``images``), so that ``positions + images * (xmax - xmin, ymax -
+    ymin)`` are the unwrapped positions (``Simulator.unwrapped_positions``), for diffusion. Every
+    ball's diameter must be less than half the cell's width (and height, in 2D), so that a ball
+    never touches two images of another at once; positions outside the cell are wrapped into it
+    (their images counted). Stick clusters (``inelastic="stick"`` at elasticity 0) are not
+    supported in a periodic cell, and at elasticity below 1 the balls of a touching group collide
+    pairwise, one event after another, rather than as one contact group. Works in every mode."""
 
     def __new__(cls, *args: Any, **kwargs: Any) -> Scene:
         # before the generated __init__, whose TypeError names no close match

@@ -14,15 +14,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._jit import compile_for
-from .argpack import pack_arrays
 from .batch import NO_IMPACTS, BatchSimulator, Frames, frames_of, new_stepper, snapshot
 from .impacts import Impacts
 from .keywords import check_keywords
-from .modes import MODES
 from .scene import Scene
 from .snapshot import SimulatorState
-from .state import START_STEP
 from .stepper import NO_IMPACTS as NO_RECORDS
 from .stepper import Stepper
 from .validation import checked_balls, periodic_slack, real_number, state_record
@@ -222,20 +218,3 @@ class Simulator:
 
 #: The keyword arguments Simulator takes (a misspelled one is named with the closest of them).
 _KEYWORDS = tuple(inspect.signature(Simulator.__init__).parameters)[1:]
-
-
-def warm_up() -> None:
-    """Compile (or load from numba's on-disk cache) every engine kernel, so later steps are timed fairly.
-
-    Numba compiles a kernel at its first call; call this before timing anything. The stepping kernel
-    of every mode and kind of scene is compiled by its signature (none is run); one tiny scene then
-    reaches the kernels that Python calls itself (the start-state checks, nudges, frames). Without
-    numba it only runs that scene.
-    """
-    for spec in MODES.values():
-        for kernel in spec.kernels():
-            compile_for(kernel, pack_arrays([np.zeros(1)]), 1.0, START_STEP)
-    sim = Simulator(Scene(), [[-0.5, 0.0], [0.5, 0.0]], [[1.0, 0.0], [-1.0, 0.0]], [1.0, 2.0])
-    sim.nudge([[0.1, 0.0], [0.0, 0.0]])
-    sim.frames(0.3, 2)
-    sim.step(-0.3)

@@ -8,9 +8,7 @@ task (``collision_env.envs.registry``); importing a file here is what ships it.
 """
 
 # The preset files are imported in the order their ids are listed (registration order), not sorted.
-from collision_env.engine.keywords import UnknownKeywordError  # noqa: I001
-from collision_env.envs._config import PRESETS, TaskConfig, make_config
-from collision_env.engine import Impacts
+from collision_env.envs._config import PRESETS, TaskConfig, make_config  # noqa: I001
 from collision_env.envs._core import EpisodeSampler, sample_episode
 from collision_env.envs.one_ball import OneBallTargetEnv, OneBallTargetVectorEnv
 from collision_env.envs.line_1d import Line1DEnv, Line1DVectorEnv
@@ -42,7 +40,6 @@ __all__ = [
     "CollisionTargetVectorEnv",
     "CrowdEnv",
     "CrowdVectorEnv",
-    "Impacts",
     "InelasticClusterEnv",
     "InelasticClusterVectorEnv",
     "Line1DEnv",
@@ -53,7 +50,6 @@ __all__ = [
     "OneBallTargetVectorEnv",
     "Task",
     "TaskConfig",
-    "UnknownKeywordError",
     "make_config",
     "register_task",
     "EpisodeSampler",

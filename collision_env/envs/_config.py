@@ -78,98 +78,118 @@ def _number(name, value, *, low=None, high=None, strict_low=False, integer=False
 
 @dataclass(frozen=True)
 class TaskConfig:
-    """Everything that defines a task. All fields can be given to ``gym.make`` as keywords.
+    """Everything that defines a task. Every field below can be given to ``gym.make`` as a keyword.
 
-    Scene (passed to :class:`collision_env.engine.Scene`):
-        ``dimension`` (1 or 2), ``bounds`` ((xmin, ymin, xmax, ymax); ``None`` = PhET's play area for
-        the dimension), ``elasticity`` (0..1), ``inelastic`` ("slip" | "stick"), ``ball_collisions``.
-    Balls:
-        ``n_balls``; ``mass_range`` (each ball's mass uniform in it, kg); ``others_mass_range`` (the
-        range of the balls that are not controlled; ``None``: ``mass_range``); ``radius`` ("mass" = PhET's
-        density rule, "constant" = PhET's 0.15 m, or a number in metres); ``layout`` ("random":
-        anywhere without overlap, left-to-right by index in 1D; "rack": controlled balls in the left
-        40 %, the others in the right half); ``speed_range`` / ``others_speed_range`` (initial speed
-        of controlled / other balls, m/s, random direction).
-    Control:
-        ``controlled`` (indices of the nudged balls); ``dt`` (control step, s of simulated time);
-        ``max_dv`` (the velocity change a full nudge component asks for, and the most a velocity
-        step changes an axis, m/s); ``max_speed``
-        (a nudge never pushes a ball above max(max_speed, its current speed)); ``control`` ("nudge":
-        per controlled ball, one action component per axis, each a velocity change of up to
-        ``max_dv``; "velocity": per controlled ball, the velocity to steer it to, each component over
-        ``max_speed``, then an engage flag: while the flag is > 0 the env nudges the ball towards that
-        velocity, by at most ``max_dv`` per axis and step along the straight line to it, and while it is
-        <= 0 the ball coasts; a named velocity longer than ``max_speed`` is scaled back to it. The
-        same ``max_dv`` and cost per m/s of change; the line to the named velocity stays within the
-        speed cap, so the change charged is the change made).
-    Targets:
-        ``n_targets``; ``sequential`` (show and score one target at a time, else all at once);
-        ``target_width`` (m); ``target_walls`` (walls targets may sit on; ``None`` = all walls of
-        the dimension); ``window`` (``None``, or the length in s of each target's time window);
-        ``scorers`` (whose wall impacts count: "any", "controlled", "others", or "cluster" = balls
-        that have stuck to another ball).
-    Reward:
-        ``hit_reward`` per target hit, ``success_bonus`` when all are hit, ``miss_penalty`` per wall
-        impact of a scoring ball that hits no target, ``action_cost`` per m/s of requested nudge,
-        ``shaping`` (weight of the potential-based aiming term, see the docs); ``aim`` (where the aiming
-        term takes each scoring ball's next wall contact from: "straight", flying straight on, a
-        heuristic that ignores other balls; "predicted", the engine's prediction, as for ``observe``).
-    Observation:
-        ``observed_balls`` ("all": a block per ball; "controlled": the controlled balls' blocks only,
-        for scenes of many balls that the agent does not steer); ``observe`` ("plain": balls, targets
-        and the globals; "predicted": also, per observed ball, its next wall impact as the engine
-        predicts it with no further nudge, found by running a copy of the engine ``lookahead`` s
-        ahead at every step: contact point, time, and whether it hits a target);
-        ``predicted_impact`` (which impact of a scoring ball that prediction reports: "next", its
-        next wall impact; "scoring", the first of its wall impacts within the look-ahead that lands
-        on a visible pending target, or its next one when none does. With "scoring", ``aim="predicted"``
-        also takes the nearest of all its impacts within the look-ahead, not only the next).
-    Episode:
-        ``time_limit`` (s of simulated time; the env truncates after round(time_limit / dt) steps).
-    Engine:
-        ``mode`` (one of ``collision_env.engine.MODES``), ``substeps`` (1 to
-        ``collision_env.engine.MAX_SUBSTEPS``), ``max_events`` (event cap per step and scene).
+    The fields come in groups: the scene (passed to :class:`collision_env.engine.Scene`), the
+    balls, the control, the targets, the reward, the observation, the episode and the engine.
+    Construction checks every field and raises a ``ValueError`` naming it.
     """
 
+    # ---- scene
     dimension: int = 2
+    """1 or 2: a 1D scene moves along x only (y and vy stay 0)."""
     bounds: tuple | None = None
+    """The play area ``(xmin, ymin, xmax, ymax)`` in m; ``None``: PhET's play area for the dimension."""
     elasticity: float = 1.0
+    """Coefficient of restitution, 0 to 1, of ball-ball and ball-wall collisions."""
     inelastic: str = "slip"
+    """How balls collide at elasticity 0: ``"slip"``, or ``"stick"`` into one rigid, spinning cluster."""
     ball_collisions: bool = True
+    """Whether balls collide with each other (``False``: they pass through each other)."""
+    # ---- balls
     n_balls: int = 1
+    """Number of balls."""
     mass_range: tuple = (1.0, 1.0)
+    """Each ball's mass is drawn uniformly from this ``(low, high)`` range, kg."""
     others_mass_range: tuple | None = None
+    """The mass range of the balls that are not controlled; ``None``: ``mass_range``."""
     radius: str | float = "mass"
+    """Radii: ``"mass"`` (PhET's rule, a sphere of density 35 kg/m³), ``"constant"`` (PhET's 0.15 m),
+    or a number in m."""
     layout: str = "random"
+    """Where balls start: ``"random"`` (anywhere without overlap; left to right by index in 1D) or
+    ``"rack"`` (controlled balls in the left 40 % of the area, the others in the right half)."""
     speed_range: tuple = (0.3, 0.8)
+    """Initial speed of each controlled ball, drawn from this ``(low, high)`` range (m/s), in a random direction."""
     others_speed_range: tuple = (0.0, 0.0)
+    """Initial speed range of the other balls (m/s), in a random direction."""
+    # ---- control
     controlled: tuple = (0,)
+    """Indices of the balls the agent nudges."""
     control: str = "nudge"
+    """What an action means: ``"nudge"``, velocity changes, or ``"velocity"``, velocities to steer to.
+    ``"nudge"``: per controlled ball, one component per axis, each a velocity change of up to
+    ``max_dv``. ``"velocity"``: per controlled ball, the velocity to steer it to (each component over
+    ``max_speed``), then an engage flag: while the flag is > 0 the env nudges the ball
+    towards that velocity, by at most ``max_dv`` per axis and step along the straight line to it; while
+    it is <= 0 the ball coasts. A named velocity longer than ``max_speed`` is scaled back to it; the
+    change charged (``action_cost``) is the change made."""
     dt: float = 0.05
+    """The control step: seconds of simulated time per ``env.step``."""
     max_dv: float = 0.15
+    """The velocity change a full nudge component asks for, and the most a velocity step changes an axis (m/s)."""
     max_speed: float = 2.0
+    """Speed cap of a nudge: it never pushes a ball above max(``max_speed``, its current speed) (m/s)."""
+    # ---- targets
     n_targets: int = 3
+    """Number of targets per episode."""
     sequential: bool = True
+    """Show and score one target at a time (else all at once)."""
     target_width: float = 0.6
+    """Width of a target along its wall (m)."""
     target_walls: tuple | None = None
+    """The walls targets may sit on (names of ``collision_env.engine.WALL_NAMES``); ``None``: every
+    wall of the dimension."""
     window: float | None = None
+    """``None``, or the length (s) of each target's time window: an impact scores only inside it."""
     scorers: str = "any"
+    """Whose wall impacts count: ``"any"`` ball, the ``"controlled"`` ones, the ``"others"``, or
+    ``"cluster"`` (balls that have stuck to another ball)."""
+    # ---- reward
     hit_reward: float = 1.0
+    """Reward per target hit."""
     success_bonus: float = 1.0
+    """Reward when every target is hit."""
     miss_penalty: float = 0.05
+    """Penalty per wall impact of a scoring ball that hits no target."""
     action_cost: float = 0.02
+    """Penalty per m/s of requested velocity change."""
     shaping: float = 0.0
+    """Weight of the potential-based aiming term (0: off): the reward for bringing a scoring ball's
+    next wall contact nearer the nearest pending target (the env's docstring, "Rewards", gives it)."""
     aim: str = "straight"
+    """Where the aiming term takes each scoring ball's next wall contact from: ``"straight"`` (flying
+    straight on, a heuristic that ignores other balls) or ``"predicted"`` (the engine's prediction,
+    as for ``observe``)."""
+    # ---- observation
     observed_balls: str = "all"
+    """``"all"``: a block per ball in the observation; ``"controlled"``: the controlled balls' blocks
+    only, for scenes of many balls the agent does not steer."""
     observe: str = "plain"
+    """What the observation holds: ``"plain"``, the balls, targets and globals; ``"predicted"``, also,
+    per observed ball, its next wall impact as the engine predicts it with no further nudge (contact
+    point, time, and whether it hits a target), found by running a copy of the engine ``lookahead`` s
+    ahead at every step."""
     lookahead: float = 5.0
+    """How far ahead (s) the prediction of ``observe="predicted"`` and ``aim="predicted"`` runs."""
     predicted_impact: str = "next"
+    """Which impact of a scoring ball the prediction reports: ``"next"``, its next wall impact;
+    ``"scoring"``, the first of its wall impacts within the look-ahead that lands on a visible pending
+    target, or its next one when none does (``aim="predicted"`` then also takes the nearest of all its
+    impacts within the look-ahead)."""
+    # ---- episode
     time_limit: float = 10.0
+    """Episode length in s of simulated time: the env truncates after round(``time_limit`` / ``dt``) steps."""
+    # ---- engine
     mode: str = "exact"
+    """The engine's fidelity mode, one of ``collision_env.engine.MODES``."""
     substeps: int = 1
+    """Sub-steps per control step of the cheap modes, 1 to ``collision_env.engine.MAX_SUBSTEPS``."""
     max_events: int = 10_000
+    """The engine's cap on events per step and scene."""
     # derived (not arguments)
     n_steps: int = field(init=False, default=0)
+    """Control steps per episode, derived: round(``time_limit`` / ``dt``), at least 1."""
 
     def __new__(cls, *args, **kwargs):
         check_keywords(kwargs, field_names())  # before the generated __init__, which names no close match
@@ -276,7 +296,7 @@ class TaskConfig:
             if self.window > self.time_limit:
                 raise ValueError(f"window: {self.window} s is longer than time_limit {self.time_limit} s")
         if self.mode not in MODES:
-            raise ValueError(f"mode: expected one of {MODES}, got {self.mode!r}")
+            raise ValueError(f"mode: expected one of {tuple(MODES)}, got {self.mode!r}")
         s("substeps", _number("substeps", self.substeps, low=1, high=MAX_SUBSTEPS, integer=True))
         s("max_events", _number("max_events", self.max_events, low=1, integer=True))
         s("n_steps", max(1, int(round(self.time_limit / self.dt))))
@@ -305,6 +325,7 @@ class TaskConfig:
 
     @property
     def action_dim(self) -> int:
+        """Length of the action vector: :attr:`per_ball_action` per controlled ball."""
         return len(self.controlled) * self.per_ball_action
 
     @property
@@ -314,10 +335,12 @@ class TaskConfig:
 
     @property
     def target_slots(self) -> int:
+        """Target blocks in the observation: one with ``sequential`` targets, else one per target."""
         return 1 if self.sequential else self.n_targets
 
     @property
     def obs_dim(self) -> int:
+        """Length of the observation vector (the layout is tabled in each env's docstring)."""
         shown = self.n_observed
         plain = shown * BALL_FEATURES + self.target_slots * TARGET_FEATURES + GLOBAL_FEATURES
         return plain + (shown * PREDICTED_FEATURES if self.observe == "predicted" else 0)
@@ -351,6 +374,7 @@ class TaskConfig:
         return mask
 
     def replace(self, **changes: Any) -> TaskConfig:
+        """A copy with ``changes`` (field names as keywords), checked as a new config is."""
         return dataclasses.replace(self, **changes)
 
 

@@ -97,12 +97,16 @@ class EpisodeSampler:
 
     def __init__(self, cfg: TaskConfig) -> None:
         self.cfg = cfg
+        """The task whose start states it draws."""
         n, k = cfg.n_balls, cfg.n_targets
         self.block = block_size(n, k, PLACEMENT_TRIES)
+        """Uniforms per episode (the length of each episode's block)."""
         self.ctrl_mask = np.zeros(n, dtype=bool)
+        """``(n_balls,)`` bool: the controlled balls."""
         self.ctrl_mask[list(cfg.controlled)] = True
         assert cfg.bounds is not None and cfg.target_walls is not None  # (None only as arguments of TaskConfig)
         self.walls = np.array([WALL_NAMES.index(w) for w in cfg.target_walls], dtype=np.int64)
+        """The wall codes targets may sit on."""
         xmin, ymin, xmax, ymax = cfg.bounds
         (speed_low, speed_high), (others_low, others_high) = cfg.speed_range, cfg.others_speed_range
         self.episode_f = packed(
@@ -120,6 +124,7 @@ class EpisodeSampler:
             window=-1.0 if cfg.window is None else cfg.window,
             time_limit=cfg.time_limit,
         )
+        """The episode builder's float parameters (columns named by ``EPISODE_FLOATS``)."""
         self.episode_i = packed(
             EPISODE_INTS,
             np.int64,
@@ -129,6 +134,7 @@ class EpisodeSampler:
             rack=int(cfg.layout == "rack"),
             tries=PLACEMENT_TRIES,
         )
+        """The episode builder's integer parameters (columns named by ``EPISODE_INTS``)."""
 
     def _build(self, uniforms: np.ndarray) -> tuple[Episodes, np.ndarray]:
         cfg = self.cfg
@@ -160,6 +166,7 @@ class EpisodeSampler:
         return Episodes(pos, vel, masses, radii, t_wall, t_geo), ok
 
     def sample(self, rngs: list) -> Episodes:
+        """One episode's start state per generator of ``rngs`` (each draws its own blocks)."""
         uniforms = np.empty((len(rngs), self.block))
         for i, rng in enumerate(rngs):
             uniforms[i] = rng.random(self.block)

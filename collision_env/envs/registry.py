@@ -56,20 +56,19 @@ DEFAULT_HYPERPARAMS = "default"
 
 @dataclass(frozen=True)
 class Task:
-    """One task of the suite (see the module docstring).
-
-    ``env_id``: the Gymnasium id; ``preset``: its name among ``PRESETS``; ``config``: the
-    ``TaskConfig`` fields that differ from the defaults (validated at registration);
-    ``bench_scene``: the engine benchmark scene it matches most closely (shown beside its step
-    rates); ``hyperparams_like``: the id whose hyperparameter entry serves when the file has none
-    for this one (``None``: the file's ``default`` entry).
-    """
+    """One task of the suite (see the module docstring): what an env class carries as ``task``."""
 
     env_id: str
+    """The Gymnasium id."""
     preset: str
+    """Its name among ``PRESETS``."""
     config: Mapping[str, Any]
+    """The ``TaskConfig`` fields that differ from the defaults (checked at registration)."""
     bench_scene: str
+    """The engine benchmark scene it matches most closely (shown beside its step rates)."""
     hyperparams_like: str | None = None
+    """The id whose hyperparameter entry serves when the file has none for this one (``None``: the
+    file's ``default`` entry)."""
 
 
 @dataclass(frozen=True)

@@ -65,11 +65,14 @@ class CollisionSB3VecEnv(VecEnv):
                 "venv: SB3 needs same-step autoreset; create it with autoreset_mode=AutoresetMode.SAME_STEP"
             )
         self.venv = venv
+        """The native vector env underneath (same-step autoreset)."""
         super().__init__(venv.num_envs, venv.single_observation_space, venv.single_action_space)
         self._actions: np.ndarray | None = None
 
     # ------------------------------------------------------------------------------------- #
     def reset(self) -> np.ndarray:
+        """Reset every sub-env (with the seeds and options ``seed`` and ``set_options`` gave): the
+        observations; their infos are in ``reset_infos``."""
         seeds = None if all(s is None for s in self._seeds) else list(self._seeds)
         options = None
         if any(self._options):
@@ -84,9 +87,12 @@ class CollisionSB3VecEnv(VecEnv):
         return obs
 
     def step_async(self, actions: np.ndarray) -> None:
+        """Keep the actions for :meth:`step_wait` (the batched step runs there)."""
         self._actions = actions
 
     def step_wait(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[dict[str, Any]]]:
+        """Step every sub-env: SB3's ``(observations, rewards, dones, infos)``, a finished sub-env's
+        last observation in its info's ``terminal_observation`` and ``TimeLimit.truncated`` set."""
         obs, reward, term, trunc, info = self.venv.step(np.asarray(self._actions, dtype=np.float32))
         dones = term | trunc
         n = self.num_envs
@@ -117,18 +123,22 @@ class CollisionSB3VecEnv(VecEnv):
         return [{k: info[k][i].item() for k in keys} for i in range(len(mask))]
 
     def close(self) -> None:
+        """Close the native vector env."""
         self.venv.close()
 
     # ------------------------------------------------------------------------------------- #
     def get_images(self) -> list[np.ndarray | None]:
+        """One frame per sub-env (the native env's ``render``), or ``None`` each without a render mode."""
         frames = self.venv.render()
         return cast("list[np.ndarray | None]", list(frames)) if frames is not None else [None] * self.num_envs
 
     def get_attr(self, attr_name: str, indices: VecEnvIndices = None) -> list:
+        """The native env's attribute, once per sub-env of ``indices`` (the sub-envs share it)."""
         value = getattr(self.venv, attr_name)
         return [value for _ in self._get_indices(indices)]
 
     def set_attr(self, attr_name: str, value: Any, indices: VecEnvIndices = None) -> None:
+        """Set the native env's attribute (for every sub-env at once: ``indices`` must cover them all)."""
         if indices is not None and len(list(self._get_indices(indices))) != self.num_envs:
             raise ValueError("set_attr: the batched env shares its attributes; set them for all sub-envs at once")
         setattr(self.venv, attr_name, value)
@@ -136,6 +146,8 @@ class CollisionSB3VecEnv(VecEnv):
     def env_method(
         self, method_name: str, *method_args: Any, indices: VecEnvIndices = None, **method_kwargs: Any
     ) -> list:
+        """Call the native env's method once; its result per sub-env of ``indices`` (a tuple with one
+        item per sub-env is split among them)."""
         result = getattr(self.venv, method_name)(*method_args, **method_kwargs)
         idx = list(self._get_indices(indices))
         if isinstance(result, tuple) and len(result) == self.num_envs:
@@ -143,6 +155,7 @@ class CollisionSB3VecEnv(VecEnv):
         return [result for _ in idx]
 
     def env_is_wrapped(self, wrapper_class: type[gym.Wrapper], indices: VecEnvIndices = None) -> list[bool]:
+        """``False`` for each sub-env: the scenes of the batched env are not Gymnasium envs to wrap."""
         return [False for _ in self._get_indices(indices)]
 
 

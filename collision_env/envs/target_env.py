@@ -11,11 +11,12 @@ from gymnasium import spaces
 from numpy.typing import ArrayLike
 
 from collision_env.engine import BatchSimulator, Impacts
-from collision_env.envs._config import PRESETS, TaskConfig, keywords_of, make_config
+from collision_env.envs._config import TaskConfig, keywords_of, make_config
 from collision_env.envs._core import TaskCore, check_state_keys
 from collision_env.envs.task.layout import ROW_RESET, ROW_STEPPED, SCENE_FLOATS, SCENE_INTS
 
 if TYPE_CHECKING:
+    from collision_env.envs.registry import Task
     from collision_env.envs.rendering import Renderer
 
 _CLASS_PRESET = "__class_preset__"
@@ -131,7 +132,11 @@ class CollisionTargetEnv(gym.Env):
     """
 
     metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 20}
+    """Gymnasium's metadata: the render modes, and frames per second (an instance's follow its ``dt``)."""
     preset: str | None = "one_ball"
+    """The preset a class makes when ``preset`` is not given (a name in ``PRESETS``)."""
+    task: Task | None = None
+    """The task registry entry of a preset's env class (its id, preset and config); ``None`` here."""
 
     def __init__(
         self, preset: str | None = _CLASS_PRESET, render_mode: str | None = None, trails: bool = False, **overrides: Any
@@ -139,16 +144,20 @@ class CollisionTargetEnv(gym.Env):
         if preset is _CLASS_PRESET:
             preset = type(self).preset
         self.config: TaskConfig = make_config(preset, also=keywords_of(type(self).__init__, gym.make), **overrides)
+        """The task this env runs: the preset's fields with the keyword overrides, checked."""
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
                 f"render_mode: expected one of {self.metadata['render_modes']} or None, got {render_mode!r}"
             )
         self.render_mode = render_mode
+        """``"rgb_array"``, ``"human"`` or ``None``."""
         self.metadata = {**type(self).metadata, "render_fps": max(1, int(round(1.0 / self.config.dt)))}
         self._core = TaskCore(self.config, 1)
         cfg = self.config
         self.action_space = spaces.Box(-1.0, 1.0, (cfg.action_dim,), np.float32)
+        """``Box(-1, 1, (config.action_dim,), float32)``: see "Action Space" above."""
         self.observation_space = spaces.Box(-1.0, 1.0, (cfg.obs_dim,), np.float32)
+        """``Box(-1, 1, (config.obs_dim,), float32)``: see "Observation Space" above."""
         self._ones = np.ones(1, dtype=bool)
         self._reset_flag = np.full(1, ROW_RESET, dtype=np.int8)
         self._step_flag = np.full(1, ROW_STEPPED, dtype=np.int8)
@@ -179,6 +188,8 @@ class CollisionTargetEnv(gym.Env):
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
+        """Start an episode (Gymnasium's ``Env.reset``): ``(observation, info)``; ``seed`` seeds
+        ``self.np_random``, from which the start state is drawn; ``options`` is unused."""
         super().reset(seed=seed)
         core = self._core
         core.reset_scenes(np.zeros(1, dtype=np.int64), [self.np_random])
@@ -201,6 +212,10 @@ class CollisionTargetEnv(gym.Env):
         return obs[0], info
 
     def step(self, action: ArrayLike) -> tuple[np.ndarray, SupportsFloat, bool, bool, dict[str, Any]]:
+        """One control step (Gymnasium's ``Env.step``): nudge, advance the engine by ``config.dt``,
+        score; ``(observation, reward, terminated, truncated, info)``. ``info`` holds the step's
+        ``impacts`` (an ``Impacts``), ``event_cap``, ``nudge``, ``energy``, ``time``,
+        ``targets_hit`` and ``is_success``. An action with a NaN raises; others are clipped."""
         TaskCore.check_actions(action)
         a = self._action  # (1, A) float64, the kernel's input (reused: the kernel only reads it)
         if getattr(action, "shape", None) == self.action_space.shape:
@@ -231,6 +246,7 @@ class CollisionTargetEnv(gym.Env):
 
     # ------------------------------------------------------------------------------------- #
     def render(self) -> np.ndarray | None:
+        """An ``(H, W, 3)`` uint8 frame (``render_mode="rgb_array"``), or draw the window (``"human"``)."""
         if self.render_mode is None:
             env_id = self.spec.id if self.spec is not None else "..."
             gym.logger.warn(
@@ -253,6 +269,7 @@ class CollisionTargetEnv(gym.Env):
         return self._renderer
 
     def close(self) -> None:
+        """Close the window, if one is open."""
         if self._renderer is not None:
             self._renderer.close()
             self._renderer = None
@@ -286,7 +303,3 @@ class CollisionTargetEnv(gym.Env):
     def simulator(self) -> BatchSimulator:
         """The engine's :class:`~collision_env.engine.BatchSimulator` (one scene) behind this env."""
         return self._core.batch
-
-
-def preset_names() -> list[str]:
-    return sorted(PRESETS)

@@ -49,7 +49,9 @@ class CollisionTargetVectorEnv(VectorEnv):
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 20, "autoreset_mode": AutoresetMode.NEXT_STEP}
+    """Gymnasium's metadata: the render modes, frames per second and the autoreset mode."""
     preset: str | None = "one_ball"
+    """The preset a class makes when ``preset`` is not given (a name in ``PRESETS``)."""
     # set before __init__ can fail: gymnasium < 1.3's VectorEnv.__del__ closes a half-made env
     _renderers: list[Renderer] | None = None
 
@@ -80,20 +82,29 @@ class CollisionTargetVectorEnv(VectorEnv):
         if preset is _CLASS_PRESET:
             preset = type(self).preset
         self.config: TaskConfig = make_config(preset, also=keywords_of(type(self).__init__, gym.make_vec), **overrides)
+        """The task every sub-env runs: the preset's fields with the keyword overrides, checked."""
         cfg = self.config
         self.num_envs = int(num_envs)
+        """Number of sub-envs: scenes of one batched engine."""
         self.max_episode_steps = None if max_episode_steps is None else int(max_episode_steps)
+        """Steps after which a sub-env is truncated (``None``: only by its ``time_limit``)."""
         self.render_mode = render_mode
+        """``"rgb_array"`` or ``None``."""
         self.autoreset_mode = autoreset_mode
+        """When a finished sub-env is reset: ``AutoresetMode.NEXT_STEP`` or ``SAME_STEP``."""
         self.metadata = {
             **type(self).metadata,
             "autoreset_mode": autoreset_mode,
             "render_fps": max(1, int(round(1.0 / cfg.dt))),
         }
         self.single_action_space = spaces.Box(-1.0, 1.0, (cfg.action_dim,), np.float32)
+        """One sub-env's action space, as the single env's."""
         self.single_observation_space = spaces.Box(-1.0, 1.0, (cfg.obs_dim,), np.float32)
+        """One sub-env's observation space, as the single env's."""
         self.action_space = batch_space(self.single_action_space, self.num_envs)
+        """``(num_envs, action_dim)``: one action per sub-env."""
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        """``(num_envs, obs_dim)``: one observation per sub-env."""
 
         self._core = TaskCore(cfg, self.num_envs)
         self._rngs: list = [None] * self.num_envs
@@ -141,6 +152,8 @@ class CollisionTargetVectorEnv(VectorEnv):
     def reset(
         self, *, seed: int | list[int | None] | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
+        """Reset every sub-env, or those of ``options={"reset_mask": mask}``: ``(observations, info)``
+        (see the class docstring for ``seed``)."""
         options = dict(options) if options else {}
         mask = options.pop("reset_mask", None)
         if mask is None:
@@ -175,6 +188,9 @@ class CollisionTargetVectorEnv(VectorEnv):
         return np.zeros((self.num_envs, self._core.obs_dim), dtype=np.float32)
 
     def step(self, actions: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        """Step every sub-env (one row of ``actions`` each) in one call of the batched engine:
+        ``(observations, rewards, terminations, truncations, info)``, the single env's info keys as
+        arrays; finished sub-envs are reset as ``autoreset_mode`` says."""
         if self._rngs[0] is None:
             raise ResetNeeded("call reset() before step() on the vector env")
         TaskCore.check_actions(actions, "actions")
@@ -279,6 +295,7 @@ class CollisionTargetVectorEnv(VectorEnv):
         return self._renderers
 
     def close_extras(self, **kwargs: Any) -> None:
+        """Free the renderers (``close()`` calls it)."""
         if self._renderers is not None:
             for r in self._renderers:
                 r.close()
@@ -325,4 +342,5 @@ class CollisionTargetVectorEnv(VectorEnv):
 
     @property
     def core(self) -> TaskCore:
+        """The batched task core: the engine in ``core.batch``, the task arrays alongside."""
         return self._core

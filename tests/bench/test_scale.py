@@ -5,12 +5,12 @@ from __future__ import annotations
 import pytest
 
 from collision_env.bench import scale
-from collision_env.engine import warm_up
+from collision_env.precompile import precompile
 
 
 @pytest.fixture(scope="module", autouse=True)
 def compiled():
-    warm_up()  # numba's compile must not count as the engine's memory
+    precompile(envs=False)  # numba's compile must not count as the engine's memory
 
 
 def test_a_gas_on_the_grid_stays_valid_and_collides_at_enskogs_rate():

@@ -2,10 +2,10 @@
 
 import pytest
 
-from collision_env.engine import warm_up
+from collision_env.precompile import precompile
 
 
 @pytest.fixture(scope="session", autouse=True)
 def compiled_kernels():
     """Compile the kernels before any test runs: tests that bound a step's time must not time numba."""
-    warm_up()
+    precompile(envs=False)

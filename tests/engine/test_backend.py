@@ -3,14 +3,16 @@
 import json
 import os
 import platform
+import re
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from collision_env.engine import BACKEND, Scene, Simulator
-from collision_env.engine._jit import HAVE_NUMBA, _numba, prefetch
+from collision_env.engine._jit import HAVE_NUMBA, PYTHON_SLOWDOWN, _numba, prefetch
 from collision_env.engine.layout import CAL_RECORD
 
 SCRIPT = """
@@ -105,3 +107,38 @@ def test_prefetch_wants_one_integer_per_axis():
 
     with pytest.raises(TypingError):
         row_only(np.zeros((2, 2)))
+
+
+def test_without_numba_the_engine_runs_as_python_with_one_warning_that_says_what_to_install(tmp_path):
+    """A platform without numba's wheels installs the package without it: the envs still run, and
+    one warning (not one per kernel or per env) says how much slower and what to install."""
+    code = (
+        "import sys, warnings\n"
+        "sys.modules['numba'] = None\n"  # as if it could not be installed
+        "warnings.simplefilter('always')\n"
+        "import gymnasium as gym\n"
+        "import collision_env\n"
+        "from collision_env.engine import BACKEND, Scene, Simulator\n"
+        "for _ in range(2):\n"
+        "    env = gym.make('CollisionEnv/OneBallTarget-v0')\n"
+        "    env.reset(seed=0)\n"
+        "    env.step(env.action_space.sample())\n"
+        "Simulator(Scene(), [[0.0, 0.0]], [[1.0, 0.0]], [1.0]).step(3.0)\n"
+        "print(BACKEND)\n"
+    )
+    root = str(Path(__file__).resolve().parents[2])
+    env = {**os.environ, "PYTHONPATH": root, "NUMBA_DISABLE_JIT": "0"}
+    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "python"
+    warnings = [line for line in done.stderr.splitlines() if "SlowBackendWarning" in line]
+    assert len(warnings) == 1, done.stderr
+    assert f"{PYTHON_SLOWDOWN} times slower" in warnings[0] and "pip install numba" in warnings[0]
+
+
+def test_the_slowdown_the_warning_states_is_the_measured_one():
+    """``PYTHON_SLOWDOWN`` is the figure ``python -m collision_env.bench.backend`` measured (within
+    a factor of 1.5: it is a guide, rounded, and the machines are noisy)."""
+    page = (Path(__file__).resolve().parents[2] / "docs" / "bench" / "backend.md").read_text()
+    measured = float(re.search(r"plain Python is \*\*([\d,.]+)×\*\* slower", page)[1].replace(",", ""))
+    assert measured / 1.5 <= PYTHON_SLOWDOWN <= measured * 1.5

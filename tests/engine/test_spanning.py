@@ -70,7 +70,7 @@ def test_touching_balls_from_wall_to_wall_are_refused_at_every_entry(along, acro
     good = spanning(along, across, axis, 0.01, size, offset, e)
     sim = Simulator(*good)
     before = sim.get_state()
-    bad = {**before, "positions": pos, "radii": radii}
+    bad = before.replace(positions=pos, radii=radii)
     with pytest.raises(ValueError, match=f"along {'xy'[axis]}"):
         sim.set_state(bad)
     with pytest.raises(ValueError, match=f"along {'xy'[axis]}"):

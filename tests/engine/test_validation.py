@@ -168,7 +168,7 @@ def test_set_scenes_names_a_bad_index(index):
         (lambda: make().nudge(0.5), r"nudge: expected shape \(2, 2\), got \(\)"),
         (lambda: make(positions=[1.0, 0.0]), r"positions: expected shape \(N, 2\), got \(2,\)"),
         (lambda: make().set_balls(velocities=[[1.0, 0.0]]), r"velocities: expected shape \(2, 2\), got \(1, 2\)"),
-        (lambda: make().set_state({**make().get_state(), "radii": np.ones(3)}), r"expected shape \(2,\), got \(3,\)"),
+        (lambda: make().set_state(make().get_state().replace(radii=np.ones(3))), r"expected shape \(2,\), got \(3,\)"),
     ],
 )
 def test_a_single_simulator_gives_shapes_without_a_batch_axis(call, message):
@@ -272,7 +272,7 @@ def test_set_state_refuses_what_the_constructor_refuses_and_changes_nothing(bad)
     sim.step(0.3)
     before = sim.get_state()
     with pytest.raises(ValueError, match=message):
-        sim.set_state({**before, key: np.asarray(value)})
+        sim.set_state(before.replace(**{key: np.asarray(value)}))
     for k, v in sim.get_state().items():
         np.testing.assert_array_equal(v, before[k])
     sim.set_state(before)  # the state itself is good

@@ -12,7 +12,8 @@ import pytest
 from gymnasium.utils.env_checker import check_env, data_equivalence
 
 import collision_env
-from collision_env.envs import GENERIC_ID, PRESET_IDS, PRESETS, Impacts, TaskConfig
+from collision_env.engine import Impacts
+from collision_env.envs import GENERIC_ID, PRESET_IDS, PRESETS, TaskConfig
 
 
 def rollout(env, seed, n=60, action_seed=0):

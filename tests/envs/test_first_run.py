@@ -116,7 +116,8 @@ def test_a_kernel_outside_the_package_is_cached_by_its_contents(tmp_path):
     the same modification time) recompiles it, and a kernel with no file is compiled uncached."""
     script = tmp_path / "outside.py"
     source = "from collision_env.engine._jit import njit\n@njit\ndef k(x):\n    return x + {}\nprint(k(1))\n"
-    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    root = str(Path(__file__).resolve().parents[2])  # this checkout's package, whatever is installed
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"), "PYTHONPATH": root}
 
     def run(*args):
         done = subprocess.run([sys.executable, *args], capture_output=True, text=True, env=env, timeout=300)

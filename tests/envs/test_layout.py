@@ -29,10 +29,10 @@ def test_generic_docstring_shows_the_generated_observation_table():
 
 
 def test_wall_one_hot_follows_the_engine_wall_codes():
-    from collision_env import engine
+    from collision_env.engine import scene
 
     for name in WALL_NAMES:
-        code = getattr(engine, f"WALL_{name.upper()}")
+        code = getattr(scene, f"WALL_{name.upper()}")
         assert getattr(TARGET_OBS, f"wall_{name}") == TARGET_OBS.wall_left + code
 
 

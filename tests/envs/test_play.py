@@ -134,3 +134,43 @@ def test_every_id_plays_a_few_frames(env_id):
         p.tick()
     assert p.steps == 3 and np.isfinite(p.episode_return)
     p.env.close()
+
+
+def test_the_command_takes_any_task_field_as_an_env_keyword(monkeypatch, capsys):
+    made = []
+    monkeypatch.setattr(play, "play", lambda env_id, **kwargs: made.append({"env_id": env_id, **kwargs}))
+    play.main(["CollisionEnv/Billiards-v0", "--mode", "naive", "--dt", "0.1", "--n-targets", "2", "--seed", "4"])
+    play.main(["--bounds", "(-1, -1, 1, 1)", "--target-walls", "('left', 'top')"])
+    play.main(["CollisionEnv/Line1D-v0", "--window", "None"])  # the preset's time windows off
+    assert made == [
+        {"env_id": "CollisionEnv/Billiards-v0", "seed": 4, "trails": False, "mode": "naive", "dt": 0.1, "n_targets": 2},
+        {
+            "env_id": "CollisionEnv/OneBallTarget-v0",
+            "seed": None,
+            "trails": False,
+            "bounds": (-1, -1, 1, 1),
+            "target_walls": ("left", "top"),
+        },
+        {"env_id": "CollisionEnv/Line1D-v0", "seed": None, "trails": False, "window": None},
+    ]
+    with pytest.raises(SystemExit) as exit_info:
+        play.main(["CollisionEnv/Billiards-v0", "--mode", "fastest"])
+    assert exit_info.value.code == 2
+    assert "mode: expected one of ('naive', 'posteriori', 'exact'), got 'fastest'" in capsys.readouterr().err
+
+
+def test_help_is_plain_text_and_names_every_field(capsys):
+    import dataclasses
+
+    from collision_env.envs import TaskConfig
+
+    with pytest.raises(SystemExit):
+        play.main(["--help"])
+    out = capsys.readouterr().out
+    assert "``" not in out and ":class:" not in out and ":func:" not in out
+    assert "as gymnasium.utils.play offers" in out
+    for field in dataclasses.fields(TaskConfig):
+        if field.init:
+            assert f"--{field.name.replace('_', '-')} VALUE" in out
+    assert "--mode VALUE          The engine's fidelity mode" in out
+    assert play.plain("see :class:`~collision_env.engine.Scene` and ``x``") == "see Scene and x"

@@ -8,7 +8,8 @@ import pytest
 from gymnasium.utils.env_checker import data_equivalence
 from gymnasium.vector import AutoresetMode
 
-from collision_env.envs import CollisionTargetVectorEnv, Impacts
+from collision_env.engine import Impacts
+from collision_env.envs import CollisionTargetVectorEnv
 
 N_ENVS = 4
 

@@ -14,6 +14,8 @@ from .._jit import njit
 from .tolerance import CONTACT_RTOL, contact_tolerance, coordinate_size
 
 WALL_NAMES = ("left", "right", "bottom", "top")
+"""The walls by name, as ``Impact.wall`` gives them; a raw impact record's ``wall`` code is an index
+into this tuple (-1 for a ball-ball impact)."""
 #: Wall codes: indices into ``WALL_NAMES``, as impact records and the kernels store them.
 WALL_LEFT, WALL_RIGHT, WALL_BOTTOM, WALL_TOP = 0, 1, 2, 3
 

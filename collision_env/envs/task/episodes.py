@@ -163,7 +163,7 @@ def _draw_windows(uniforms, off, episode_f, t_geo):  # pragma: no cover - numba
             t_geo[r, k, TARGET_GEOMETRY.closes] = t_geo[r, k, TARGET_GEOMETRY.opens] + win
 
 
-@njit(label="the env's episode builder")
+@njit(label="the environments' resets")
 def build_episodes(
     uniforms, ctrl_mask, walls, episode_f, episode_i, pos, vel, masses, radii, t_wall, t_geo, ok
 ):  # pragma: no cover

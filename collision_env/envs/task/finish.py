@@ -10,7 +10,7 @@ from .observe import observe
 from .scoring import score_impacts
 
 
-@njit(refcount=False, label="the env's task kernel")
+@njit(refcount=False, label="the environments' rewards and observations")
 def task_kernel(h, flags, imp, obs):  # pragma: no cover - numba
     """Score a step's impacts, update the targets, and write the observation, reward and end flags.
 

@@ -99,7 +99,7 @@ SCENE_INTS = layout(
 TARGET_INTS = layout(
     "TargetInts",
     (
-        ("wall", "wall code (collision_env.engine.WALL_LEFT ... WALL_TOP)"),
+        ("wall", "wall code (an index into collision_env.engine.WALL_NAMES)"),
         ("status", "TARGET_PENDING, TARGET_HIT or TARGET_FAILED"),
     ),
 )

@@ -78,7 +78,7 @@ def requested_change(a, o, dim, velocity_control, vx, vy, max_dv, max_speed):  #
     return dx, dy
 
 
-@njit(refcount=False, label="the env's nudge kernel")
+@njit(refcount=False, label="the environments' actions")
 def nudge_kernel(h, actions, active):  # pragma: no cover - numba
     """Turn ``actions`` (B, A) into velocity changes of the controlled balls (``TaskState.nudge``)
     and their size (``scene_f[:, nudge]``: the requested |dv| summed over the controlled balls, m/s,

@@ -25,7 +25,7 @@ from .observe import centre_and_half_size
 from .scoring import aim_distance, next_wall_impact, target_hit
 
 
-@njit(label="the env's prediction kernel")
+@njit(label="the environments' predicted observation")
 def predict_kernel(h, flags, imp, obs):  # pragma: no cover - numba
     """Each ball's predicted wall impact: written into the observation's last entries, one
     ``PREDICTED_OBS`` block per shown ball (``observe_predicted``), and made the aiming potential
