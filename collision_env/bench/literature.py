@@ -380,6 +380,7 @@ def render_markdown(results: dict) -> str:
                 f"{c['deviation_sigma']:+.1f} | {c['drift_sigma']:+.1f} | {_bp(m, m['z'], m['z_err'])} | "
                 f"{m['deviation_sigma']:+.1f} | {m['drift_sigma']:+.1f} |"
             )
+        lines += ["", _loop_note([r for pair in loop for r in pair])]
     lines += [
         "",
         "| method | N | points | events per point | events/s (CPU, median) | CPU per point |",
@@ -397,6 +398,27 @@ def render_markdown(results: dict) -> str:
                 f"| {_NAMES[method]} | {n} | {len(group)} | {events:.3g} {_UNITS[method]} | {rate:.3g} | {cpu:.0f} s |"
             )
     return "\n".join(lines)
+
+
+def _loop_note(rows: Sequence[dict]) -> str:
+    """The loop's points that a method did not equilibrate at this run length: beyond
+    :data:`WITHIN_SIGMA` of the reference, or drifting by as much."""
+    off = [
+        r
+        for r in rows
+        if not within(r) or not (math.isfinite(r["drift_sigma"]) and abs(r["drift_sigma"]) <= WITHIN_SIGMA)
+    ]
+    if not off:
+        return f"Every loop point within {WITHIN_SIGMA:g} σ of Li et al., none drifting by as much."
+    where = "; ".join(
+        f"φ = {r['packing']:.3f} by {_NAMES[r['method']]} ({r['deviation_sigma']:+.1f} σ, "
+        f"drift {r['drift_sigma']:+.1f}{'' if r['reliable'] else ', a segment too short for its error'})"
+        for r in sorted(off, key=lambda r: (r["packing"], r["method"]))
+    )
+    return (
+        f"Beyond {WITHIN_SIGMA:g} σ of Li et al., or drifting by as much: {where}. At this run length such a point "
+        "is not equilibrated; the coexistence relaxes slowly."
+    )
 
 
 def _verdict(rows: Sequence[dict]) -> str:
