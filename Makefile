@@ -93,10 +93,12 @@ wheel-check: $(STAMP)
 	cd $(WHEEL_VENV) && bin/python $(CURDIR)/scripts/wheel_smoke.py
 
 # The env API under the oldest allowed gymnasium and under Ray's (1.2.2), with the RLlib smoke test and
-# the code blocks of the README and docs/ (those that need Ray run there).
+# the code blocks of the README and docs/ (those that need Ray run there); then, on its own (its private
+# Ray instance beside no other), a benchmark sweep on Ray against the same sweep run serially.
 test-compat: $(OLD_STAMP) $(RAY_STAMP)
 	$(OLD_PY) -m pytest -n 2 -q -p no:cacheprovider $(COMPAT_TESTS)
 	$(RAY_PY) -m pytest -n 2 -q -p no:cacheprovider $(COMPAT_TESTS) tests/agents/test_rllib.py tests/test_docs_code.py
+	$(RAY_PY) -m pytest -q -p no:cacheprovider tests/bench/test_parallel_ray.py
 
 test-rllib: $(RAY_STAMP)
 	$(RAY_PY) -m pytest -q -p no:cacheprovider tests/agents/test_rllib.py
@@ -125,12 +127,15 @@ bench: $(STAMP)
 	$(PY) -m collision_env.bench.engine --quick
 
 # Re-measure every figure of the README and docs/ (the README holds the study's headline table and the
-# env table; every other page is docs/bench/*.md; the agents study is separate). About half an hour.
+# env table; every other page is docs/bench/*.md; the agents study is separate). About an hour and a half, an
+# hour of it the physics benchmark's literature section on two processes.
 figures: $(STAMP)
 	$(PY) -m collision_env.bench --readme README.md
 	$(PY) -m collision_env.bench.engine --markdown docs/bench/engine.md
 	$(PY) -m collision_env.bench.scale --markdown docs/bench/scale.md
 	$(PY) -m collision_env.bench.physics --json docs/bench/physics.json --markdown docs/bench/physics.md --plot docs/img
+	$(PY) -m collision_env.bench.physics --section literature --jobs 2 --json docs/bench/literature.json \
+		--markdown docs/bench/physics.md --plot docs/img
 	$(PY) -m collision_env.bench.chains --json docs/bench/chains.json --markdown docs/bench/chains.md
 	$(PY) -m collision_env.bench.peer --json docs/bench/peer.json --markdown docs/bench/peer.md
 	$(PY) -m collision_env.bench.envs --markdown docs/bench/envs_bench.md

@@ -5,6 +5,11 @@ Run it as::
     python -m collision_env.bench.physics                 # N = 4096, jamming at N = 1024 and 4096
     python -m collision_env.bench.physics --quick         # N = 1024, fewer jamming runs
     python -m collision_env.bench.physics --markdown docs/bench/physics.md --plot docs/img
+    python -m collision_env.bench.physics --section literature --jobs 2 --markdown docs/bench/physics.md --plot docs/img
+
+**Against Li et al. (2022)** (``--section literature``, :mod:`~collision_env.bench.literature`): small
+periodic systems (N = 72, 224, 870) in the literature's cells, by exact-mode MD and by event chains,
+against published event-chain pressures; its state points run serially, in local processes, or on Ray.
 
 **Equation of state.** A periodic monodisperse fluid of ``N`` disks (diameter ``sigma = 1``, mass 1,
 ``kT = 1``), started on a triangular lattice (:func:`~collision_env.engine.disk_gas`) at each area
@@ -44,6 +49,7 @@ from collision_env.engine.compression import DEFAULT_RATE, DEFAULT_UNTIL_PRESSUR
 from collision_env.observables import collision_rate, henderson_z, kolafa_rottner_z, reduced_pressure
 from collision_env.precompile import precompile
 
+from . import literature
 from .machine import cpus, machine, timestamp, versions
 
 PACKINGS = (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.65, 0.68)
@@ -346,20 +352,34 @@ def plot_jamming(results: dict, folder: str) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m collision_env.bench.physics", description=__doc__.split("\n")[0])
-    parser.add_argument("--quick", action="store_true", help=f"N = {QUICK_SIZE} rather than {SIZE}")
+    parser.add_argument(
+        "--section",
+        choices=("fluid", "literature"),
+        default="fluid",
+        help="fluid: the equation of state, speed and jamming (the default); literature: against Li et al. (2022)",
+    )
+    parser.add_argument(
+        "--quick", action="store_true", help=f"N = {QUICK_SIZE} rather than {SIZE} (literature: a few short points)"
+    )
     parser.add_argument("--json", help="write the raw figures here")
-    parser.add_argument("--markdown", help="write the tables here")
-    parser.add_argument("--plot", help="write physics_eos.png and physics_jamming.png into this folder")
+    parser.add_argument(
+        "--markdown", help="write the tables into this page's bench:physics (or bench:literature) block"
+    )
+    parser.add_argument(
+        "--plot", help="write physics_eos.png and physics_jamming.png (literature: physics_li2022.png) into this folder"
+    )
+    literature.add_arguments(parser)
     args = parser.parse_args(argv)
+    if args.section == "literature":
+        return literature.main(args)
     results = run(args.quick)
     text = render_markdown(results)
     print(text)
     if args.json:
         with open(args.json, "w") as fh:
             json.dump(results, fh, indent=1)
-    if args.markdown:
-        with open(args.markdown, "w") as fh:
-            fh.write("# Hard disks against the literature\n\n" + text + "\n")
+    if args.markdown:  # (its block of the page: the literature section writes another)
+        literature.write_page_block(args.markdown, "bench:physics", text)
     if args.plot:
         print(plot(results, args.plot))
         print(plot_jamming(results, args.plot))

@@ -18,7 +18,8 @@ Boltzmann constant: ``kT`` is an energy), ``N`` is the number of disks, ``A`` th
   (the ``analysis`` extra);
 - :mod:`~collision_env.observables.reference`: what the hard-disk fluid is known to do, to compare
   with: the equation of state (:func:`kolafa_rottner_z`, :func:`henderson_z`), the contact value
-  :func:`henderson_g` and Enskog's collision rate :func:`enskog_rate`.
+  :func:`henderson_g`, Enskog's collision rate :func:`enskog_rate`, and event-chain pressures of
+  small periodic cells (:func:`li_2022_pressures`).
 
 Every name is importable from ``collision_env.observables`` itself. Impacts are
 :class:`~collision_env.engine.Impacts` or their structured arrays
@@ -44,17 +45,31 @@ from .pressure import (
     temperature,
     wall_pressure,
 )
-from .reference import KOLAFA_ROTTNER, KOLAFA_ROTTNER_MAX, enskog_rate, henderson_g, henderson_z, kolafa_rottner_z
+from .reference import (
+    KOLAFA_ROTTNER,
+    KOLAFA_ROTTNER_MAX,
+    LI_2022,
+    LI_2022_CELLS,
+    CellPressures,
+    enskog_rate,
+    henderson_g,
+    henderson_z,
+    kolafa_rottner_z,
+    li_2022_pressures,
+)
 from .statistics import BlockAverage, Blocking, block_average
 from .structure import PAIR_CHUNK, mean_squared_displacement, radial_distribution, unwrapped_positions
 
 __all__ = [
     "KOLAFA_ROTTNER",
     "KOLAFA_ROTTNER_MAX",
+    "LI_2022",
+    "LI_2022_CELLS",
     "PAIR_CHUNK",
     "SHORTEST_EDGE",
     "BlockAverage",
     "Blocking",
+    "CellPressures",
     "PressureAccumulator",
     "block_average",
     "collision_rate",
@@ -66,6 +81,7 @@ __all__ = [
     "hexatic_correlation",
     "hexatic_order",
     "kolafa_rottner_z",
+    "li_2022_pressures",
     "mean_free_time",
     "mean_squared_displacement",
     "radial_distribution",

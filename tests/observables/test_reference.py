@@ -63,3 +63,42 @@ def test_enskog_rate_refuses_bad_input():
         enskog_rate(math.nan, 1.0, 0.3, 1.0, 1.0)
     with pytest.raises(ValueError, match="packing"):
         enskog_rate(1.0, 1.0, 1.0, 1.0, 1.0)
+
+
+def test_li_2022_converts_beta_p_sigma2_to_z_and_finds_its_points():
+    from collision_env.observables import li_2022_pressures
+
+    ref = li_2022_pressures(224, "1:1")
+    # Z = beta P sigma^2 pi / (4 phi): the N = 224, phi = 0.68 row, 8.49105 +- 0.00019
+    z, err = ref.at(0.68)
+    assert z == pytest.approx(8.49105 * math.pi / (4 * 0.68), rel=1e-12)
+    assert err == pytest.approx(0.00019 * math.pi / (4 * 0.68), rel=1e-12)
+    assert ref.sides == (1.0, 1.0) and ref.n == 224
+    assert list(ref.packing) == sorted(ref.packing) and ref.packing[0] == 0.67 and ref.packing[-1] == 0.71
+    with pytest.raises(ValueError, match="0.670, 0.672"):
+        ref.at(0.6)
+    with pytest.raises(ValueError, match="N = 72 in 1:1"):
+        li_2022_pressures(100, "1:1")
+
+
+def test_li_2022_series_are_fluid_or_the_n224_loop_and_agree_with_kolafa_rottner_at_large_n():
+    from collision_env.observables import LI_2022, li_2022_pressures
+
+    for n, cell in LI_2022:
+        ref = li_2022_pressures(n, cell)
+        assert ((ref.error > 0) & (ref.error < 1e-3 * ref.pressure)).all()
+        assert ref.packing.max() <= (0.71 if n == 224 else 0.68)
+    # 870 disks: within the fit's few 1e-4 of the large-N equation of state, in both cells
+    for cell in ("1:1", "29:30sqrt3/2"):
+        z, _ = li_2022_pressures(870, cell).at(0.67)
+        assert z == pytest.approx(kolafa_rottner_z(0.67), rel=5e-4)
+
+
+def test_li_2022_crystal_cells_are_the_cells_disk_gas_tiles():
+    from collision_env.engine import disk_gas
+    from collision_env.observables import LI_2022_CELLS
+
+    for n, cell in ((72, "9:8sqrt3/2"), (870, "29:30sqrt3/2")):
+        gas = disk_gas(n, 0.7, arrangement="crystal", periodic=True, aspect=LI_2022_CELLS[cell])
+        width, height = gas.scene.period
+        assert height / width == pytest.approx(LI_2022_CELLS[cell][1] / LI_2022_CELLS[cell][0], rel=1e-12)
