@@ -17,7 +17,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ._jit import BACKEND
-from .broadphase import GRID_MIN_BALLS, grid_geometry
+from .broadphase import GRID_MIN_BALLS, PERIODIC_GRID_MIN_BALLS, grid_geometry
 from .frames import copy_impacts, record_frame
 from .layout import (
     B_INV_MASS,
@@ -277,7 +277,8 @@ class Stepper:
 
     def uses_grid(self) -> bool:
         """The broad phase pays only in large scenes with ball pairs (and no stick clusters)."""
-        return self.scene.ball_collisions and self.n >= GRID_MIN_BALLS and not self.scene.sticky
+        least = PERIODIC_GRID_MIN_BALLS if self.scene.periodic else GRID_MIN_BALLS
+        return self.scene.ball_collisions and self.n >= least and not self.scene.sticky
 
     def _alloc_work(self, rows: int | None = None) -> None:
         if rows is None:

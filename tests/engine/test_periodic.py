@@ -12,7 +12,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from collision_env.engine import BatchSimulator, EventCapWarning, Scene, Simulator
-from collision_env.engine.broadphase import GRID_MIN_BALLS
+from collision_env.engine.broadphase import GRID_MIN_BALLS, PERIODIC_GRID_MIN_BALLS
 from collision_env.engine.layout import W_GRID_NX
 
 MODES = ["exact", "naive", "posteriori"]
@@ -203,16 +203,17 @@ def _gas(n, radius, seed, side=1.0):
     return grid + rng.uniform(-0.2, 0.2, (n, 2)) * (side / k - 2 * radius), rng.normal(size=(n, 2))
 
 
-@pytest.mark.parametrize("n", [GRID_MIN_BALLS + 36, 400])
+@pytest.mark.parametrize("n", [20, GRID_MIN_BALLS + 36, 400])
 def test_wrapping_grid_finds_what_all_pairs_find(n, monkeypatch):
-    """Above GRID_MIN_BALLS a periodic gas runs on a wrapping grid; with the grid switched off every
-    pair is looked at through all its images: the same impacts at the same times."""
+    """A periodic gas runs on a wrapping grid at any size (PERIODIC_GRID_MIN_BALLS); with the grid
+    switched off every pair is looked at through all its images: the same impacts at the same times."""
+    assert n >= PERIODIC_GRID_MIN_BALLS
     radius = 0.25 / math.sqrt(n)
     pos, vel = _gas(n, radius, seed=n)
     grid = Simulator(Scene(bounds=CELL, periodic=True), pos, vel, np.ones(n), np.full(n, radius))
     import collision_env.engine.stepper as stepper
 
-    monkeypatch.setattr(stepper, "GRID_MIN_BALLS", 10**9)
+    monkeypatch.setattr(stepper, "PERIODIC_GRID_MIN_BALLS", 10**9)
     brute = Simulator(Scene(bounds=CELL, periodic=True), pos, vel, np.ones(n), np.full(n, radius))
     assert grid._stepper.work_i[0, W_GRID_NX] >= 3 and brute._stepper.work_i[0, W_GRID_NX] == 1
     total = 0
@@ -235,7 +236,7 @@ def test_cheap_modes_wrapping_grid_agrees_with_all_pairs(mode, monkeypatch):
     grid = Simulator(Scene(bounds=CELL, periodic=True), pos, vel, np.ones(n), np.full(n, radius), mode=mode, substeps=4)
     import collision_env.engine.stepper as stepper
 
-    monkeypatch.setattr(stepper, "GRID_MIN_BALLS", 10**9)
+    monkeypatch.setattr(stepper, "PERIODIC_GRID_MIN_BALLS", 10**9)
     brute = Simulator(
         Scene(bounds=CELL, periodic=True), pos, vel, np.ones(n), np.full(n, radius), mode=mode, substeps=4
     )
@@ -335,7 +336,7 @@ def test_reverse_steps_return_an_elastic_periodic_gas():
 # ---------------------------------------------------------------------------- batches
 @pytest.mark.parametrize("mode", MODES)
 def test_a_batch_of_periodic_scenes_steps_like_each_scene_alone(mode):
-    n = 70  # (above GRID_MIN_BALLS: the wrapping grid)
+    n = 70  # (the wrapping grid)
     scenes = [_gas(n, 0.02, seed=s) for s in range(3)]
     scene = Scene(bounds=CELL, periodic=True, elasticity=0.9)
     options = dict(mode=mode, substeps=1 if mode == "exact" else 3)
