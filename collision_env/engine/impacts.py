@@ -115,7 +115,13 @@ class Impacts(Sequence):
             return self.array[key]
         if isinstance(key, numbers.Integral) and not isinstance(key, (bool, np.bool_)):
             return _impact(self.array[key].tolist())
-        return Impacts(self.array[key])
+        rows = self.array[key]
+        if rows.ndim != 1:  # (None, a boolean scalar or a 2-D index would make a 2-D array of records)
+            raise TypeError(
+                "impacts: index with an integer, a slice, a field name, a bool mask of the impacts or "
+                f"a 1-D array of indices, got {key!r}"
+            )
+        return Impacts(rows)
 
     def __iter__(self) -> Iterator[Impact]:
         a = self.array

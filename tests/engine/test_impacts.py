@@ -59,6 +59,15 @@ def test_impacts_is_a_sequence_of_impact_tuples_over_the_records():
     assert imp != imp[1:] and imp != tuples[1:] and (imp == "impacts") is False
 
 
+@pytest.mark.parametrize("key", [None, True, False, np.True_, (None,), [[0, 1]], np.zeros((2, 2), dtype=int)])
+def test_impacts_refuse_an_index_that_is_not_one_of_rows(key):
+    # issue 39: impacts[None] and impacts[True] gave 2-D arrays of records, which no Impacts is
+    imp = _box_gas().step(1.0)
+    with pytest.raises(TypeError, match="impacts: index with an integer, a slice, a field name, a bool mask"):
+        imp[key]
+    assert len(imp[np.arange(len(imp)) % 2 == 0]) == (len(imp) + 1) // 2 and len(imp[[0, 2]]) == 2
+
+
 def test_frames_give_the_impacts_the_steps_give():
     a, b = _box_gas(seed=3), _box_gas(seed=3)
     rec = a.frames(0.05, 40)
