@@ -18,7 +18,10 @@ regulariser's ``u_min``, see :mod:`collision_env.engine.physics.response`):
   same instant (the group's later sweeps) are not added. Where the group's cascade is replaced by
   its limit (``exact.contacts.settle``), a contact first reported there carries the two-body
   impulse ``(u + u') / (w_i + w_j)`` of its closing speed before and separation speed ``u'``
-  after the limit.
+  after the limit. So the group's later impulses, the collapse regulariser's push-apart among
+  them, are not in the report: a contact's impulses reported over a step are at most the momentum
+  it passes in that step, and all of it outside contact groups (an isolated impact's report
+  includes the push-apart: ``u' = u_min``).
 - In stick scenes (``inelastic="stick"``) the impulse is the plastic one of the bodies as point
   masses, at the recorded closing speed ``u`` of the contact: ``u / (1/M_i + 1/M_j)`` for two
   bodies (clusters) of masses ``M_i``, ``M_j`` that stick, ``M u`` for a body that stops dead at a

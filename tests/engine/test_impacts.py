@@ -102,6 +102,44 @@ def test_stick_impulse_is_the_plastic_impulse_of_the_bodies(mode):
     assert hits[0].impulse == pytest.approx(2.0 * speed, rel=1e-12)  # the cluster (2 kg) stops dead
 
 
+@pytest.mark.parametrize("mode", MODES)
+def test_the_collapse_regularisers_push_apart_is_in_the_reported_impulse(mode):
+    # e = 0, touching balls closing at 1e-10 m/s, below u_min (1e-9 of their speed, ~1.4e-9 m/s):
+    # the response sets them apart at u_min, and the impulse reported is the one applied
+    scene = Scene(elasticity=0.0)
+    sim = Simulator(
+        scene, [[0.0, 0.0], [0.4, 0.0]], [[1.0, 1.0], [1.0 - 1e-10, 1.0]], [1.0, 3.0], [0.2, 0.2], mode=mode
+    )
+    v0 = sim.velocities
+    (pair,) = sim.step(0.1)
+    applied = 3.0 * abs(sim.velocities[1, 0] - v0[1, 0])
+    assert pair.impulse == pytest.approx(applied, rel=1e-6)
+    assert sim.velocities[1, 0] - sim.velocities[0, 0] > 0.0  # (apart, not merely stopped)
+    assert pair.impulse > 0.75 * pair.speed * 1.5  # (more than the plastic mu u: the push-apart is in it)
+
+
+@pytest.mark.parametrize("e", [0.0, 0.5, 1.0])
+def test_a_contacts_reported_impulses_are_at_most_the_momentum_it_passes(e):
+    # a 1D row of 4 touching balls against the right wall, hit by a fifth: the momentum contact k
+    # passes rightwards in the step (ball k to k + 1, the last to the wall) is J_k = -sum_{i <= k} dp_i.
+    # A contact group reports each contact's first impulse only (impacts.py): at most J_k, and
+    # all of it outside groups (e = 1)
+    n, r = 5, 0.1
+    pos = [[0.0, 0.0]] + [[2.0 - r - 2 * r * k, 0.0] for k in range(n - 1)][::-1]
+    vel = [[1.0, 0.0]] + [[0.0, 0.0]] * (n - 1)
+    sim = Simulator(Scene(bounds=PLAY_AREA_1D, dimension=1, elasticity=e), pos, vel, np.ones(n), np.full(n, r))
+    v0 = sim.velocities
+    imp = sim.step(1.5)
+    passed = -np.cumsum(sim.velocities[:, 0] - v0[:, 0])
+    reported = np.zeros(n)
+    for i in imp:
+        assert i.other is None or abs(i.other - i.ball) == 1
+        reported[i.ball if i.other is None else min(i.ball, i.other)] += i.impulse
+    assert (reported > 0.0).all() and (reported <= passed * (1 + 1e-9)).all()
+    if e == 1.0:
+        np.testing.assert_allclose(reported, passed, rtol=1e-12)
+
+
 @settings(max_examples=40, deadline=None)
 @given(log_ratio=st.floats(-6.0, 6.0), seed=st.integers(0, 2**16))
 def test_wall_impulses_account_for_the_momentum_a_gas_gains(log_ratio, seed):
