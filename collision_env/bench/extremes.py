@@ -962,6 +962,7 @@ def _round_trip_past_the_edge(past):
 
     def check(sim, count, impacts):
         scene = Scene(periodic=True)
+        assert scene.bounds is not None  # (a periodic cell has bounds: PhET's box by default)
         edge = scene.bounds[2] if past > 0 else scene.bounds[0]
         twin = Simulator(scene, [[0.0, 0.0], [1.0, 0.3]], [[0.7, 0.2], [-0.3, 0.1]], [1.0, 2.0], mode=sim.mode)
         positions = np.array(twin.positions)
