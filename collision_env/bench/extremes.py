@@ -14,8 +14,8 @@ move), ``set_state`` with each kind of bad field (refused, the state untouched) 
 (refused in every mode), a position a round-off outside a periodic cell (back bit for bit), an
 env's task state with an index out of its array, a NaN or a misspelt key (refused, the env
 untouched) and its round trip, env configs beyond what is counted (refused), impacts indexed by
-None or True (a TypeError), a box compressed to Z = 1e9 (a state the engine takes) and compression
-of an inelastic or stick scene (refused), g(r) of a clump (within 50 MB), and the observables'
+None or True (a TypeError), a box compressed to Z = 1e9 (a state the engine takes), compression without a
+collision (Z = 1) and of an inelastic or stick scene (refused), g(r) of a clump (within 50 MB), and the observables'
 meaningless inputs (refused). Each cell is one scene, one control step and one duration; every mode runs it, stepping
 the public :class:`~collision_env.engine.Simulator` and checking after every step:
 
@@ -1030,6 +1030,18 @@ def _box_packing(sim, count, impacts):
     return None
 
 
+def _no_collision(sim, count, impacts):
+    """Two disks side by side in a periodic cell, never growing, never meet: Z = 1 (it was NaN)."""
+    from collision_env.engine import compress
+
+    scene = Scene(bounds=(0.0, 0.0, 10.0, 10.0), periodic=True)
+    pos, vel = [[2.0, 2.0], [2.0, 6.0]], [[1.0, 0.0], [1.0, 0.0]]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        packing = compress(scene, pos, [0.5, 0.5], velocities=vel, rate=0.0, progress=False)
+    return None if packing.reduced_pressure == 1.0 else f"Z = {packing.reduced_pressure} without a collision"
+
+
 def _clumped_rdf(sim, count, impacts):
     """g(r) of 2,600 points, 600 in one 0.5 m patch, within 50 MB (it took 1.8 GB on d8ab1a0)."""
     import tracemalloc
@@ -1106,6 +1118,7 @@ def _add_input_cells(add):
             _refuses(lambda k=key: impacts_of_a_step()[k], "impacts: index with an integer", TypeError),
         )
     cell("compress a box to Z = 1e9", "compress", _box_packing)
+    cell("compress without a collision", "compress", _no_collision)
     gas = disk_gas(12, 0.3, arrangement="random", seed=0)
     for name, scene, match in (
         ("e = 0.5", Scene(bounds=gas.scene.bounds, elasticity=0.5), "compress bounces the disks elastically"),

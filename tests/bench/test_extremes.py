@@ -22,6 +22,7 @@ def test_the_grid_has_a_cell_for_each_way_in():
         "impacts[None]",
         "impacts[True]",
         "compress a box to Z = 1e9",
+        "compress without a collision",
         "g(r) of a clump",
         "henderson_g(2)",
         "MSD lag 1.5",
