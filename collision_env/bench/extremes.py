@@ -10,7 +10,13 @@ the origin, slow pairs beside a fast ball, inputs at the edge of float64 (and ju
 must be refused) and balls as tall as the box (refused), rows and lattices of touching balls that
 span the box along x or y (2 to 4,096 balls, e = 1, 0.5 and 0; refused, and run with room to
 move), ``set_state`` with each kind of bad field (refused, the state untouched) and 1e9 sub-steps
-(refused). Each cell is one scene, one control step and one duration; every mode runs it, stepping
+(refused), and every other way in (issue 39): a stick cluster glued 1 m across and a misspelt key
+(refused in every mode), a position a round-off outside a periodic cell (back bit for bit), an
+env's task state with an index out of its array, a NaN or a misspelt key (refused, the env
+untouched) and its round trip, env configs beyond what is counted (refused), impacts indexed by
+None or True (a TypeError), a box compressed to Z = 1e9 (a state the engine takes), compression without a
+collision (Z = 1) and of an inelastic or stick scene (refused), g(r) of a clump (within 50 MB), and the observables'
+meaningless inputs (refused). Each cell is one scene, one control step and one duration; every mode runs it, stepping
 the public :class:`~collision_env.engine.Simulator` and checking after every step:
 
 - **NaN**: a position or velocity is not finite;
@@ -508,6 +514,7 @@ def cells(quick: bool = False) -> list[Cell]:
     _add_robustness_cells(add)
     _add_spanning_cells(add)
     _add_state_cells(add)
+    _add_input_cells(add)
     return [c for c in out if c.quick] if quick else out
 
 
@@ -634,15 +641,33 @@ def _check_slow_pair(e, dt, duration):
     return check
 
 
-def _refuses(build, match):
-    """A check that the input ``build()`` makes is refused with a ValueError saying ``match``."""
+def _refuses(build, match, error: type[Exception] = ValueError):
+    """A check that the input ``build()`` makes is refused with an ``error`` saying ``match``."""
 
     def check(sim, count, impacts):
         try:
-            build()
-        except ValueError as err:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", DeprecationWarning)  # (a dict state: still taken, with one)
+                build()
+        except error as err:
             return None if match in str(err) else f"refused with another message: {err}"
         return f"accepted an input that should be refused ({match})"
+
+    return check
+
+
+def _refused_untouched(make, match):
+    """A check that ``target.set_state(bad)``, ``(target, bad) = make(mode)`` for the mode of the
+    cell's run, is refused saying ``match``, and leaves ``target``'s state exactly as it was."""
+
+    def check(sim, count, impacts):
+        from gymnasium.utils.env_checker import data_equivalence
+
+        target, bad = make(sim.mode)
+        before = target.get_state()
+        message = _refuses(lambda: target.set_state(bad), match)(sim, count, impacts)
+        same = data_equivalence(dict(before), dict(target.get_state()), exact=True)
+        return message or (None if same else "a refused set_state changed the state")
 
     return check
 
@@ -884,16 +909,6 @@ def _add_state_cells(add):
         "spanning": "ball 0: position leaves no room to move along x",
     }
 
-    def untouched(field, match):
-        def check(sim, count, impacts):
-            target, state = _bad_state(field)
-            before = target.get_state()
-            message = _refuses(lambda: target.set_state(state), match)(sim, count, impacts)
-            same = all(np.array_equal(v, target.get_state()[k]) for k, v in before.items())
-            return message or (None if same else "a refused set_state changed the state")
-
-        return check
-
     for name, match in messages.items():
         add(
             f"set_state {name}",
@@ -902,7 +917,7 @@ def _add_state_cells(add):
             0.1,
             0.2,
             10.0,
-            untouched(name, match),
+            _refused_untouched(lambda mode, name=name: _bad_state(name), match),
             q=name == "velocity 1e200",
         )
     for mode in ("naive", "posteriori"):
@@ -918,6 +933,211 @@ def _add_state_cells(add):
             ),
             q=mode == "naive",
         )
+
+
+# --------------------------------------------------------------------------- refusals and round trips
+# Every way in besides the constructor (issue 39): engine and env states (a refusal names the field
+# and changes nothing; a state goes back bit for bit), env configs, impacts' indices, compression
+# and the observables. Each cell steps the three balls once in the mode, then makes its check there.
+def _stick_cluster_apart(mode):
+    """A stick simulator in ``mode`` and its state with ball 2, 1 m from a touching pair, glued to it."""
+    scene = Scene(bounds=PLAY_AREA_2D, elasticity=0.0, inelastic="stick")
+    pos = [[-0.25, 0.0], [0.25, 0.0], [1.65, 0.0]]
+    sim = Simulator(scene, pos, [[0.0, 0.0]] * 3, [1.0, 1.0, 1.0], [0.25, 0.25, 0.15], mode=mode)
+    glued = dict(clusters=np.zeros(3, dtype=np.int64), velocities=np.tile([0.3, 0.0], (3, 1)), omega=np.zeros(3))
+    return sim, sim.get_state().replace(**glued)
+
+
+def _unknown_key(mode):
+    """A periodic simulator whose balls crossed the cell, and its state with ``images`` misspelt."""
+    sim = Simulator(Scene(periodic=True), [[0.0, 0.0], [1.0, 0.0]], [[1.0, 0.0], [0.0, 0.0]], [1.0, 1.0], mode=mode)
+    sim.step(3.0)
+    state = dict(sim.get_state())
+    state["image"] = state.pop("images")
+    return sim, state
+
+
+def _round_trip_past_the_edge(past):
+    """A check that a position ``past`` m outside a periodic cell goes back bit for bit."""
+
+    def check(sim, count, impacts):
+        scene = Scene(periodic=True)
+        assert scene.bounds is not None  # (a periodic cell has bounds: PhET's box by default)
+        edge = scene.bounds[2] if past > 0 else scene.bounds[0]
+        twin = Simulator(scene, [[0.0, 0.0], [1.0, 0.3]], [[0.7, 0.2], [-0.3, 0.1]], [1.0, 2.0], mode=sim.mode)
+        positions = np.array(twin.positions)
+        positions[0] = (edge + past, 0.0)
+        state = twin.get_state().replace(positions=positions)
+        twin.set_state(state)
+        return None if twin.get_state() == state else "the state did not go back bit for bit"
+
+    return check
+
+
+def _env(mode, steps=3, **config):
+    """A stepped generic env in ``mode`` whose task reads every field of its state."""
+    import gymnasium as gym
+
+    env = gym.make("CollisionEnv/Target-v0", mode=mode, n_balls=3, shaping=1.0, window=5.0, **config).unwrapped
+    env.reset(seed=7)
+    env.action_space.seed(7)
+    for _ in range(steps):
+        env.step(env.action_space.sample())
+    return env
+
+
+def _bad_env_state(field, column, value):
+    """``make(mode)``: a stepped env and its state with one task value changed (target or scene 0)."""
+    from collision_env.envs.task import layout
+
+    def make(mode):
+        env = _env(mode)
+        state = env.get_state()
+        core = state["core"]
+        if field == "target_geo":
+            core[field][0, 0, getattr(layout.TARGET_GEOMETRY, column)] = value
+        else:
+            core[field][0, getattr(layout.SCENE_FLOATS if field == "scene_f" else layout.SCENE_INTS, column)] = value
+        return env, state
+
+    return make
+
+
+def _check_env_round_trip(sim, count, impacts):
+    """An env's state goes back bit for bit: the same 30 steps after set_state(get_state())."""
+    from gymnasium.utils.env_checker import data_equivalence
+
+    env = _env(sim.mode)
+    state = env.get_state()
+    actions = [env.action_space.sample() for _ in range(30)]
+    first = [env.step(a) for a in actions]
+    env.set_state(state)
+    second = [env.step(a) for a in actions]
+    return None if data_equivalence(first, second, exact=True) else "the steps after set_state differ"
+
+
+def _box_packing(sim, count, impacts):
+    """A box compressed to Z = 1e9 (its touching disks spanned the box) is a state the engine takes."""
+    from collision_env.engine import compress, disk_gas
+
+    gas = disk_gas(30, 0.3, arrangement="random", diameters=(1.0, 1.4), seed=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        packing = compress(gas.scene, gas.positions, gas.radii, rate=0.1, until_pressure=1e9, seed=0, progress=False)
+    if not math.isfinite(packing.reduced_pressure):
+        return f"reduced pressure {packing.reduced_pressure}"
+    packing.gas().simulator(mode=sim.mode)  # (raises if the engine refuses it)
+    return None
+
+
+def _no_collision(sim, count, impacts):
+    """Two disks side by side in a periodic cell, never growing, never meet: Z = 1 (it was NaN)."""
+    from collision_env.engine import compress
+
+    scene = Scene(bounds=(0.0, 0.0, 10.0, 10.0), periodic=True)
+    pos, vel = [[2.0, 2.0], [2.0, 6.0]], [[1.0, 0.0], [1.0, 0.0]]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        packing = compress(scene, pos, [0.5, 0.5], velocities=vel, rate=0.0, progress=False)
+    return None if packing.reduced_pressure == 1.0 else f"Z = {packing.reduced_pressure} without a collision"
+
+
+def _clumped_rdf(sim, count, impacts):
+    """g(r) of 2,600 points, 600 in one 0.5 m patch, within 50 MB (it took 1.8 GB on d8ab1a0)."""
+    import tracemalloc
+
+    from collision_env.observables import radial_distribution
+
+    rng = np.random.default_rng(0)
+    p = rng.uniform(0.0, 100.0, size=(2600, 2))
+    p[:600] = rng.uniform(50.0, 50.5, size=(600, 2))
+    tracemalloc.start()
+    try:
+        radial_distribution(p, (0.0, 0.0, 100.0, 100.0), 2.0, bins=40)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    return None if peak < 50e6 else f"peak memory {peak / 1e6:.0f} MB"
+
+
+def _add_input_cells(add):
+    from collision_env import observables
+    from collision_env.engine import compress, disk_gas
+    from collision_env.envs import make_config
+
+    def cell(name, group, check, q=False):
+        add(name, group, lambda: _three_balls(1.0), 0.1, 0.1, 10.0, check, q=q)
+
+    cell(
+        "set_state stick cluster 1 m apart",
+        "set_state",
+        _refused_untouched(_stick_cluster_apart, "ball 2: does not touch the rest of its stick cluster"),
+        q=True,
+    )
+    cell(
+        "set_state unknown key 'image'",
+        "set_state",
+        _refused_untouched(_unknown_key, "unknown key(s) 'image' (did you mean 'images'"),
+    )
+    for past in (1.6e-15, -1.6e-15):
+        cell(f"set_state {past:g} m past the cell", "round trip", _round_trip_past_the_edge(past))
+    env_cases = {
+        "current target -5": ("scene_i", "current", -5, "scene_i current: must be a target index"),
+        "NaN phi": ("scene_f", "phi", math.nan, "scene_f phi: must be from -1 to 0"),
+        "NaN target centre": ("target_geo", "centre", math.nan, "target_geo centre: target 0: must be finite"),
+    }
+    for name, (array, column, value, match) in env_cases.items():
+        cell(f"env set_state {name}", "env state", _refused_untouched(_bad_env_state(array, column, value), match))
+
+    def misspelt(mode):
+        env = _env(mode)
+        state = env.get_state()
+        state["core"]["target_geometry"] = state["core"].pop("target_geo")
+        return env, state
+
+    cell(
+        "env set_state unknown key",
+        "env state",
+        _refused_untouched(misspelt, "unknown key(s) 'target_geometry' (did you mean 'target_geo'?)"),
+    )
+    cell("env get_state/set_state", "round trip", _check_env_round_trip, q=True)
+    for name, value, match in (
+        ("max_dv", 1e300, "max_dv: must be <= 1e+150"),
+        ("dt", 1e-300, "time_limit: 10 s in control steps of dt = 1e-300 s"),
+        ("max_events", 10**20, "max_events: must be <="),
+    ):
+        cell(f"env {name}={value:g}", "env config", _refuses(lambda n=name, v=value: make_config(**{n: v}), match))
+
+    def impacts_of_a_step():
+        return Simulator(*_three_balls(1.0)).step(2.0)
+
+    for key in (None, True):
+        cell(
+            f"impacts[{key}]",
+            "impacts",
+            _refuses(lambda k=key: impacts_of_a_step()[k], "impacts: index with an integer", TypeError),
+        )
+    cell("compress a box to Z = 1e9", "compress", _box_packing)
+    cell("compress without a collision", "compress", _no_collision)
+    gas = disk_gas(12, 0.3, arrangement="random", seed=0)
+    for name, scene, match in (
+        ("e = 0.5", Scene(bounds=gas.scene.bounds, elasticity=0.5), "compress bounces the disks elastically"),
+        ("stick", Scene(bounds=gas.scene.bounds, elasticity=0.0, inelastic="stick"), "use Scene(elasticity=1.0)"),
+    ):
+        compressed = lambda sc=scene: compress(sc, gas.positions, gas.radii, progress=False)  # noqa: E731
+        cell(f"compress {name}", "compress", _refuses(compressed, match))
+    cell("g(r) of a clump", "observables", _clumped_rdf)
+    for name, call, match in (
+        ("henderson_g(1)", lambda: observables.henderson_g(1.0), "packing: an area fraction"),
+        ("henderson_g(2)", lambda: observables.henderson_g(2.0), "packing: an area fraction"),
+        ("MSD lag 1.5", lambda: observables.mean_squared_displacement(np.zeros((5, 3, 2)), lags=[1.5]), "lags:"),
+        (
+            "NaN radius",
+            lambda: observables.reduced_pressure(impacts_of_a_step(), [0.2, np.nan, 0.15], 2.0, 1.0, scene=Scene()),
+            "radii: ball 1's radius must be finite and > 0",
+        ),
+    ):
+        cell(name, "observables", _refuses(call, match))
 
 
 # --------------------------------------------------------------------------- running a cell

@@ -18,7 +18,10 @@ regulariser's ``u_min``, see :mod:`collision_env.engine.physics.response`):
   same instant (the group's later sweeps) are not added. Where the group's cascade is replaced by
   its limit (``exact.contacts.settle``), a contact first reported there carries the two-body
   impulse ``(u + u') / (w_i + w_j)`` of its closing speed before and separation speed ``u'``
-  after the limit.
+  after the limit. So the group's later impulses, the collapse regulariser's push-apart among
+  them, are not in the report: a contact's impulses reported over a step are at most the momentum
+  it passes in that step, and all of it outside contact groups (an isolated impact's report
+  includes the push-apart: ``u' = u_min``).
 - In stick scenes (``inelastic="stick"``) the impulse is the plastic one of the bodies as point
   masses, at the recorded closing speed ``u`` of the contact: ``u / (1/M_i + 1/M_j)`` for two
   bodies (clusters) of masses ``M_i``, ``M_j`` that stick, ``M u`` for a body that stops dead at a
@@ -115,7 +118,13 @@ class Impacts(Sequence):
             return self.array[key]
         if isinstance(key, numbers.Integral) and not isinstance(key, (bool, np.bool_)):
             return _impact(self.array[key].tolist())
-        return Impacts(self.array[key])
+        rows = self.array[key]
+        if rows.ndim != 1:  # (None, a boolean scalar or a 2-D index would make a 2-D array of records)
+            raise TypeError(
+                "impacts: index with an integer, a slice, a field name, a bool mask of the impacts or "
+                f"a 1-D array of indices, got {key!r}"
+            )
+        return Impacts(rows)
 
     def __iter__(self) -> Iterator[Impact]:
         a = self.array

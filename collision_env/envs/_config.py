@@ -22,7 +22,7 @@ import numpy as np
 
 from collision_env.engine import MAX_SUBSTEPS, MODES
 from collision_env.engine.keywords import check_keywords
-from collision_env.engine.scene import PLAY_AREA_1D, PLAY_AREA_2D, WALL_NAMES, radius_from_mass
+from collision_env.engine.scene import MAX_MAGNITUDE, PLAY_AREA_1D, PLAY_AREA_2D, WALL_NAMES, radius_from_mass
 from collision_env.engine.validation import MAX_EVENT_CAP
 from collision_env.envs.task.layout import BALL_OBS, GLOBAL_OBS, PREDICTED_OBS, TARGET_OBS
 
@@ -87,7 +87,9 @@ class TaskConfig:
 
     The fields come in groups: the scene (passed to :class:`collision_env.engine.Scene`), the
     balls, the control, the targets, the reward, the observation, the episode and the engine.
-    Construction checks every field and raises a ``ValueError`` naming it.
+    Construction checks every field and raises a ``ValueError`` naming it. Speeds (``max_dv``,
+    ``max_speed``) and reward weights are at most 1e150 in size (the engine's ``MAX_MAGNITUDE``),
+    so that a nudge's size, a ball's speed and a reward stay finite.
     """
 
     # ---- scene
@@ -253,8 +255,8 @@ class TaskConfig:
         if self.control not in CONTROLS:
             raise ValueError(f"control: expected one of {CONTROLS}, got {self.control!r}")
         s("dt", _number("dt", self.dt, low=0.0, strict_low=True))
-        s("max_dv", _number("max_dv", self.max_dv, low=0.0))
-        s("max_speed", _number("max_speed", self.max_speed, low=0.0, strict_low=True))
+        s("max_dv", _number("max_dv", self.max_dv, low=0.0, high=MAX_MAGNITUDE))
+        s("max_speed", _number("max_speed", self.max_speed, low=0.0, strict_low=True, high=MAX_MAGNITUDE))
         s("n_targets", _number("n_targets", self.n_targets, low=1, integer=True))
         s("sequential", bool(self.sequential))
         allowed = WALL_NAMES[:2] if self.dimension == 1 else WALL_NAMES
@@ -283,7 +285,7 @@ class TaskConfig:
         if self.scorers == "cluster" and self.n_balls < 2:
             raise ValueError("scorers: 'cluster' needs at least 2 balls")
         for name in ("hit_reward", "success_bonus", "miss_penalty", "action_cost", "shaping"):
-            s(name, _number(name, getattr(self, name)))
+            s(name, _number(name, getattr(self, name), low=-MAX_MAGNITUDE, high=MAX_MAGNITUDE))
         if self.observed_balls not in OBSERVED_BALLS:
             raise ValueError(f"observed_balls: expected one of {OBSERVED_BALLS}, got {self.observed_balls!r}")
         if self.aim not in AIMS:

@@ -17,10 +17,12 @@ import numpy as np
 from numpy.typing import DTypeLike
 
 from collision_env.engine import MAX_SUBSTEPS
+from collision_env.engine.keywords import close_matches
 from collision_env.engine.modes import MODES
 from collision_env.engine.scene import WALL_NAMES
 from collision_env.envs._config import TaskConfig
 from collision_env.envs.task.arrays import Engine, TaskParams, TaskState, pack
+from collision_env.envs.task.checks import checked_task_state
 from collision_env.envs.task.episodes import block_size, build_episodes
 from collision_env.envs.task.finish import task_kernel
 from collision_env.envs.task.layout import (
@@ -195,10 +197,17 @@ def sample_episode(cfg: TaskConfig, rng: np.random.Generator) -> Episodes:
 
 
 def check_state_keys(state: Any, keys: tuple, source: str) -> None:
-    """Raise unless ``state`` is a dict holding ``keys`` (the state ``source`` gives): a
-    ``TypeError`` for anything but a mapping, a ``ValueError`` naming the missing keys."""
+    """Raise unless ``state`` is a dict holding ``keys`` (the state ``source`` gives) and nothing
+    else: a ``TypeError`` for anything but a mapping, a ``ValueError`` naming the unknown keys (each
+    with the closest of ``keys``: a misspelt key would otherwise be ignored) or the missing ones."""
     if not isinstance(state, dict):
         raise TypeError(f"set_state: expected a dict with the keys {list(keys)} ({source}), got {type(state).__name__}")
+    unknown = [key for key in state if key not in keys]
+    if unknown:
+        raise ValueError(
+            f"set_state: unknown key(s) {close_matches(unknown, keys)}; expected a dict with the keys "
+            f"{list(keys)} ({source})"
+        )
     missing = [key for key in keys if key not in state]
     if missing:
         raise ValueError(f"set_state: missing {missing}; expected a dict with the keys {list(keys)} ({source})")
@@ -445,15 +454,12 @@ class TaskCore:
         return state
 
     def set_state(self, state: dict) -> None:
+        """Restore a state from :meth:`get_state`: its keys, the task's values
+        (:func:`~collision_env.envs.task.checks.checked_task_state`) and the engine's state are all
+        checked before anything changes (raises ValueError or TypeError naming the field)."""
         check_state_keys(state, (*self._TASK_FIELDS, "engine"), "as get_state gives")
-        arrays = {}
-        for name in self._TASK_FIELDS:  # check everything before changing anything
-            arr = np.asarray(state[name])
-            if arr.shape != getattr(self.state, name).shape:
-                raise ValueError(
-                    f"set_state: field {name!r} has shape {arr.shape}, expected {getattr(self.state, name).shape}"
-                )
-            arrays[name] = arr
+        current = {name: getattr(self.state, name) for name in self._TASK_FIELDS}
+        arrays = checked_task_state(state, current, self.cfg.n_targets, tuple(self.sampler.walls.tolist()))
         self.batch.set_state(state["engine"])
         for name, arr in arrays.items():
-            np.copyto(getattr(self.state, name), arr, casting="unsafe")
+            np.copyto(current[name], arr)

@@ -59,6 +59,15 @@ def test_impacts_is_a_sequence_of_impact_tuples_over_the_records():
     assert imp != imp[1:] and imp != tuples[1:] and (imp == "impacts") is False
 
 
+@pytest.mark.parametrize("key", [None, True, False, np.True_, (None,), [[0, 1]], np.zeros((2, 2), dtype=int)])
+def test_impacts_refuse_an_index_that_is_not_one_of_rows(key):
+    # issue 39: impacts[None] and impacts[True] gave 2-D arrays of records, which no Impacts is
+    imp = _box_gas().step(1.0)
+    with pytest.raises(TypeError, match="impacts: index with an integer, a slice, a field name, a bool mask"):
+        imp[key]
+    assert len(imp[np.arange(len(imp)) % 2 == 0]) == (len(imp) + 1) // 2 and len(imp[[0, 2]]) == 2
+
+
 def test_frames_give_the_impacts_the_steps_give():
     a, b = _box_gas(seed=3), _box_gas(seed=3)
     rec = a.frames(0.05, 40)
@@ -91,6 +100,44 @@ def test_stick_impulse_is_the_plastic_impulse_of_the_bodies(mode):
     speed = abs(sim.velocities[0, 0])
     hits = [i for _ in range(200) for i in sim.step(0.1) if i.wall is not None]
     assert hits[0].impulse == pytest.approx(2.0 * speed, rel=1e-12)  # the cluster (2 kg) stops dead
+
+
+@pytest.mark.parametrize("mode", MODES)
+def test_the_collapse_regularisers_push_apart_is_in_the_reported_impulse(mode):
+    # e = 0, touching balls closing at 1e-10 m/s, below u_min (1e-9 of their speed, ~1.4e-9 m/s):
+    # the response sets them apart at u_min, and the impulse reported is the one applied
+    scene = Scene(elasticity=0.0)
+    sim = Simulator(
+        scene, [[0.0, 0.0], [0.4, 0.0]], [[1.0, 1.0], [1.0 - 1e-10, 1.0]], [1.0, 3.0], [0.2, 0.2], mode=mode
+    )
+    v0 = sim.velocities
+    (pair,) = sim.step(0.1)
+    applied = 3.0 * abs(sim.velocities[1, 0] - v0[1, 0])
+    assert pair.impulse == pytest.approx(applied, rel=1e-6)
+    assert sim.velocities[1, 0] - sim.velocities[0, 0] > 0.0  # (apart, not merely stopped)
+    assert pair.impulse > 0.75 * pair.speed * 1.5  # (more than the plastic mu u: the push-apart is in it)
+
+
+@pytest.mark.parametrize("e", [0.0, 0.5, 1.0])
+def test_a_contacts_reported_impulses_are_at_most_the_momentum_it_passes(e):
+    # a 1D row of 4 touching balls against the right wall, hit by a fifth: the momentum contact k
+    # passes rightwards in the step (ball k to k + 1, the last to the wall) is J_k = -sum_{i <= k} dp_i.
+    # A contact group reports each contact's first impulse only (impacts.py): at most J_k, and
+    # all of it outside groups (e = 1)
+    n, r = 5, 0.1
+    pos = [[0.0, 0.0]] + [[2.0 - r - 2 * r * k, 0.0] for k in range(n - 1)][::-1]
+    vel = [[1.0, 0.0]] + [[0.0, 0.0]] * (n - 1)
+    sim = Simulator(Scene(bounds=PLAY_AREA_1D, dimension=1, elasticity=e), pos, vel, np.ones(n), np.full(n, r))
+    v0 = sim.velocities
+    imp = sim.step(1.5)
+    passed = -np.cumsum(sim.velocities[:, 0] - v0[:, 0])
+    reported = np.zeros(n)
+    for i in imp:
+        assert i.other is None or abs(i.other - i.ball) == 1
+        reported[i.ball if i.other is None else min(i.ball, i.other)] += i.impulse
+    assert (reported > 0.0).all() and (reported <= passed * (1 + 1e-9)).all()
+    if e == 1.0:
+        np.testing.assert_allclose(reported, passed, rtol=1e-12)
 
 
 @settings(max_examples=40, deadline=None)

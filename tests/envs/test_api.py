@@ -2,6 +2,7 @@
 
 import copy
 import importlib.util
+import math
 import pickle
 import re
 import warnings
@@ -323,3 +324,23 @@ def test_episode_lengths_and_event_caps_beyond_what_is_counted_exactly_are_refus
     # (these raised OverflowError, naming no field, when the step counter or the cap was stored)
     with pytest.raises(ValueError, match=message):
         gym.make("CollisionEnv/OneBallTarget-v0", **kwargs)
+
+
+@pytest.mark.parametrize(
+    "field", ["max_dv", "max_speed", "hit_reward", "success_bonus", "miss_penalty", "action_cost", "shaping"]
+)
+def test_speeds_and_reward_weights_beyond_the_engines_range_are_refused_by_name(field):
+    # issue 39: max_dv=1e300 squared to inf in the nudge's size, and the reward was -inf
+    with pytest.raises(ValueError, match=rf"{field}: must be <= 1e\+150, got 1e\+300"):
+        gym.make("CollisionEnv/OneBallTarget-v0", **{field: 1e300})
+    if field not in ("max_dv", "max_speed"):
+        with pytest.raises(ValueError, match=rf"{field}: must be >= -1e\+150, got -1e\+300"):
+            gym.make("CollisionEnv/OneBallTarget-v0", **{field: -1e300})
+
+
+def test_the_largest_nudge_and_action_cost_give_finite_rewards():
+    env = gym.make("CollisionEnv/OneBallTarget-v0", max_dv=1e150, action_cost=1e150, shaping=1e150)
+    env.reset(seed=0)
+    for _ in range(20):
+        obs, reward, *_ = env.step(np.ones(env.action_space.shape, dtype=np.float32))
+        assert np.isfinite(obs).all() and math.isfinite(reward) and reward < -1e299

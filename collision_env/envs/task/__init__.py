@@ -11,5 +11,6 @@ A control step of an env (a batch of scenes, one for the single env) is:
    reports.
 
 Resets draw start states with :mod:`~.episodes`. The task's packed arrays are named in
-:mod:`~.layout` and handed to the kernels as named bundles (:mod:`~.arrays`).
+:mod:`~.layout` and handed to the kernels as named bundles (:mod:`~.arrays`); :mod:`~.checks` checks
+a task state handed to ``set_state``.
 """
