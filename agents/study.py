@@ -42,6 +42,7 @@ from pathlib import Path
 from agents.config import UsageError, as_int, check_env_id, hyperparams_for, read_run, run_cli
 from agents.evaluate import pct
 from collision_env.bench.machine import cpus, machine, timestamp, versions
+from collision_env.bench.readme import write_outputs
 from collision_env.engine import MODES
 
 DEFAULT_ENVS = ("CollisionEnv/Crowd-v0",)
@@ -73,8 +74,9 @@ def train_and_evaluate(task: dict) -> dict:
     evaluate in exact mode and, if different, in the training mode. Runs in a worker process."""
     import torch
 
+    from agents.config import run_label
     from agents.evaluate import evaluate
-    from agents.train_ppo import run_label, train
+    from agents.train_ppo import train
 
     torch.set_num_threads(1)
     env_kwargs = task.get("env_kwargs") or {}
@@ -441,8 +443,6 @@ def plot(rows: list, path: Path) -> Path | None:
 
 def render(data: dict, docs: Path, readme: Path | None) -> None:
     """Write the tables (and plot) from the study's JSON, and the README block."""
-    from collision_env.bench.readme import write_block
-
     docs.mkdir(parents=True, exist_ok=True)
     meta = data["meta"]
     stamp = (
@@ -476,7 +476,7 @@ def render(data: dict, docs: Path, readme: Path | None) -> None:
             parts.append(split)
         if advice:
             parts.append(advice)
-        write_block(readme, README_BLOCK, "\n\n".join(parts))
+        write_outputs("\n\n".join(parts), markdown=readme, block=README_BLOCK, echo=False)
 
 
 # --------------------------------------------------------------------------------------- main
@@ -607,7 +607,7 @@ def main(argv: list[str] | None = None) -> dict:
         "baselines": base,
     }
     docs.mkdir(parents=True, exist_ok=True)
-    (docs / "study.json").write_text(json.dumps(data, indent=1))
+    write_outputs("", data, json_path=docs / "study.json", echo=False)
     render(data, docs, readme)
     print(modes_table(rows))
     print()
