@@ -464,10 +464,16 @@ def _verdict_text(found: list) -> str:
             if any(m["verdict"] == verdict for m in c["cheap"])
         )
 
-    pays, costs = where("pays"), where("costs")
+    pays, costs, idle = where("pays"), where("costs"), where("no gain")
     out = []
     if pays:
         out.append(f"Training cheap **paid** (faster, exact-evaluated success within the seed spread) on {pays}.")
+    if idle:
+        out.append(
+            f"It **did not pay** (no faster than exact) on {idle}: where few events happen per step, exact mode "
+            "jumps from one to the next while a cheap mode works through every sub-step (and every sub-step of "
+            "the look-ahead of a predicted observation)."
+        )
     if costs:
         out.append(
             f"It **cost** exact-evaluated success beyond the seed spread on {costs}: there the cheap mode's "

@@ -19,8 +19,9 @@ class PegsEnv(CollisionTargetEnv):
     posteriori step that jumps a whole contact lets the ball pass through a peg (tunnelling), and a
     naive step reports a wall impact up to 0.5 m from where the ball really met the wall, more
     than the target is wide. A shot planned in a cheap mode that goes through a peg or lands on a
-    target only by those errors misses when the impacts are exact (`agents.study` measures what
-    training cheaply costs here). `CollisionEnv/Pegs-v0`; the generic env with `preset="pegs"`.
+    target only by those errors misses when the impacts are exact (`tests/envs/test_pegs.py`); a
+    policy that re-aims at every step can make up for them (`agents.study` measures what training
+    cheaply costs here). `CollisionEnv/Pegs-v0`; the generic env with `preset="pegs"`.
 
     ## Action Space
 
