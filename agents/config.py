@@ -14,9 +14,11 @@ import ast
 import difflib
 import math
 import os
+import shutil
 import sys
 import time
 from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, TypeVar, cast
 
@@ -97,6 +99,19 @@ def parse_env_kwargs(pairs: list[str] | None) -> dict:
         except yaml.YAMLError:
             raise UsageError(f"--env-kwargs: cannot read the value of {pair!r}") from None
     return check_env_kwargs(out)
+
+
+def merge_env_kwargs(
+    entry_kwargs: dict | None, env_kwargs: dict | None, mode: str | None = None, substeps: int | None = None
+) -> dict:
+    """A run's env keywords: the hyperparameter entry's ``env_kwargs``, overridden by the caller's,
+    overridden by ``mode`` and ``substeps`` when given (each mapping checked first)."""
+    kwargs = {**check_env_kwargs(entry_kwargs or {}), **check_env_kwargs(env_kwargs or {})}
+    if mode is not None:
+        kwargs["mode"] = mode
+    if substeps is not None:
+        kwargs["substeps"] = substeps
+    return kwargs
 
 
 def episode_steps(env_id: str, env_kwargs: dict) -> int:
@@ -343,6 +358,51 @@ def track(items: Iterable[T], total: int, desc: str, bar: bool | None = None, un
 
 
 # ----------------------------------------------------------------------------------- run folders
+def run_label(env_id: str, mode: str, substeps: int, seed: int) -> str:
+    """``oneballtarget-posteriori4-s0``: what a run folder's name starts with."""
+    name = env_id.split("/")[-1].rsplit("-v", 1)[0].lower()
+    knob = f"{mode}{substeps}" if substeps != 1 else mode
+    return f"{name}-{knob}-s{seed}"
+
+
+def default_run_name(env_id: str, mode: str, substeps: int, seed: int) -> str:
+    """:func:`run_label` and the time: ``oneballtarget-exact-s0-20260101-120000``."""
+    return f"{run_label(env_id, mode, substeps, seed)}-{time.strftime('%Y%m%d-%H%M%S')}"
+
+
+def make_run_dir(
+    output: str | Path, run_name: str | None, env_id: str, env_kwargs: dict, seed: int, overwrite: bool
+) -> Path:
+    """The run folder ``output/run_name`` (default :func:`default_run_name` of the run's mode and
+    substeps in ``env_kwargs``), made empty: an existing non-empty one is a UsageError unless
+    ``overwrite``, and then nothing of the earlier run survives into this one."""
+    mode, substeps = env_kwargs.get("mode", "exact"), int(env_kwargs.get("substeps", 1))
+    run_dir = Path(output) / (run_name or default_run_name(env_id, mode, substeps, seed))
+    if run_dir.exists() and any(run_dir.iterdir()):
+        if not overwrite:
+            raise UsageError(f"run folder {run_dir} exists and is not empty (pass --overwrite to replace it)")
+        shutil.rmtree(run_dir)
+    run_dir.mkdir(parents=True, exist_ok=True)
+    return run_dir
+
+
+@contextmanager
+def log_tee(log: Callable[[str], None], path: Path | None) -> Iterator[Callable[[str], None]]:
+    """A logger that calls ``log`` and also appends each line to the file ``path`` (flushed); the file
+    is closed when the block ends, on an error too. ``path`` None: ``log`` itself."""
+    if path is None:
+        yield log
+        return
+    with path.open("a") as fh:
+
+        def say(line: str) -> None:
+            log(line)
+            fh.write(line + "\n")
+            fh.flush()
+
+        yield say
+
+
 def read_run(run_dir: str | Path) -> dict:
     """The resolved config of a run folder (UsageError if it is not one)."""
     run_dir = Path(run_dir)

@@ -25,7 +25,6 @@ naive mode's (wrong) impacts, which is part of what such an evaluation measures.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import time
 from collections.abc import Callable
@@ -53,6 +52,7 @@ from agents.config import (
     track,
 )
 from agents.train_rllib import ALGORITHM, CHECKPOINT_DIR, quiet_ray_logs
+from collision_env.bench.readme import write_outputs
 from collision_env.engine import MODES
 from collision_env.extras import require
 
@@ -437,9 +437,8 @@ def main(argv: list[str] | None = None) -> dict:
         model=args.model,
         progress=args.progress,
     )
-    print(markdown(results))
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(results, indent=1))
+    write_outputs(markdown(results), results, json_path=out)
     print(f"results: {out}")
     for video in videos:
         path = record(

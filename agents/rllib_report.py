@@ -23,6 +23,7 @@ from pathlib import Path
 
 from agents.config import CONFIG_FILE, load_yaml, run_cli
 from agents.train_rllib import DEFAULT_ENV, HYPERPARAMS
+from collision_env.bench.readme import write_outputs
 
 BLOCK = "agents:rllib"
 
@@ -158,11 +159,7 @@ def main(argv: list[str] | None = None) -> str:
         run, results = training_run(args.env, Path(tmp))
     cluster = load_yaml(Path(args.cluster) / CONFIG_FILE) if args.cluster else None
     text = block(args.env, rates, run, results, cluster, time.perf_counter() - start)
-    print(text)
-    if args.markdown:
-        from collision_env.bench.readme import write_block
-
-        write_block(args.markdown, BLOCK, text)
+    write_outputs(text, markdown=args.markdown, block=BLOCK)
     return text
 
 

@@ -1,17 +1,20 @@
 """Train cheap, evaluate exact: what the engine's fidelity mode costs and buys a PPO agent.
 
-    python -m agents.study --jobs 2                      # both parts, 3 seeds each (hours on 2 cores)
+    python -m agents.study --jobs 2                      # both parts, 3 seeds each (many hours on 2 cores)
     python -m agents.study --part modes --envs CollisionEnv/Line1D-v0 --modes naive:1 exact:1 --seeds 0
     python -m agents.study --part presets --presets CollisionEnv/Billiards-v0 --add
 
-Part **modes**: each preset of ``--envs`` (default ``Crowd``, the preset where the engine does most of
-a training step's work: a cheaper mode can only save the engine's share of the time) is trained
-with the shipped hyperparameters under each engine mode (``mode:substeps``), over several seeds;
-every policy is then evaluated deterministically in **exact** mode (and in its own training mode)
-on the same 100 episodes. The table gives success per seed, its mean and spread, the wall-clock
-training time and the engine's share of it, so the trade is read off directly: is a policy trained
-on a cheaper, less exact engine as good when the impacts are exact, and how much training time did
-the cheaper engine save?
+Part **modes**: each preset of ``--envs`` (default: every preset) is trained with the shipped
+hyperparameters under each engine mode of ``--modes`` (``mode:substeps``, default naive k=1,
+posteriori k=1, posteriori k=4 and exact), over several seeds; every policy is then evaluated
+deterministically in **exact** mode (and in its own training mode) on the same 100 episodes. The
+tables give success per seed, its mean and spread, the wall-clock training time and the engine's
+share of it, so the trade is read off directly: is a policy trained on a cheaper, less exact engine
+as good when the impacts are exact, and how much training time did the cheaper engine save? The
+trade table sums it up per preset, the Pareto figure (``pareto.png``) sets training time against
+exact-evaluated success, and the rule says, from the same figures, where training cheap pays and
+where it costs points (``Pegs``, the preset built for it: small, fast balls, narrow targets, long
+control steps).
 
 Part **presets**: every registered preset is trained in exact mode over the same seeds and set
 beside the random and the scripted (exact-aim) baselines on the same evaluation episodes; a preset
@@ -22,7 +25,8 @@ Every run records where its training time went (``agents.timing``); the time-spl
 and the closing rule says when a cheaper engine mode can pay. ``--add`` adds runs to an earlier
 study's ``study.json`` (a cell run again replaces its figures), so a study can be run in parts.
 
-Writes ``study.json`` (every figure), ``modes.md``, ``presets.md``, ``time_split.md`` and ``modes.png`` into
+Writes ``study.json`` (every figure), ``modes.md``, ``presets.md``, ``time_split.md``, ``modes.png`` and
+``pareto.png`` into
 ``--docs`` (default ``docs/agents``: the site's agents pages), and with ``--readme`` the tables into a
 page's ``agents:study`` block too. Training runs go to ``--output`` (default ``runs/study``). With
 ``--jobs 2`` two runs train at once (one core each), as every figure on those pages was measured.
@@ -42,10 +46,10 @@ from pathlib import Path
 from agents.config import UsageError, as_int, check_env_id, hyperparams_for, read_run, run_cli
 from agents.evaluate import pct
 from collision_env.bench.machine import cpus, machine, timestamp, versions
+from collision_env.bench.readme import write_outputs
 from collision_env.engine import MODES
 
-DEFAULT_ENVS = ("CollisionEnv/Crowd-v0",)
-DEFAULT_MODES = ("naive:1", "posteriori:1", "exact:1")
+DEFAULT_MODES = ("naive:1", "posteriori:1", "posteriori:4", "exact:1")
 DEFAULT_SEEDS = (0, 1, 2)
 README_BLOCK = "agents:study"
 
@@ -73,8 +77,9 @@ def train_and_evaluate(task: dict) -> dict:
     evaluate in exact mode and, if different, in the training mode. Runs in a worker process."""
     import torch
 
+    from agents.config import run_label
     from agents.evaluate import evaluate
-    from agents.train_ppo import run_label, train
+    from agents.train_ppo import train
 
     torch.set_num_threads(1)
     env_kwargs = task.get("env_kwargs") or {}
@@ -211,20 +216,46 @@ def modes_table(rows: list) -> str:
     return "\n\n".join(tables)
 
 
-def modes_reading(rows: list) -> str:
-    """What the modes tables say, in words generated from the same figures."""
+def _mean_exact(rows: list) -> float:
+    return statistics.fmean(r["exact"]["success_rate"] for r in rows)
+
+
+def comparisons(rows: list) -> list[dict]:
+    """Per preset of the modes part that has exact-trained runs and cheaper ones: the exact-trained
+    mean exact-evaluated success ``ref``, the largest standard deviation over seeds of any of its
+    modes ``spread``, the engine's share of exact training ``f``, and per cheaper mode (``cheap``,
+    in run order) its exact-evaluated success, its loss against ``ref``, how many times as fast it
+    trained, and the verdict: ``"costs"`` (a loss beyond the spread), ``"pays"`` (faster, no such
+    loss) or ``"no gain"``."""
     out = []
     for env_id, groups in _by_env_and_mode(rows).items():
         exact_rows = groups.get(("exact", 1))
         cheap = {key: rs for key, rs in groups.items() if key != ("exact", 1)}
         if not exact_rows or not cheap:
             continue
-        ref = statistics.fmean(r["exact"]["success_rate"] for r in exact_rows)
-        diffs = [statistics.fmean(r["exact"]["success_rate"] for r in rs) - ref for rs in cheap.values()]
+        ref = _mean_exact(exact_rows)
         spread = max(
             statistics.stdev([r["exact"]["success_rate"] for r in rs]) if len(rs) > 1 else 0.0 for rs in groups.values()
         )
-        ratios = [_seconds(rs) / _seconds(exact_rows) for rs in cheap.values()]
+        modes = []
+        for (mode, k), rs in cheap.items():
+            success = _mean_exact(rs)
+            loss, speed = ref - success, _seconds(exact_rows) / _seconds(rs)
+            verdict = "costs" if loss > spread and loss >= 0.01 else "pays" if speed > 1.0 else "no gain"
+            modes.append(
+                {"mode": mode, "substeps": k, "success": success, "loss": loss, "speed": speed, "verdict": verdict}
+            )
+        out.append({"env_id": env_id, "ref": ref, "spread": spread, "f": _engine_share(exact_rows), "cheap": modes})
+    return out
+
+
+def modes_reading(rows: list) -> str:
+    """What the modes tables say, in words generated from the same figures."""
+    out = []
+    for c in comparisons(rows):
+        ref, spread = c["ref"], c["spread"]
+        diffs = [-m["loss"] for m in c["cheap"]]
+        ratios = [1 / m["speed"] for m in c["cheap"]]
         worst = min(diffs)
         verdict = (
             "within the seed-to-seed spread"
@@ -234,12 +265,42 @@ def modes_reading(rows: list) -> str:
             else "no worse"
         )
         out.append(
-            f"- `{env_id}`: policies trained in the cheaper modes succeed in exact mode "
+            f"- `{c['env_id']}`: policies trained in the cheaper modes succeed in exact mode "
             f"{pct(ref + min(diffs))}–{pct(ref + max(diffs))} against exact-trained {pct(ref)}, "
             f"{verdict} (largest standard deviation over seeds {100 * spread:.0f} points), after "
             f"{min(ratios):.2f}–{max(ratios):.2f}× exact mode's training time."
         )
     return "\n".join(out)
+
+
+def trade_table(rows: list) -> str:
+    """One row per preset of the modes part, one column per training mode: the trade at a glance."""
+    envs = _by_env_and_mode(rows)
+    if not envs:
+        return ""
+    keys = {key for groups in envs.values() for key in groups}
+    modes = sorted(keys, key=lambda key: (key == ("exact", 1), key))  # cheaper modes by name, exact last
+    lines = [
+        "The trade, per preset: success of the policies trained in each mode, evaluated exact (mean over seeds; "
+        "in brackets: evaluated in the mode they trained in), and their median training time; the engine's share "
+        "is that of exact training.",
+        "",
+        "| env | engine's share | " + " | ".join(_label(m, k) for m, k in modes) + " |",
+        "|---|---:|" + "---:|" * len(modes),
+    ]
+    for env_id, groups in envs.items():
+        cells = []
+        for key in modes:
+            rs = groups.get(key)
+            if not rs:
+                cells.append("")
+                continue
+            own = statistics.fmean(r["own"]["success_rate"] for r in rs)
+            cells.append(f"{pct(_mean_exact(rs))} ({pct(own)}), {_seconds(rs):.0f} s")
+        exact_rows = groups.get(("exact", 1))
+        share = _share(_engine_share(exact_rows)) if exact_rows else "n/a"
+        lines.append(f"| `{env_id}` | {share} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
 
 
 @functools.cache
@@ -349,26 +410,20 @@ def split_table(rows: list) -> str:
 
 
 def rule(rows: list, base: list) -> str:
-    """The rule for choosing a training mode, stated with this study's figures."""
+    """The rule for choosing a training mode, stated with this study's figures: where training cheap
+    paid (faster, no exact-evaluated loss beyond the seed spread) and where it cost points."""
     measured = {env: _engine_share(rs) for (env, setting), rs in _by_preset(rows, base).items() if _shipped(rs[0])}
     shares = {env: f for env, f in measured.items() if f is not None}
+    found = comparisons(rows)
     lines = []
-    for env_id, groups in _by_env_and_mode(rows).items():
-        exact_rows = groups.get(("exact", 1))
-        if not exact_rows:
-            continue
-        ref = statistics.fmean(r["exact"]["success_rate"] for r in exact_rows)
-        f = _engine_share(exact_rows)
-        for (mode, k), rs in groups.items():
-            if (mode, k) == ("exact", 1):
-                continue
-            speed = _seconds(exact_rows) / _seconds(rs)
-            loss = ref - statistics.fmean(r["exact"]["success_rate"] for r in rs)
-            points = round(100 * loss)
+    for c in found:
+        for m in c["cheap"]:
+            points = round(100 * m["loss"])
             change = f"loses {points}" if points > 0 else f"gains {-points}" if points < 0 else "loses no"
             lines.append(
-                f"`{env_id}` ({_share(f)} of exact training in the engine): {_label(mode, k)} trains "
-                f"{speed:.2f}× as fast and {change} points of exact-evaluated success"
+                f"`{c['env_id']}` ({_share(c['f'])} of exact training in the engine): "
+                f"{_label(m['mode'], m['substeps'])} trains {m['speed']:.2f}× as fast and {change} points of "
+                "exact-evaluated success"
             )
     if not shares and not lines:
         return ""
@@ -385,9 +440,98 @@ def rule(rows: list, base: list) -> str:
             + "; ".join(f"`{env}` f = {_share(f)} (at most {1 / max(1 - f, 1e-9):.1f}×)" for env, f in shares.items())
             + "."
         )
+    verdicts = _verdict_text(found)
+    if verdicts:
+        text += "\n\n" + verdicts
     if lines:
         text += "\n\n" + "\n".join(f"- {line}." for line in lines)
     return text
+
+
+def _verdict_text(found: list) -> str:
+    """Where training cheap paid and where it cost points, in one sentence each, from :func:`comparisons`."""
+
+    def where(verdict: str) -> str:
+        return "; ".join(
+            f"`{c['env_id']}` ("
+            + ", ".join(
+                f"{_label(m['mode'], m['substeps'])} {-round(100 * m['loss']):+d} points at {m['speed']:.2f}×"
+                for m in c["cheap"]
+                if m["verdict"] == verdict
+            )
+            + ")"
+            for c in found
+            if any(m["verdict"] == verdict for m in c["cheap"])
+        )
+
+    pays, costs, idle = where("pays"), where("costs"), where("no gain")
+    out = []
+    if pays:
+        out.append(f"Training cheap **paid** (faster, exact-evaluated success within the seed spread) on {pays}.")
+    if idle:
+        out.append(
+            f"It **did not pay** (no faster than exact) on {idle}: where few events happen per step, exact mode "
+            "jumps from one to the next while a cheap mode works through every sub-step (and every sub-step of "
+            "the look-ahead of a predicted observation)."
+        )
+    if costs:
+        out.append(
+            f"It **cost** exact-evaluated success beyond the seed spread on {costs}: there the cheap mode's "
+            "errors (tunnelling, late or misplaced impacts) change outcomes, so train exact or with more sub-steps."
+        )
+    elif found:
+        out.append("No preset here lost exact-evaluated success beyond the seed spread by training cheap.")
+    return " ".join(out)
+
+
+def pareto_plot(rows: list, path: Path) -> Path | None:
+    """Training time (median over seeds) against exact-evaluated success (mean, with the seeds' standard
+    deviation), one point per preset and training mode, each preset's modes joined in order of time and
+    its Pareto front (no other mode of the preset both faster and better) drawn solid."""
+    envs = _by_env_and_mode(rows)
+    if not envs:
+        return None
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.ticker import FuncFormatter
+
+    markers = dict(zip(("naive", "posteriori", "substep", "cells", "exact"), "v^sDo", strict=False))
+    fig, ax = plt.subplots(figsize=(8, 5))
+    for i, (env_id, groups) in enumerate(envs.items()):
+        color = f"C{i % 10}"
+        points = []
+        for (mode, k), rs in groups.items():
+            exact = [100 * r["exact"]["success_rate"] for r in rs]
+            sd = statistics.stdev(exact) if len(exact) > 1 else 0.0
+            points.append((_seconds(rs), statistics.fmean(exact), sd, mode, k))
+        points.sort()
+        front, best = [], -1.0
+        for t, y, *_ in points:
+            if y > best:
+                front.append((t, y))
+                best = y
+        ax.plot([p[0] for p in points], [p[1] for p in points], color=color, alpha=0.3, lw=1)
+        ax.plot(*zip(*front, strict=True), color=color, lw=1.5, label=env_id.split("/")[-1])
+        for t, y, sd, mode, k in points:
+            ax.errorbar(t, y, yerr=sd, color=color, marker=markers.get(mode, "o"), ms=7, capsize=2)
+            ax.annotate(_label(mode, k), (t, y), textcoords="offset points", xytext=(5, 4), fontsize=7, color=color)
+    ax.set_xscale("log")
+    seconds = FuncFormatter(lambda x, _: f"{x:g}")  # 50, 100, 200 rather than 5 x 10^1
+    ax.xaxis.set_major_formatter(seconds)
+    ax.xaxis.set_minor_formatter(seconds)
+    ax.set_xlabel("training time per seed (s, median; log scale)")
+    ax.set_ylabel("success evaluated exact (%, mean ± sd over seeds)")
+    ax.set_ylim(-3, 105)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="lower right", title="preset (solid: its Pareto front)", title_fontsize=8)
+    ax.set_title("Train cheap, evaluate exact: training time against exact-evaluated success", fontsize=10)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
 
 
 def plot(rows: list, path: Path) -> Path | None:
@@ -441,8 +585,6 @@ def plot(rows: list, path: Path) -> Path | None:
 
 def render(data: dict, docs: Path, readme: Path | None) -> None:
     """Write the tables (and plot) from the study's JSON, and the README block."""
-    from collision_env.bench.readme import write_block
-
     docs.mkdir(parents=True, exist_ok=True)
     meta = data["meta"]
     stamp = (
@@ -453,16 +595,25 @@ def render(data: dict, docs: Path, readme: Path | None) -> None:
     presets = presets_table(data["rows"], data["baselines"])
     split = split_table(data["rows"])
     advice = rule(data["rows"], data["baselines"])
+    trade = trade_table(data["rows"])
     png = plot(data["rows"], docs / "modes.png")
+    pareto = pareto_plot(data["rows"], docs / "pareto.png")
     if modes:
         reading = modes_reading(data["rows"])
-        (docs / "modes.md").write_text(f"# Train cheap, evaluate exact\n\n{stamp}\n\n{modes}\n\n{reading}\n")
+        figure = "\n\n![training time against exact-evaluated success](pareto.png)" if pareto else ""
+        (docs / "modes.md").write_text(
+            f"# Train cheap, evaluate exact\n\n{stamp}\n\n{trade}{figure}\n\n{modes}\n\n{reading}\n\n{advice}\n"
+        )
     if presets:
         (docs / "presets.md").write_text(f"# Every preset against the baselines\n\n{stamp}\n\n{presets}\n")
     if split:
         (docs / "time_split.md").write_text(f"# Where the training time goes\n\n{stamp}\n\n{split}\n")
     if readme is not None:
         parts = [stamp]
+        if trade:
+            parts.append(trade)
+        if pareto is not None:
+            parts.append(f"![training time against exact-evaluated success]({os.path.relpath(pareto, readme.parent)})")
         if modes:
             parts.append(modes)
             reading = modes_reading(data["rows"])
@@ -476,7 +627,7 @@ def render(data: dict, docs: Path, readme: Path | None) -> None:
             parts.append(split)
         if advice:
             parts.append(advice)
-        write_block(readme, README_BLOCK, "\n\n".join(parts))
+        write_outputs("\n\n".join(parts), markdown=readme, block=README_BLOCK, echo=False)
 
 
 # --------------------------------------------------------------------------------------- main
@@ -487,7 +638,7 @@ def build_parser() -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--part", choices=("modes", "presets", "both"), default="both")
-    p.add_argument("--envs", nargs="+", default=list(DEFAULT_ENVS), help="presets of the modes part")
+    p.add_argument("--envs", nargs="+", help="presets of the modes part (default: every preset)")
     p.add_argument("--modes", nargs="+", default=list(DEFAULT_MODES), metavar="MODE:K")
     p.add_argument("--presets", nargs="+", help="ids of the presets part (default: every preset)")
     p.add_argument("--seeds", nargs="+", type=int, default=list(DEFAULT_SEEDS))
@@ -538,7 +689,7 @@ def main(argv: list[str] | None = None) -> dict:
     unique = lambda items: list(dict.fromkeys(items))  # noqa: E731  (a repeated cell would train twice)
     modes = unique(parse_mode(m) for m in args.modes)
     presets = unique(check_env_id(e) for e in (args.presets or PRESET_IDS.values()))
-    envs = unique(check_env_id(e) for e in args.envs)
+    envs = unique(check_env_id(e) for e in (args.envs or PRESET_IDS.values()))
     seeds = unique(as_int("seeds", s, low=0) for s in args.seeds)
     as_int("jobs", args.jobs)
     if args.timesteps is not None:
@@ -607,7 +758,7 @@ def main(argv: list[str] | None = None) -> dict:
         "baselines": base,
     }
     docs.mkdir(parents=True, exist_ok=True)
-    (docs / "study.json").write_text(json.dumps(data, indent=1))
+    write_outputs("", data, json_path=docs / "study.json", echo=False)
     render(data, docs, readme)
     print(modes_table(rows))
     print()

@@ -49,11 +49,13 @@ from agents.config import (
     add_progress_flags,
     as_int,
     check_env_id,
-    check_env_kwargs,
     episode_steps,
     hyperparams_for,
     is_run_config,
     load_yaml,
+    log_tee,
+    make_run_dir,
+    merge_env_kwargs,
     normalize_settings,
     parse_env_kwargs,
     ppo_kwargs,
@@ -243,17 +245,6 @@ def _progress_log(total: int, log, every: float = 0.1):
     return ProgressLog()
 
 
-def run_label(env_id: str, mode: str, substeps: int, seed: int) -> str:
-    """``oneballtarget-posteriori4-s0``: what a run folder's name starts with."""
-    name = env_id.split("/")[-1].rsplit("-v", 1)[0].lower()
-    knob = f"{mode}{substeps}" if substeps != 1 else mode
-    return f"{name}-{knob}-s{seed}"
-
-
-def default_run_name(env_id: str, mode: str, substeps: int, seed: int) -> str:
-    return f"{run_label(env_id, mode, substeps, seed)}-{time.strftime('%Y%m%d-%H%M%S')}"
-
-
 class Tuned(NamedTuple):
     """What :func:`tuned_ppo` returns: the model, and the steps its entry trains for."""
 
@@ -281,7 +272,13 @@ class _Settings(NamedTuple):
 
 
 def _settings(
-    env_id: str, hyperparams: str | Path, n_envs: int | None, timesteps: float | None, env_kwargs: dict
+    env_id: str,
+    hyperparams: str | Path,
+    n_envs: int | None,
+    timesteps: float | None,
+    env_kwargs: dict,
+    mode: str | None = None,
+    substeps: int | None = None,
 ) -> _Settings:
     """The entry of ``env_id`` in ``hyperparams``, with the given overrides, every value checked
     (a UsageError names the first bad one) before anything is built."""
@@ -289,7 +286,7 @@ def _settings(
     hp = hyperparams_for(env_id, hyperparams)
     n_envs = as_int("n_envs", n_envs if n_envs is not None else hp.get("n_envs", 8))
     asked = as_int("timesteps", timesteps if timesteps is not None else hp.get("n_timesteps", 1e6))
-    kwargs = {**check_env_kwargs(hp.get("env_kwargs") or {}), **check_env_kwargs(env_kwargs)}
+    kwargs = merge_env_kwargs(hp.get("env_kwargs"), env_kwargs, mode, substeps)
     steps = episode_steps(env_id, kwargs)  # validates every env kwarg
     algo_kwargs = ppo_kwargs(hp)  # validates every PPO keyword
     rollout = n_envs * as_int("n_steps", algo_kwargs.get("n_steps", 2048))
@@ -419,12 +416,7 @@ def train(
     log = log or _print
     if vec_env not in VEC_ENVS:
         raise UsageError(f"--vec-env: expected one of {VEC_ENVS}, got {vec_env!r}")
-    kwargs = dict(check_env_kwargs(env_kwargs or {}))
-    if mode is not None:
-        kwargs["mode"] = mode
-    if substeps is not None:
-        kwargs["substeps"] = substeps
-    settings = _settings(env_id, hyperparams, n_envs, timesteps, kwargs)
+    settings = _settings(env_id, hyperparams, n_envs, timesteps, env_kwargs or {}, mode, substeps)
     seed = as_int("seed", seed, low=0)
     eval_freq = as_int("eval_freq", eval_freq, low=0)
     save_freq = as_int("save_freq", save_freq, low=0)
@@ -434,12 +426,7 @@ def train(
     mode = kwargs.get("mode", "exact")
     substeps = int(kwargs.get("substeps", 1))
 
-    run_dir = Path(output) / (run_name or default_run_name(env_id, mode, substeps, seed))
-    if run_dir.exists() and any(run_dir.iterdir()):
-        if not overwrite:
-            raise UsageError(f"run folder {run_dir} exists and is not empty (pass --overwrite to replace it)")
-        shutil.rmtree(run_dir)  # nothing of an earlier run may survive into this one
-    run_dir.mkdir(parents=True, exist_ok=True)
+    run_dir = make_run_dir(output, run_name, env_id, kwargs, seed, overwrite)
 
     callbacks_cfg = {"eval_freq": eval_freq, "eval_episodes": eval_episodes, "save_freq": save_freq}
     config = {
@@ -489,20 +476,11 @@ def train(
     timer = time_split(venv)
     callbacks.append(timer)
     start = time.perf_counter()
-    log_file = None
-    if not progress:  # no bar: progress lines in the log instead (and in train.log)
-        log_file = (run_dir / LOG_FILE).open("a")
-
-        def log_line(line: str) -> None:
-            log(line)
-            log_file.write(line + "\n")
-            log_file.flush()
-
-        callbacks.append(_progress_log(timesteps, log_line))
-    model.learn(total_timesteps=timesteps, callback=callbacks, progress_bar=progress, tb_log_name="ppo")
+    with log_tee(log, None if progress else run_dir / LOG_FILE) as log_line:
+        if not progress:  # no bar: progress lines in the log instead (and in train.log)
+            callbacks.append(_progress_log(timesteps, log_line))
+        model.learn(total_timesteps=timesteps, callback=callbacks, progress_bar=progress, tb_log_name="ppo")
     seconds = time.perf_counter() - start
-    if log_file is not None:
-        log_file.close()
     model.save(run_dir / MODEL_FILE)
     if norm is not None:
         venv.save(str(run_dir / VECNORMALIZE_FILE))  # type: ignore[attr-defined]

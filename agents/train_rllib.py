@@ -28,7 +28,6 @@ import argparse
 import logging
 import os
 import platform
-import shutil
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -42,9 +41,11 @@ from agents.config import (
     UsageError,
     as_int,
     check_env_id,
-    check_env_kwargs,
     episode_steps,
     hyperparams_for,
+    log_tee,
+    make_run_dir,
+    merge_env_kwargs,
     parse_env_kwargs,
     run_cli,
     write_yaml,
@@ -316,11 +317,7 @@ def train(
     target = float(pick(target_success, "target_success", 0.9))
     if not 0.0 < target <= 1.0:
         raise UsageError(f"target_success: expected a share in (0, 1], got {target!r}")
-    kwargs = {**check_env_kwargs(hp.get("env_kwargs") or {}), **check_env_kwargs(env_kwargs or {})}
-    if mode is not None:
-        kwargs["mode"] = mode
-    if substeps is not None:
-        kwargs["substeps"] = substeps
+    kwargs = merge_env_kwargs(hp.get("env_kwargs"), env_kwargs, mode, substeps)
     steps = episode_steps(env_id, kwargs)  # validates every env kwarg
     mode = kwargs.get("mode", "exact")
     kwargs_env = {**kwargs, "max_episode_steps": steps}
@@ -329,108 +326,95 @@ def train(
         env_id, kwargs_env, hp, env_runners=env_runners, envs_per_runner=envs_per_runner, vectorize=vectorize, seed=seed
     )  # validates the PPO keywords
 
-    label = env_id.split("/")[-1].rsplit("-v", 1)[0].lower()
-    run_dir = Path(output) / (run_name or f"{label}-rllib-{mode}-s{seed}-{time.strftime('%Y%m%d-%H%M%S')}")
-    if run_dir.exists() and any(run_dir.iterdir()):
-        if not overwrite:
-            raise UsageError(f"run folder {run_dir} exists and is not empty (pass --overwrite to replace it)")
-        shutil.rmtree(run_dir)
-    run_dir.mkdir(parents=True, exist_ok=True)
-    log_file = (run_dir / LOG_FILE).open("a")
+    run_dir = make_run_dir(output, run_name, env_id, kwargs, seed, overwrite)
+    with log_tee(log, run_dir / LOG_FILE) as say:  # (closed on an error too)
+        import ray
+        import torch
 
-    def say(line: str) -> None:
-        log(line)
-        log_file.write(line + "\n")
-        log_file.flush()
-
-    import ray
-    import torch
-
-    torch.set_num_threads(threads)
-    record = {
-        "algorithm": ALGORITHM,
-        "env_id": env_id,
-        "env_kwargs": kwargs,
-        "episode_steps": steps,
-        "seed": seed,
-        "iterations": iterations,
-        "env_runners": env_runners,
-        "envs_per_runner": envs_per_runner,
-        "vectorize": vectorize,
-        "target_success": target,
-        "eval_episodes": eval_episodes,
-        "eval_seed": EVAL_SEED,
-        "address": address,
-        "node_ip_address": node_ip_address,
-        "hyperparams": {**hp, "env_kwargs": dict(kwargs)},
-        "hyperparams_file": str(hyperparams),
-        "versions": _versions(),
-    }
-    write_yaml(run_dir / CONFIG_FILE, record)
-    setup_start = time.perf_counter()
-    warm_up(env_id, kwargs)  # compile (or load) the kernels once here, not in every runner at once
-    start_ray(address, max(env_runners, 1), node_ip_address)
-    try:
-        say(
-            f"training RLlib PPO on {env_id} (mode={mode}) for up to {iterations} iterations, {env_runners} env "
-            f"runners x {envs_per_runner} envs ({vectorize}), seed {seed} -> {run_dir}"
-        )
-        algo = config.build_algo()
-        placement = runner_placement(algo)
-        for spot in placement:
-            say(
-                f"env runner {spot['runner']}: node {spot['node_id'][:12]} ({spot['node_address']}"
-                f"{', the driver node' if spot['driver_node'] else ''}), pid {spot['pid']}"
-            )
-        history = []
-        start = time.perf_counter()
-        setup_seconds = start - setup_start
-        env_steps = 0
-        for it in range(1, iterations + 1):
-            result = algo.train()
-            env_steps = int(result.get("num_env_steps_sampled_lifetime", env_steps))
-            ret = result.get("env_runners", {}).get("episode_return_mean", float("nan"))
-            line = (
-                f"iteration {it}: {env_steps:,} env steps, episode return {ret:.2f}, "
-                f"{time.perf_counter() - start:.0f} s"
-            )
-            if it % eval_every == 0 or it == iterations:
-                success = success_rate(algo.get_module(), env_id, kwargs, eval_episodes, EVAL_SEED)
-                history.append(
-                    {
-                        "iteration": it,
-                        "env_steps": env_steps,
-                        "success": success,
-                        "seconds": round(time.perf_counter() - start, 2),
-                    }
-                )
-                line += f", evaluation success {100 * success:.0f} %"
-                if success >= target:
-                    say(line + f" (target {100 * target:.0f} % reached)")
-                    break
-            say(line)
-        seconds = time.perf_counter() - start
-        algo.save_to_path(str((run_dir / CHECKPOINT_DIR).resolve()))
-        algo.stop()
-    finally:
-        ray.shutdown()  # stops the local instance; with --address it only disconnects from the cluster
-    record.update(
-        {
-            "setup_seconds": round(setup_seconds, 2),
-            "train_seconds": round(seconds, 2),
-            "iterations_done": it,
-            "env_steps_done": env_steps,
-            "evaluations": history,
-            "final_success": history[-1]["success"] if history else None,
-            "runner_placement": placement,
+        torch.set_num_threads(threads)
+        record = {
+            "algorithm": ALGORITHM,
+            "env_id": env_id,
+            "env_kwargs": kwargs,
+            "episode_steps": steps,
+            "seed": seed,
+            "iterations": iterations,
+            "env_runners": env_runners,
+            "envs_per_runner": envs_per_runner,
+            "vectorize": vectorize,
+            "target_success": target,
+            "eval_episodes": eval_episodes,
+            "eval_seed": EVAL_SEED,
+            "address": address,
+            "node_ip_address": node_ip_address,
+            "hyperparams": {**hp, "env_kwargs": dict(kwargs)},
+            "hyperparams_file": str(hyperparams),
+            "versions": _versions(),
         }
-    )
-    write_yaml(run_dir / CONFIG_FILE, record)
-    say(
-        f"trained {env_steps:,} env steps in {seconds:.0f} s ({env_steps / seconds:,.0f} steps/s); "
-        f"checkpoint {run_dir / CHECKPOINT_DIR}"
-    )
-    log_file.close()
+        write_yaml(run_dir / CONFIG_FILE, record)
+        setup_start = time.perf_counter()
+        warm_up(env_id, kwargs)  # compile (or load) the kernels once here, not in every runner at once
+        start_ray(address, max(env_runners, 1), node_ip_address)
+        try:
+            say(
+                f"training RLlib PPO on {env_id} (mode={mode}) for up to {iterations} iterations, {env_runners} env "
+                f"runners x {envs_per_runner} envs ({vectorize}), seed {seed} -> {run_dir}"
+            )
+            algo = config.build_algo()
+            placement = runner_placement(algo)
+            for spot in placement:
+                say(
+                    f"env runner {spot['runner']}: node {spot['node_id'][:12]} ({spot['node_address']}"
+                    f"{', the driver node' if spot['driver_node'] else ''}), pid {spot['pid']}"
+                )
+            history = []
+            start = time.perf_counter()
+            setup_seconds = start - setup_start
+            env_steps = 0
+            for it in range(1, iterations + 1):
+                result = algo.train()
+                env_steps = int(result.get("num_env_steps_sampled_lifetime", env_steps))
+                ret = result.get("env_runners", {}).get("episode_return_mean", float("nan"))
+                line = (
+                    f"iteration {it}: {env_steps:,} env steps, episode return {ret:.2f}, "
+                    f"{time.perf_counter() - start:.0f} s"
+                )
+                if it % eval_every == 0 or it == iterations:
+                    success = success_rate(algo.get_module(), env_id, kwargs, eval_episodes, EVAL_SEED)
+                    history.append(
+                        {
+                            "iteration": it,
+                            "env_steps": env_steps,
+                            "success": success,
+                            "seconds": round(time.perf_counter() - start, 2),
+                        }
+                    )
+                    line += f", evaluation success {100 * success:.0f} %"
+                    if success >= target:
+                        say(line + f" (target {100 * target:.0f} % reached)")
+                        break
+                say(line)
+            seconds = time.perf_counter() - start
+            algo.save_to_path(str((run_dir / CHECKPOINT_DIR).resolve()))
+            algo.stop()
+        finally:
+            ray.shutdown()  # stops the local instance; with --address it only disconnects from the cluster
+        record.update(
+            {
+                "setup_seconds": round(setup_seconds, 2),
+                "train_seconds": round(seconds, 2),
+                "iterations_done": it,
+                "env_steps_done": env_steps,
+                "evaluations": history,
+                "final_success": history[-1]["success"] if history else None,
+                "runner_placement": placement,
+            }
+        )
+        write_yaml(run_dir / CONFIG_FILE, record)
+        say(
+            f"trained {env_steps:,} env steps in {seconds:.0f} s ({env_steps / seconds:,.0f} steps/s); "
+            f"checkpoint {run_dir / CHECKPOINT_DIR}"
+        )
     return run_dir
 
 
@@ -460,7 +444,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--substeps", type=int, help="sub-steps per control step for naive/posteriori")
     p.add_argument("--env-kwargs", nargs="*", metavar="KEY=VALUE", help="more env keywords, e.g. dt=0.1")
     p.add_argument("--output", default="runs", help="folder for run folders (default: %(default)s)")
-    p.add_argument("--run-name", help="run folder name (default: <env>-rllib-<mode>-s<seed>-<time>)")
+    p.add_argument("--run-name", help="run folder name (default: <env>-<mode>-s<seed>-<time>, as train_ppo's)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing run folder")
     p.add_argument("--hyperparams", default=str(HYPERPARAMS), help="hyperparameter YAML (default: the shipped file)")
     p.add_argument("--threads", type=int, default=1, help="torch threads of the learner (default: %(default)s)")

@@ -28,6 +28,8 @@ import sys
 import time
 from collections.abc import Callable
 
+from collision_env.bench.readme import write_outputs
+
 from .machine import cpus, machine, timestamp, versions
 
 #: Run in a fresh process: ``{"gas": impacts/s, "env": steps/s, "backend": ...}`` on stdout.
@@ -131,13 +133,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     results = run(args.seconds, args.rounds)
     table = render_markdown(results)
-    print(table)
-    if args.json:
-        with open(args.json, "w") as f:
-            json.dump(results, f, indent=1)
-    if args.markdown:
-        with open(args.markdown, "w") as f:
-            f.write("# Compiled against plain Python\n\n" + table)
+    write_outputs(table, results, json_path=args.json, markdown=args.markdown, title="# Compiled against plain Python")
     return 0
 
 

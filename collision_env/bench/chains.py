@@ -32,7 +32,6 @@ liftings): the events to ``10^-4`` at each, to check the default.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 import time
@@ -40,6 +39,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from collision_env.bench.readme import write_outputs
 from collision_env.engine import Scene, Simulator, event_chain
 from collision_env.engine.blocking import new_blocks, push_all, standard_error
 from collision_env.observables import reduced_pressure
@@ -257,13 +257,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     results = run(args.quick)
     text = render_markdown(results)
-    print(text)
-    if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(results, fh, indent=1)
-    if args.markdown:
-        with open(args.markdown, "w") as fh:
-            fh.write("# Event chains against molecular dynamics\n\n" + text + "\n")
+    title = "# Event chains against molecular dynamics"
+    write_outputs(text, results, json_path=args.json, markdown=args.markdown, title=title)
     return 0
 
 

@@ -29,6 +29,8 @@ import tempfile
 import time
 from collections.abc import Callable
 
+from collision_env.bench.readme import write_outputs
+
 from .machine import cpus, machine, timestamp, versions
 
 _STEP = """
@@ -152,13 +154,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     results = run(args.repeats)
     table = render_markdown(results)
-    print(table)
-    if args.json:
-        with open(args.json, "w") as f:
-            json.dump(results, f, indent=1)
-    if args.markdown:
-        with open(args.markdown, "w") as f:
-            f.write("# Compile time\n\n" + table)
+    write_outputs(table, results, json_path=args.json, markdown=args.markdown, title="# Compile time")
     if args.estimates:
         with open(args.estimates, "w") as f:
             estimates = {"measured_by": "python -m collision_env.bench.compile", "machine": results["machine"]}

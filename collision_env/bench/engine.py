@@ -45,6 +45,7 @@ from typing import Any
 
 import numpy as np
 
+from collision_env.bench.readme import write_outputs
 from collision_env.engine import PLAY_AREA_2D, BatchSimulator, Scene, Simulator
 from collision_env.precompile import precompile
 
@@ -504,14 +505,8 @@ def main(argv: list[str] | None = None) -> int:
                 log=lambda msg: print(msg, file=sys.stderr, flush=True),
             )
         )
-        if args.json:
-            with open(args.json, "w") as fh:
-                json.dump(results, fh, indent=1)
-    text = render_markdown(results)
-    print(text)
-    if args.markdown:
-        with open(args.markdown, "w") as fh:
-            fh.write(text + "\n")
+    measured = None if args.render else results  # (a rendered file is not written again)
+    write_outputs(render_markdown(results), measured, json_path=args.json, markdown=args.markdown)
     return 0
 
 

@@ -26,6 +26,7 @@ import gymnasium as gym
 import numpy as np
 
 import collision_env
+from collision_env.bench.readme import write_outputs
 from collision_env.engine import MODES
 from collision_env.envs import CollisionTargetEnv, CollisionTargetVectorEnv
 
@@ -170,10 +171,7 @@ def main(argv: list[str] | None = None) -> None:
             *vector,
         ]
     )
-    print(text)
-    if args.markdown:
-        with open(args.markdown, "w") as fh:
-            fh.write(text + "\n")
+    write_outputs(text, markdown=args.markdown)
 
 
 if __name__ == "__main__":

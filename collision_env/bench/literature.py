@@ -56,7 +56,7 @@ from collision_env.observables import LI_2022_CELLS, PressureAccumulator, li_202
 
 from .machine import cpus, machine, timestamp, versions
 from .parallel import run_tasks
-from .readme import markers, replace_block
+from .readme import write_outputs
 
 #: The fluid's state points: ``(N, cell, area fractions)``, the cells keys of ``LI_2022_CELLS``.
 FLUID = (
@@ -491,18 +491,6 @@ def plot(results: dict, folder: str | Path) -> str:
 PAGE_TITLE = "# Hard disks against the literature"
 
 
-def write_page_block(path: str | Path, name: str, text: str) -> None:
-    """Put ``text`` between block ``name``'s markers in the docs page ``path`` (see
-    :mod:`~collision_env.bench.readme`): replaced where they are, added at the end where they are
-    not, the page made (with :data:`PAGE_TITLE`) where it is missing."""
-    p = Path(path)
-    if p.exists() and replace_block(p, name, text):
-        return
-    start, end = markers(name)
-    head = p.read_text().rstrip("\n") + "\n\n" if p.exists() else PAGE_TITLE + "\n\n"
-    p.write_text(f"{head}{start}\n{text.rstrip()}\n{end}\n")
-
-
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The section's options (``python -m collision_env.bench.physics --section literature``)."""
     parser.add_argument(
@@ -524,12 +512,10 @@ def main(args: argparse.Namespace) -> int:
     else:
         results = run(args.quick, jobs=args.jobs, ray=args.ray, address=args.address, seed=args.seed)
     text = render_markdown(results)
-    print(text)
-    if args.json and not args.render:
-        with open(args.json, "w") as fh:
-            json.dump(results, fh, indent=1)
-    if args.markdown:
-        write_page_block(args.markdown, "bench:literature", text)
+    measured = None if args.render else results  # (a rendered file is not written again)
+    write_outputs(
+        text, measured, json_path=args.json, markdown=args.markdown, block="bench:literature", title=PAGE_TITLE
+    )
     if args.plot:
         print(plot(results, args.plot))
     return 0

@@ -39,13 +39,14 @@ So the counts rank the arrays; they are not a time.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import subprocess
 import sys
 from collections import OrderedDict
 
 import numpy as np
+
+from collision_env.bench.readme import write_outputs
 
 SIZES = (1_000, 100_000)
 CACHE_KIB = 2048
@@ -217,10 +218,7 @@ def main(argv: list[str] | None = None) -> int:
     for n in args.sizes:
         rows.append(measure(n, args.cache_kib, args.sites))
         print(f"  N = {n:,}: {sum(rows[-1]['misses_per_event'].values()):.1f} misses per event", flush=True)
-    print(render_markdown(rows))
-    if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(rows, fh, indent=1)
+    write_outputs(render_markdown(rows), rows, json_path=args.json)
     return 0
 
 

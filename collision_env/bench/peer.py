@@ -44,6 +44,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+from collision_env.bench.readme import write_outputs
+
 from .machine import machine, timestamp, versions
 
 SIZES = (1_000, 10_000, 100_000, 1_000_000)
@@ -253,11 +255,8 @@ def main(argv: list[str] | None = None) -> None:
     os.environ.setdefault("PYTHONHASHSEED", "0")
     result = measure(tuple(args.sizes), tuple(args.phis), args.rounds, args.peer_source)
     table = render_markdown(result)
-    print(table)
-    if args.json:
-        args.json.write_text(json.dumps(result, indent=2) + "\n")
-    if args.markdown:
-        args.markdown.write_text("# The exact engine against EDMD\n\n" + table)
+    title = "# The exact engine against EDMD"
+    write_outputs(table, result, json_path=args.json, markdown=args.markdown, title=title, indent=2)
 
 
 if __name__ == "__main__":

@@ -36,7 +36,6 @@ collisions per second of each compression.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 import time
@@ -44,6 +43,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from collision_env.bench.readme import write_outputs
 from collision_env.engine import Simulator, compress, disk_gas
 from collision_env.engine.compression import DEFAULT_RATE, DEFAULT_UNTIL_PRESSURE
 from collision_env.observables import collision_rate, henderson_z, kolafa_rottner_z, reduced_pressure
@@ -374,12 +374,9 @@ def main(argv: list[str] | None = None) -> int:
         return literature.main(args)
     results = run(args.quick)
     text = render_markdown(results)
-    print(text)
-    if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(results, fh, indent=1)
-    if args.markdown:  # (its block of the page: the literature section writes another)
-        literature.write_page_block(args.markdown, "bench:physics", text)
+    # (its block of the page: the literature section writes another)
+    page = {"markdown": args.markdown, "block": "bench:physics", "title": literature.PAGE_TITLE}
+    write_outputs(text, results, json_path=args.json, **page)
     if args.plot:
         print(plot(results, args.plot))
         print(plot_jamming(results, args.plot))

@@ -40,7 +40,6 @@ their first-call cost is reported on its own.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 import time
@@ -49,6 +48,7 @@ from collections.abc import Callable, Iterable
 
 import numpy as np
 
+from collision_env.bench.readme import write_outputs
 from collision_env.engine import BatchSimulator, Scene, Simulator
 from collision_env.engine.broadphase import first_overlap
 from collision_env.engine.state import RESUME, START_STEP
@@ -415,13 +415,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     results = run(args.quick)
     text = render_markdown(results)
-    print(text)
-    if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(results, fh, indent=1)
-    if args.markdown:
-        with open(args.markdown, "w") as fh:
-            fh.write("# Exact mode at scale\n\n" + text + "\n")
+    write_outputs(text, results, json_path=args.json, markdown=args.markdown, title="# Exact mode at scale")
     return 0
 
 

@@ -25,7 +25,7 @@ from . import report
 from .envrates import ENV_FIELDS, env_rates
 from .extremes import EXTREME_FIELDS, extremes_markdown, run_extremes
 from .machine import cpus, machine, timestamp, versions
-from .readme import write_block
+from .readme import write_outputs
 from .stats import STAT_FIELDS, gas_statistics, stats_markdown
 from .sweep import run_sweep
 
@@ -125,7 +125,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.readme:
         rel = os.path.relpath(out.resolve(), Path(args.readme).resolve().parent)
         block = report.readme_block(rows, rel.replace(os.sep, "/"), quick)
-        write_block(args.readme, report.README_BLOCK, block)
+        write_outputs(block, markdown=args.readme, block=report.README_BLOCK, echo=False)
     exact_fail = [r for r in extreme_rows if r["mode"] == "exact" and r["status"] != "pass"]
     return 1 if exact_fail else 0
 

@@ -16,6 +16,7 @@ from collision_env.envs.billiards import BilliardsEnv, BilliardsVectorEnv
 from collision_env.envs.inelastic_cluster import InelasticClusterEnv, InelasticClusterVectorEnv
 from collision_env.envs.multi_ball import MultiBallEnv, MultiBallVectorEnv
 from collision_env.envs.crowd import CrowdEnv, CrowdVectorEnv
+from collision_env.envs.pegs import PegsEnv, PegsVectorEnv
 from collision_env.envs.registry import PRESET_IDS, REGISTERED, Task, register_env, register_task
 from collision_env.envs.target_env import CollisionTargetEnv
 from collision_env.envs.vector import CollisionTargetVectorEnv
@@ -48,6 +49,8 @@ __all__ = [
     "MultiBallVectorEnv",
     "OneBallTargetEnv",
     "OneBallTargetVectorEnv",
+    "PegsEnv",
+    "PegsVectorEnv",
     "Task",
     "TaskConfig",
     "make_config",

@@ -3,7 +3,7 @@
 * :class:`AimingPolicy` (controlled balls with nothing but walls in the way): each step it asks a copy
   of the engine (``BatchSimulator.copy()`` then ``step``) where each ball's next wall impact will land;
   if not on a target, it searches directions the same way and steers towards one that is.
-* :class:`SteeringPolicy` (one controlled ball among balls it does not control, such as ``Crowd``):
+* :class:`SteeringPolicy` (one controlled ball among balls it does not control: ``Crowd``, ``Pegs``):
   it steers at the target and coasts when a copy of the engine predicts a hit.
 * :class:`ShootingPolicy` (any preset): candidate plans (action sequences) are run ahead on a
   planning copy of the env (``copy.deepcopy``, no renderer) from the env's current state

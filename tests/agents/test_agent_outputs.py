@@ -102,3 +102,57 @@ def test_the_rllib_hyperparameter_file_has_an_entry_for_the_default_env():
     entry = raw[train_rllib.DEFAULT_ENV]
     assert entry["vectorize"] == "native" and 0 < entry["target_success"] <= 1
     assert entry["train_batch_size_per_learner"] >= entry["minibatch_size"]
+
+
+def test_run_preparation_is_shared_kwargs_merge_folder_name_and_overwrite_rule(tmp_path):
+    from agents.config import make_run_dir, merge_env_kwargs, run_label
+
+    entry, given = {"mode": "posteriori", "dt": 0.1}, {"dt": 0.2, "substeps": 2}
+    assert merge_env_kwargs(entry, given) == {"mode": "posteriori", "dt": 0.2, "substeps": 2}
+    assert merge_env_kwargs(entry, given, mode="naive", substeps=4) == {"mode": "naive", "dt": 0.2, "substeps": 4}
+    with pytest.raises(UsageError, match="render_mode"):
+        merge_env_kwargs({}, {"render_mode": "rgb_array"})
+    kwargs = merge_env_kwargs({}, {}, mode="posteriori", substeps=4)
+    run_dir = make_run_dir(tmp_path, None, "CollisionEnv/Billiards-v0", kwargs, 3, overwrite=False)
+    assert run_dir.name.startswith("billiards-posteriori4-s3-")
+    assert run_label("CollisionEnv/Billiards-v0", "posteriori", 4, 3) == "billiards-posteriori4-s3"
+    (run_dir / "old.txt").write_text("an earlier run")
+    with pytest.raises(UsageError, match="--overwrite"):
+        make_run_dir(tmp_path, run_dir.name, "CollisionEnv/Billiards-v0", kwargs, 3, overwrite=False)
+    assert (run_dir / "old.txt").is_file()  # refused: untouched
+    assert not any(make_run_dir(tmp_path, run_dir.name, "x/y-v0", kwargs, 3, overwrite=True).iterdir())
+
+
+def test_the_log_tee_writes_every_line_and_closes_its_file_on_an_error(tmp_path, monkeypatch):
+    from agents.config import log_tee
+
+    opened, real_open = [], Path.open
+
+    def recording_open(self, *args, **kwargs):
+        opened.append(real_open(self, *args, **kwargs))
+        return opened[-1]
+
+    monkeypatch.setattr(Path, "open", recording_open)
+    seen, path = [], tmp_path / "train.log"
+    with pytest.raises(RuntimeError), log_tee(seen.append, path) as say:
+        say("one")
+        say("two")
+        raise RuntimeError("training failed")
+    assert seen == ["one", "two"] and path.read_text() == "one\ntwo\n"
+    assert len(opened) >= 1 and all(fh.closed for fh in opened)
+    with log_tee(seen.append, None) as say:
+        assert say == seen.append  # no file: the logger itself
+
+
+def test_rllib_run_folders_are_named_as_ppos(tmp_path, monkeypatch):
+    pytest.importorskip("ray")
+    made = {}
+
+    def stop(output, run_name, env_id, kwargs, seed, overwrite):
+        made.update(kwargs=kwargs, seed=seed)
+        raise UsageError("stop here")
+
+    monkeypatch.setattr(train_rllib, "make_run_dir", stop)
+    with pytest.raises(UsageError, match="stop here"):
+        train_rllib.train(output=tmp_path, mode="posteriori", substeps=4, seed=2)
+    assert made == {"kwargs": {"mode": "posteriori", "substeps": 4}, "seed": 2}

@@ -347,6 +347,79 @@ def test_study_writes_tables_plot_and_readme_block(tmp_path):
     assert {r["run"] for r in more["rows"]} == {r["run"] for r in data["rows"]}  # the same cell, replaced
 
 
+def test_study_by_default_trains_every_mode_of_the_trade_and_draws_its_pareto_figure(tmp_path):
+    # the smallest configuration of the full study's code path: one preset, one seed, the default modes
+    docs = tmp_path / "docs"
+    data = study.main(
+        ["--part", "modes", "--envs", "CollisionEnv/Pegs-v0", "--seeds", "0", "--timesteps", "512", "--episodes", "2"]
+        + ["--output", str(tmp_path / "runs"), "--docs", str(docs)]
+    )
+    cells = [(r["mode"], r["substeps"]) for r in data["rows"]]
+    assert (
+        cells
+        == [("naive", 1), ("posteriori", 1), ("posteriori", 4), ("exact", 1)]
+        == [study.parse_mode(m) for m in study.DEFAULT_MODES]
+    )
+    for r in data["rows"]:  # every policy evaluated exact, and in its own mode
+        assert 0.0 <= r["exact"]["success_rate"] <= 1.0 and 0.0 <= r["own"]["success_rate"] <= 1.0
+        assert r["train_seconds"] > 0 and r["time_split"]["engine"] is not None
+    assert (docs / "pareto.png").stat().st_size > 0
+    page = (docs / "modes.md").read_text()
+    assert "| `CollisionEnv/Pegs-v0` |" in page and "| posteriori k=4 |" in page and "pareto.png" in page
+    assert "**Rule**" in page
+
+
+def _mode_row(env_id, mode, k, seed, success, seconds):
+    return {
+        "part": "modes",
+        "env_id": env_id,
+        "mode": mode,
+        "substeps": k,
+        "seed": seed,
+        "episodes": 100,
+        "run": f"runs/{env_id}-{mode}{k}-{seed}",
+        "train_seconds": seconds,
+        "timesteps_done": 1000,
+        "time_split": {part: (0.5 * seconds if part == "engine" else 0.0) for part in timing.PARTS},
+        "observe": "plain",
+        "exact": {"success_rate": success, "mean_return": 1.0},
+        "own": {"success_rate": 1.0, "mean_return": 1.0},
+    }
+
+
+def test_study_rule_names_where_training_cheap_pays_and_where_it_costs(tmp_path):
+    rows = []
+    for seed, jitter in enumerate((0.0, 0.02, -0.02)):
+        rows += [
+            _mode_row("CollisionEnv/Crowd-v0", "naive", 1, seed, 0.95 + jitter, 60.0),
+            _mode_row("CollisionEnv/Crowd-v0", "exact", 1, seed, 0.96 - jitter, 90.0),
+            _mode_row("CollisionEnv/Pegs-v0", "naive", 1, seed, 0.10 + jitter, 50.0),
+            _mode_row("CollisionEnv/Pegs-v0", "posteriori", 4, seed, 0.80 + jitter, 80.0),
+            _mode_row("CollisionEnv/Pegs-v0", "exact", 1, seed, 0.82 - jitter, 100.0),
+        ]
+    found = {c["env_id"]: c for c in study.comparisons(rows)}
+    crowd, pegs = found["CollisionEnv/Crowd-v0"], found["CollisionEnv/Pegs-v0"]
+    assert [m["verdict"] for m in crowd["cheap"]] == ["pays"] and crowd["cheap"][0]["speed"] == pytest.approx(1.5)
+    assert [m["verdict"] for m in pegs["cheap"]] == ["costs", "pays"]
+    assert pegs["cheap"][0]["loss"] == pytest.approx(0.72) and pegs["spread"] == pytest.approx(0.02)
+    text = study.rule(rows, [])
+    paid, cost = text.split("**paid**")[1].split("**cost**")
+    assert "`CollisionEnv/Crowd-v0` (naive k=1 -1 points at 1.50×)" in paid
+    assert "`CollisionEnv/Pegs-v0` (posteriori k=4 -2 points at 1.25×)" in paid
+    assert "`CollisionEnv/Pegs-v0` (naive k=1 -72 points at 2.00×)" in cost
+    table = study.trade_table(rows)
+    assert "| `CollisionEnv/Pegs-v0` | 50 % | 10 % (100 %), 50 s | 80 % (100 %), 80 s | 82 % (100 %), 100 s |" in table
+    assert "| `CollisionEnv/Crowd-v0` | 50 % | 95 % (100 %), 60 s |  | 96 % (100 %), 90 s |" in table  # (none trained)
+    assert study.pareto_plot(rows, tmp_path / "pareto.png").stat().st_size > 0
+    # no cheap mode beyond the spread: the rule says so rather than naming one
+    slow = rows + [_mode_row("CollisionEnv/Pegs-v0", "posteriori", 1, seed, 0.82, 400.0) for seed in range(3)]
+    assert "**did not pay** (no faster than exact) on `CollisionEnv/Pegs-v0` (posteriori k=1 +0 points at 0.25×)" in (
+        study.rule(slow, [])
+    )
+    calm = [r for r in rows if r["env_id"] == "CollisionEnv/Crowd-v0"]
+    assert "**cost**" not in study.rule(calm, []) and "No preset here lost" in study.rule(calm, [])
+
+
 def test_study_variants_change_one_setting_of_the_entry_back_to_the_default():
     # Billiards' entry trains on the predicted observation with velocity control
     assert study.variants("CollisionEnv/Billiards-v0") == [{}, {"observe": "plain"}, {"control": "nudge"}]

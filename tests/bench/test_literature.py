@@ -11,6 +11,7 @@ import pytest
 from collision_env.bench import literature as L
 from collision_env.bench import physics
 from collision_env.bench.parallel import run_tasks
+from collision_env.bench.readme import write_page_block
 from collision_env.observables import LI_2022_CELLS
 
 
@@ -118,9 +119,9 @@ def test_the_table_the_page_block_and_the_plot(short_rows, tmp_path):
     assert "fluid points within 3 σ" in text and "Mayer–Wood loop" in text and "| 0.690 |" in text
     assert "| event chains | 72 |" in text and "| exact-mode MD | 224 |" in text
     page = tmp_path / "physics.md"
-    L.write_page_block(page, "bench:literature", text)  # a new page
-    L.write_page_block(page, "bench:physics", "fluid")  # a block the page lacks: added
-    L.write_page_block(page, "bench:literature", "again")  # a block it has: replaced
+    write_page_block(page, "bench:literature", text, L.PAGE_TITLE)  # a new page
+    write_page_block(page, "bench:physics", "fluid", L.PAGE_TITLE)  # a block the page lacks: added
+    write_page_block(page, "bench:literature", "again", L.PAGE_TITLE)  # a block it has: replaced
     body = page.read_text()
     assert body.startswith(L.PAGE_TITLE) and "again" in body and text not in body and "fluid" in body
     assert L.plot(results, tmp_path).endswith("physics_li2022.png") and (tmp_path / "physics_li2022.png").stat().st_size
