@@ -266,7 +266,8 @@ def cascade_kernel(periodic: bool) -> Any:
         for start in (i0, j0):  # (the impact's balls moved; the sweeps mark the others they move)
             if start >= 0:
                 wk.in_group[start] = True
-        outcome, work = _sweep(sc, t_abs, n_contacts, u_min, sweeps, budget, b, ph, wk)
+        # (the sweeps leave room in the budget for the limit's reports, should they not end)
+        outcome, work = _sweep(sc, t_abs, n_contacts, u_min, sweeps, budget - n_contacts - 2, b, ph, wk)
         if outcome == OPEN:
             outcome, more = settle_group(sc, t_abs, size, n_contacts, u_min, plastic_row, budget - work, b, ph, wk)
             work += more

@@ -643,7 +643,9 @@ def _step(kind: Kind):
             if sticky:
                 rot = has_rotation(b.body, b.omega)
             invalidate(n_pending, now, ev, in_place, cl, wk)
-            if out_of_budget:  # (a contact group cut short: its contacts may still close)
+            # (a contact group cut short, whose contacts may still close, or one that took the step's
+            # work to the cap: the step stops here)
+            if out_of_budget or (work > 0 and state.work_i[sc, W_EVENTS] >= max_events):
                 state.capped[sc] = True
                 break
         return now, rot
