@@ -43,7 +43,10 @@ a prediction made steps ago gives the same impact time as a fresh one.
 
 The cap on events per step (``max_events``) is never silent: a scene that reaches it stops at
 the instant of its last resolved event, in a valid state (no overlap, nothing outside the border),
-is flagged in ``capped``, and its clock shows how far it got.
+is flagged in ``capped``, and its clock shows how far it got. It counts every resolved event, every
+sweep, iteration and impulse of a contact group (:mod:`~.contacts`) and, in a periodic cell, every
+cell crossing, so that a step's laps round the cell are bounded by it too (a step of any length is
+accepted; one that laps the cell without bound stops at the cap).
 
 Reverse steps are run forward on negated velocities with restitution 1/e (the caller negates).
 """
@@ -577,6 +580,7 @@ def _step(kind: Kind):
         else:
             n_pending = 0
         walk = -1  # (see calendar.walk_next_bucket)
+        crossed = False  # (the last event popped was a cell crossing of a periodic scene)
         while True:
             # predict (the one place where predictions are made: what begin or the last event listed)
             for q in range(n_pending):
@@ -585,6 +589,9 @@ def _step(kind: Kind):
                 build(n, now, cl.rec, cl.ci, cl.q)
                 state.work_i[sc, W_CALENDAR_VALID] = True
                 whole = False
+            if crossed and state.work_i[sc, W_EVENTS] >= max_events:  # (laps count: see below)
+                state.capped[sc] = True
+                break
             # pop and screen
             bi = first(cl.rec, cl.ci, cl.q)
             if bi < 0:
@@ -595,6 +602,9 @@ def _step(kind: Kind):
             if not t <= horizon_end:
                 break
             if periodic:
+                # a cell crossing counts toward the cap: a step's laps round the cell are bounded by it
+                crossed = cal.is_crossing(cl.ci[bi, C_EVENT_OTHER])
+                state.work_i[sc, W_EVENTS] += crossed
                 verdict, t, now = cyclic.screen(bi, t, now, ph, cl, geo, wk, state.images[sc])
             else:
                 verdict, t, now = screen(bi, t, now, ph, cl, geo, wk)
