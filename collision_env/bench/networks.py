@@ -61,13 +61,11 @@ def pile(n: int, e: float, hexagonal: bool = False) -> tuple[Scene, np.ndarray, 
     r = 0.01
     d = 2.0 * r * (1.0 + 1e-12)  # (a hair apart: touching within the contact tolerance, no overlap)
     rise = d * math.sqrt(3.0) / 2.0 if hexagonal else d
-    places = []
+    places: list[tuple[float, float]] = []
     k = 0
     while len(places) < n:
-        shift = 0.5 * (k % 2) if hexagonal else 0.0
-        count = 19 if hexagonal and k % 2 else 20
-        places.extend((j + shift) * d for j in range(count))
-        places[len(places) - count :] = [(x, r + k * rise) for x in places[len(places) - count :]]
+        odd = hexagonal and k % 2 == 1
+        places.extend(((j + (0.5 if odd else 0.0)) * d, r + k * rise) for j in range(19 if odd else 20))
         k += 1
     pos = np.array(places[:n], dtype=np.float64)
     scene = Scene(bounds=(-0.2, 0.0, 0.6, 1.0), elasticity=e)

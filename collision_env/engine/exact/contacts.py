@@ -396,7 +396,7 @@ def settle_group(sc, t_abs, size, n_contacts, u_min, row, budget, b, ph, wk):
     return outcome, work
 
 
-@njit(inline="always")
+@njit(python=False)
 def _settle_large(size, n_contacts, u_min, fastest, budget, b, wk):
     """The limit of the first ``size`` balls of a large group over its first ``n_contacts``
     contacts: in one pass for a row, else accelerated. Returns the outcome and the work."""
@@ -407,7 +407,7 @@ def _settle_large(size, n_contacts, u_min, fastest, budget, b, wk):
     return _settle_accelerated(size, n_contacts, u_min, accuracy, iterations, budget, b, wk)
 
 
-@njit(inline="always")
+@njit(python=False)
 def _moved_first(size, n_contacts, wk):
     """Reorder a group: the balls the cascade moved (marked in ``wk.in_group``) first, in group
     order, and the contacts among them (and their walls) first. Returns how many of each."""
@@ -445,7 +445,7 @@ def _swap_contacts(c, d, wk):
             wk.c_f[c, k], wk.c_f[d, k] = wk.c_f[d, k], wk.c_f[c, k]
 
 
-@njit(inline="always")
+@njit(python=False)
 def _closing_speeds(n_contacts, b, wk):
     """Each contact's closing speed (``wk.c_f[:, F_CLOSING]``, a view of it is returned) and the largest
     normal speed of any contact."""
@@ -501,7 +501,7 @@ def settle(size, n_contacts, u_min, b, wk):
         vel[i, 1] += x[2 * q + 1] * root_w[q]
 
 
-@njit(inline="always")
+@njit(python=False)
 def _row_axis(size, n_contacts, wk):
     """The axis (0: x, 1: y) along which the group is a row, with each place's neighbours along it
     in ``wk.g_i`` (low side, high side; -1: none, ``_WALL``: a wall), or -1 if it is not one: a
@@ -538,7 +538,7 @@ def _row_axis(size, n_contacts, wk):
     return axis
 
 
-@njit(inline="always")
+@njit(python=False)
 def _settle_row(size, n_contacts, u_min, b, wk):
     """The limit of a row's cascade in one pass, if the group is a row (else False, nothing changed):
     with ``z_k = v_k - k u`` along the row (``u = u_min``), the contacts ask for ``z`` non-decreasing,
@@ -592,7 +592,7 @@ def _settle_row(size, n_contacts, u_min, b, wk):
     return True
 
 
-@njit(inline="always")
+@njit(python=False)
 def _lipschitz(size, n_contacts, inv_mass, wk):
     """A bound on the largest eigenvalue of the group's Delassus matrix ``A = G M^-1 G^T`` (row sums,
     Gershgorin): each contact's ``w_a deg_a + w_b deg_b`` at most, ``deg`` a ball's contacts."""
@@ -614,7 +614,7 @@ def _lipschitz(size, n_contacts, inv_mass, wk):
     return bound
 
 
-@njit(inline="always")
+@njit(python=False)
 def _settle_accelerated(size, n_contacts, u_min, accuracy, iterations, budget, b, wk):
     """The limit of any group's cascade by an accelerated projected gradient on the least-distance
     dual ``min f(l) = 1/2 l^T A l - h^T l`` over contact impulses ``l >= 0`` (``A = G M^-1 G^T``, ``h``
