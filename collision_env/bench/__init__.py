@@ -19,6 +19,8 @@ Every section is a module with a ``main(argv)``, runnable on its own
   Enskog's collision rate; events per second through the public API.
 - :mod:`.chains`: event-chain Monte Carlo against exact-mode MD on one dense hard-disk state: events
   per CPU second and the CPU time to an error bar on the pressure.
+- :mod:`.networks`: contact networks at e < 1 in exact mode (a row of 10^4 struck at one end, a
+  pile under gravity nudges, a collapsing cluster, a cooling gas): ms per step, memory, the clock.
 - :mod:`.compile`: the CPU seconds numba takes with empty caches: a first step, a first env step,
   every kernel.
 - :mod:`.backend`: compiled kernels against plain Python (numba missing) on a gas and an env.
@@ -44,4 +46,5 @@ SECTIONS: dict[str, tuple[str, str]] = {
     "backend": ("collision_env.bench.backend", "compiled kernels against plain Python: a 1000-disk gas, an env"),
     "physics": ("collision_env.bench.physics", "a periodic hard-disk fluid against the published equation of state"),
     "chains": ("collision_env.bench.chains", "event-chain Monte Carlo against MD: CPU time to an error bar"),
+    "networks": ("collision_env.bench.networks", "contact networks at e < 1: ms per step, memory, the clock"),
 }

@@ -87,6 +87,11 @@ class ExactScratch(NamedTuple):
     kinematics: np.ndarray  #: (2, len(KINEMATICS)) float64: two cluster members' rigid kinematics
     event: np.ndarray  #: (1, 2, len(BALL)) float64: the two balls of an event, laid out as ``BALL``
     event_body: np.ndarray  #: (2,) int64: their cluster roots (the rows' own indices)
+    slot: np.ndarray  #: (N,) int64: a ball's place in the contact group being resolved (-1: none)
+    near: np.ndarray  #: (N,) int64: the balls touching one ball of a contact group
+    g_i: np.ndarray  #: (N, 2) int64: per group place, its neighbours along a row (or pooled blocks)
+    g_f: np.ndarray  #: (N, 4) float64: per group place, pooled blocks or velocities (``contacts``)
+    c_f: np.ndarray  #: (C, 8) float64: per contact, its geometry and impulses (``contacts.F_*``)
 
 
 class SubstepScratch(NamedTuple):
@@ -258,6 +263,11 @@ if HAVE_NUMBA:
             view(h, s + 5, np.float64, 2),
             view(h, s + 6, np.float64, 3),
             view(h, s + 7, np.int64, 1),
+            view(h, s + 8, np.int64, 1),
+            view(h, s + 9, np.int64, 1),
+            view(h, s + 10, np.int64, 2),
+            view(h, s + 11, np.float64, 2),
+            view(h, s + 12, np.float64, 2),
         )
 
     @njit(inline="always")

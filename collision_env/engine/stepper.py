@@ -253,10 +253,18 @@ class Stepper:
 
     def _reset_fast_path(self) -> None:
         """Set the longest step that takes :meth:`step`'s fast path, ``_fast_dt``, for the state as it
-        is now: any forward step with a border; none in a periodic cell, until a checked step has
-        bounded its laps (:meth:`_checked_step`); none without a border or backwards."""
+        is now: any forward step with a border; none in a periodic cell of the cheap modes, until a
+        checked step has bounded its laps (:meth:`_checked_step`); none without a border or
+        backwards."""
         forward = self._sign > 0.0 and self.scene.bounds is not None
-        self._fast_dt = MAX_MAGNITUDE if forward and not self.scene.periodic else 0.0
+        self._fast_dt = MAX_MAGNITUDE if forward and not self._bounds_laps else 0.0
+
+    @property
+    def _bounds_laps(self) -> bool:
+        """Steps are refused for their laps round a periodic cell (``validation.check_laps``): in the
+        cheap modes. Exact mode counts each crossing of a cell toward the event cap instead, so a
+        step of any length is taken, and one that laps the cell without bound stops at the cap."""
+        return self.scene.periodic and not self.spec.persistent
 
     def invalidate(self, scenes: np.ndarray) -> None:
         """Drop the calendar's predictions for ``scenes`` (they are made afresh at the next step)
@@ -347,7 +355,7 @@ class Stepper:
         check_seconds(dt, "dt")
         if self.scene.bounds is None:
             check_reach(self.pos, self.vel, dt, label)
-        longest = check_laps(self.scene, self.mass, self.vel, dt, label) if self.scene.periodic else 0.0
+        longest = check_laps(self.scene, self.mass, self.vel, dt, label) if self._bounds_laps else 0.0
         e = self.scene.elasticity
         if dt < 0.0 and e == 0.0:
             raise ValueError(
@@ -408,7 +416,7 @@ class Stepper:
         f = 0
         buffer = None  # the compiled loop's copy of the impacts
         size = len(self._imp)
-        if self.scene.periodic:  # (the run's laps, checked once: a periodic step has no fast path)
+        if self._bounds_laps:  # (the run's laps, checked once: a periodic step has no fast path)
             check_laps(self.scene, self.mass, self.vel, dt * n, self.label)
         while f < n:
             forward = self._sign > 0.0 and self.scene.bounds is not None

@@ -405,13 +405,14 @@ def check_reach(pos: np.ndarray, vel: np.ndarray, dt: float, label: Labels) -> N
         )
 
 
-#: Most times a step may take a ball round a periodic cell: exact mode wraps a ball at each crossing
-#: of the cell (an event), so a step that laps the cell without bound would never end.
+#: Most times a step of the cheap modes may take a ball round a periodic cell (their sub-steps wrap
+#: positions by floor division, which loses a ball's place beyond that; exact mode counts each
+#: crossing toward the event cap instead).
 MAX_LAPS = 2.0**20
 
 
 def check_laps(scene: Scene, mass: np.ndarray, vel: np.ndarray, dt: float, label: Labels) -> float:
-    """In a periodic cell, a step of ``dt`` must not take any ball round the cell more than
+    """In a periodic cell of the cheap modes, a step of ``dt`` must not take any ball round the cell more than
     :data:`MAX_LAPS` times, at the fastest speed the energy of its scene allows any of its balls
     (collisions never add energy). Returns the longest step that would pass (s; inf if no ball moves)."""
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
@@ -425,7 +426,7 @@ def check_laps(scene: Scene, mass: np.ndarray, vel: np.ndarray, dt: float, label
         where = label(s).rstrip(": ")
         raise ValueError(
             f"dt: a step of {dt:g} s could take a ball{' of ' + where if where else ''} round the periodic "
-            f"cell {laps[s]:.3g} times (at most {MAX_LAPS:g}: each crossing is an event); take shorter steps"
+            f"cell {laps[s]:.3g} times (at most {MAX_LAPS:g} in this mode; exact mode takes it); take shorter steps"
         )
     return longest
 

@@ -39,6 +39,11 @@ class Work(NamedTuple):
     c_a: np.ndarray  #: a contact group's contacts: the lower ball
     c_b: np.ndarray  #: ... and the other ball (>= 0) or the wall (-1 - wall)
     c_hit: np.ndarray  #: ... and whether it was reported already
+    c_f: np.ndarray  #: ... and its separation (dx, dy), closing speed and impulse (``contacts``)
+    slot: np.ndarray  #: a ball's place in the contact group (-1: none)
+    near: np.ndarray  #: the balls touching one ball of the group
+    g_i: np.ndarray  #: per group place: neighbours along a row, pooled blocks (``contacts``)
+    g_f: np.ndarray  #: per group place: pooled blocks' weights and sums
     ki: np.ndarray  #: a rotating cluster member's kinematics (``layout.KINEMATICS``)
     kj: np.ndarray  #: ... and its partner's
     event: SceneBalls  #: the two balls of an event, rows 0 and 1 (see ``scheduler.advance``)
@@ -58,6 +63,11 @@ def work(state, scratch):
         scratch.c_a,
         scratch.c_b,
         scratch.c_hit,
+        scratch.c_f,
+        scratch.slot,
+        scratch.near,
+        scratch.g_i,
+        scratch.g_f,
         scratch.kinematics[0],
         scratch.kinematics[1],
         event,

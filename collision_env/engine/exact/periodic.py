@@ -22,8 +22,9 @@ in for the scheduler's wall and grid steps where a periodic scene differs.
   (:func:`nearest_partner`): at contact, with diameters below half a period, that is the touching
   one.
 
-Pair events are the only collisions (there are no walls), and at e < 1 a touching group collides
-pairwise, one event after another, rather than as one contact group.
+Pair events are the only collisions (there are no walls). At e < 1 an impact inside a touching
+group resolves the whole group at one instant (:mod:`~.contacts`), its contacts found through the
+minimum images as here (:func:`neighbour`), as in a box.
 """
 
 from __future__ import annotations
@@ -70,7 +71,7 @@ def crossing(x, y, vx, vy, c, geo):
 
 
 @njit(inline="always")
-def _neighbour(c, oy, ox, nx, ny, lx, ly):
+def neighbour(c, oy, ox, nx, ny, lx, ly):
     """The cell ``(ox, oy)`` cells away from cell ``c``, wrapped, and the shift ``(sx, sy)`` that
     brings a ball there next to cell ``c``."""
     gx = c % nx + ox
@@ -112,7 +113,7 @@ def next_event(i, rebuild, cl, ph, geo, wk):
     reach_y = 1 if ly > 0.0 else 0
     for oy in range(-reach_y, reach_y + 1):
         for ox in range(-1, 2):
-            cell, sx, sy = _neighbour(c, oy, ox, geo.nx, geo.ny, lx, ly)
+            cell, sx, sy = neighbour(c, oy, ox, geo.nx, geo.ny, lx, ly)
             k = cl.heads[cell]
             while k >= 0:
                 if k != i and (k > i or not rebuild):
@@ -148,7 +149,7 @@ def cross(bi, direction, cl, geo, images, bounds, dim):
     c = cl.ci[bi, C_CELL]
     ox = 1 if direction == grid.CROSS_RIGHT else -1 if direction == grid.CROSS_LEFT else 0
     oy = 1 if direction == grid.CROSS_UP else -1 if direction == grid.CROSS_DOWN else 0
-    cell, sx, sy = _neighbour(c, oy, ox, geo.nx, geo.ny, lx, ly)
+    cell, sx, sy = neighbour(c, oy, ox, geo.nx, geo.ny, lx, ly)
     r = cl.rec[bi]
     if sx != 0.0:
         r["x"] -= sx

@@ -43,7 +43,10 @@ a prediction made steps ago gives the same impact time as a fresh one.
 
 The cap on events per step (``max_events``) is never silent: a scene that reaches it stops at
 the instant of its last resolved event, in a valid state (no overlap, nothing outside the border),
-is flagged in ``capped``, and its clock shows how far it got.
+is flagged in ``capped``, and its clock shows how far it got. It counts every resolved event, every
+sweep, iteration and impulse of a contact group (:mod:`~.contacts`) and, in a periodic cell, every
+cell crossing, so that a step's laps round the cell are bounded by it too (a step of any length is
+accepted; one that laps the cell without bound stops at the cap).
 
 Reverse steps are run forward on negated velocities with restitution 1/e (the caller negates).
 """
@@ -82,7 +85,8 @@ from ..layout import (
 )
 from ..physics.impacts import record
 from ..physics.motion import ball_views, has_rotation
-from ..physics.response import ball_ball, ball_wall, impact_threshold, normal_impulse
+from ..physics.periodic import cell_lengths, nearest, wrap_point
+from ..physics.response import ball_ball_along, ball_wall, impact_threshold, normal_impulse
 from ..physics.toi import INF, toi_pair
 from ..physics.walls import snap_to_wall, wall_point
 from ..state import (
@@ -116,16 +120,17 @@ class Kind(NamedTuple):
     def label(self) -> str:
         """What the compile notice calls the kernel of this kind."""
         if self.periodic:
-            return "exact mode for periodic scenes"
+            return f"exact mode for {'inelastic ' if self.cascades else ''}periodic scenes"
         return f"exact mode for {'stick' if self.sticky else 'inelastic' if self.cascades else 'elastic'} scenes"
 
 
 def scene_kind(sticky: bool, elasticity: float, periodic: bool = False) -> Kind:
-    """The :class:`Kind` of a scene (``sticky``: ``Scene.sticky``). Periodic scenes are one kind
-    whatever their elasticity (they have neither stick clusters nor contact groups)."""
+    """The :class:`Kind` of a scene (``sticky``: ``Scene.sticky``). Periodic scenes have no stick
+    clusters; at e < 1 they have contact groups, as in a box."""
+    cascades = not sticky and elasticity < 1.0
     if periodic:
-        return Kind(False, False, True)
-    return Kind(bool(sticky), not sticky and elasticity < 1.0)
+        return Kind(False, cascades, True)
+    return Kind(bool(sticky), cascades)
 
 
 #: Every kind a scene can be (stick scenes have no contact groups), but periodic scenes: their
@@ -167,6 +172,11 @@ def exact_scratch(n: int) -> ExactScratch:
         np.empty((2, len(KINEMATICS))),
         np.empty((1, 2, len(BALL))),
         np.zeros(2, dtype=np.int64),
+        np.full(n, -1, dtype=np.int64),
+        np.empty(n, dtype=np.int64),
+        np.empty((n, 2), dtype=np.int64),
+        np.empty((n, 4)),
+        np.empty((nc, len(contacts.C_F))),
     )
 
 
@@ -385,15 +395,14 @@ def resolve_wall(sc, t_abs, bi, li, wall, b, ph, wk):
 
 
 @njit(refcount=False, forceinline=True)
-def resolve_pair(sc, t_abs, bi, bj, li, lj, b, ph, wk):
-    """Balls ``bi`` and ``bj``, rows ``li`` and ``lj`` of ``b`` (as in :func:`resolve_wall`), meet;
-    they are listed in ``wk.pending``. Returns the closing speed (0: no impulse)."""
+def resolve_pair(sc, t_abs, bi, bj, li, lj, dx, dy, b, ph, wk):
+    """Balls ``bi`` and ``bj``, rows ``li`` and ``lj`` of ``b`` (as in :func:`resolve_wall`), their
+    centres ``(dx, dy)`` apart (in a periodic cell, through the nearest image), meet; they are
+    listed in ``wk.pending``. Returns the closing speed (0: no impulse)."""
     pos, vel, radius = b.pos, b.vel, b.radius
     u_min = impact_threshold(li, lj, vel, ph.ratio, ph.floor)
-    speed = ball_ball(li, lj, pos, vel, b.inv_mass, ph.e, u_min)
+    speed = ball_ball_along(li, lj, dx, dy, vel, b.inv_mass, ph.e, u_min)
     if speed > 0.0:
-        dx = pos[lj, 0] - pos[li, 0]
-        dy = pos[lj, 1] - pos[li, 1]
         dist = math.sqrt(dx * dx + dy * dy)
         x = pos[li, 0] + radius[li] * dx / dist
         y = pos[li, 1] + radius[li] * dy / dist
@@ -504,6 +513,7 @@ def _step(kind: Kind):
     whole_state = sticky or cascades  # (events may be resolved on the whole ball state)
     # (the two-level queue works as a heap of every ball when a scene has no buckets; stick scenes never do)
     build, schedule, first, rebase, walk_ahead = cal.HEAP_QUEUE if kind.sticky else cal.BUCKET_QUEUE
+    cascade = contacts.cascade_kernel(periodic)  # (compiled only where called: scenes with cascades)
 
     @njit(inline="always")
     def predict(i, now, horizon, rebuild, rot, b, cl, ph, geo, wk):
@@ -519,23 +529,33 @@ def _step(kind: Kind):
             schedule(i, cl.rec, cl.ci, cl.q)
 
     @njit(inline="always")
-    def resolve(sc, t_abs, bi, bj, code, in_place, b, ev, ph, wk):
+    def resolve(sc, t_abs, bi, bj, code, in_place, budget, b, ev, ph, cl, geo, wk):
         """Resolve the event of balls ``bi`` and ``bj`` (``bj < 0``: the wall of ``code``); returns
-        how many balls' motion it changed (listed in ``wk.pending``)."""
+        how many balls' motion it changed (listed in ``wk.pending``), the work of a contact group it
+        started (beyond the event itself) and whether that ran out of ``budget``."""
         if sticky:
             if bj < 0:
-                return clusters.resolve_wall(sc, t_abs, bi, cal.EV_WALL - code, b, ph, wk)
-            return clusters.resolve_pair(sc, t_abs, bi, bj, b, wk)
+                return clusters.resolve_wall(sc, t_abs, bi, cal.EV_WALL - code, b, ph, wk), 0, False
+            return clusters.resolve_pair(sc, t_abs, bi, bj, b, wk), 0, False
         li = bi if in_place else 0
         if bj < 0:
             speed = resolve_wall(sc, t_abs, bi, li, cal.EV_WALL - code, ev, ph, wk)
             n_changed = 1
         else:
-            speed = resolve_pair(sc, t_abs, bi, bj, li, bj if in_place else 1, ev, ph, wk)
+            lj = bj if in_place else 1
+            dx = ev.pos[lj, 0] - ev.pos[li, 0]
+            dy = ev.pos[lj, 1] - ev.pos[li, 1]
+            if periodic and in_place:  # (the rows path put the partner at its nearest image)
+                lx, ly = cell_lengths(ph.bounds, ph.dim)
+                dx = nearest(dx, lx)
+                dy = nearest(dy, ly)
+            speed = resolve_pair(sc, t_abs, bi, bj, li, lj, dx, dy, ev, ph, wk)
             n_changed = 2
-        if cascades and in_place and speed > 0.0:
-            n_changed = contacts.cascade(sc, t_abs, bi, -1 - (cal.EV_WALL - code) if bj < 0 else bj, b, ph, wk)
-        return n_changed
+        if cascades:
+            if in_place and speed > 0.0:
+                j0 = -1 - (cal.EV_WALL - code) if bj < 0 else bj
+                return cascade(sc, t_abs, bi, j0, budget, b, ph, cl, geo, wk)
+        return n_changed, 0, False
 
     @njit(inline="always")
     def run_scene(sc, start, state, b, cl, geo, ph, wk):
@@ -560,6 +580,7 @@ def _step(kind: Kind):
         else:
             n_pending = 0
         walk = -1  # (see calendar.walk_next_bucket)
+        crossed = False  # (the last event popped was a cell crossing of a periodic scene)
         while True:
             # predict (the one place where predictions are made: what begin or the last event listed)
             for q in range(n_pending):
@@ -568,6 +589,9 @@ def _step(kind: Kind):
                 build(n, now, cl.rec, cl.ci, cl.q)
                 state.work_i[sc, W_CALENDAR_VALID] = True
                 whole = False
+            if crossed and state.work_i[sc, W_EVENTS] >= max_events:  # (laps count: see below)
+                state.capped[sc] = True
+                break
             # pop and screen
             bi = first(cl.rec, cl.ci, cl.q)
             if bi < 0:
@@ -578,6 +602,9 @@ def _step(kind: Kind):
             if not t <= horizon_end:
                 break
             if periodic:
+                # a cell crossing counts toward the cap: a step's laps round the cell are bounded by it
+                crossed = cal.is_crossing(cl.ci[bi, C_EVENT_OTHER])
+                state.work_i[sc, W_EVENTS] += crossed
                 verdict, t, now = cyclic.screen(bi, t, now, ph, cl, geo, wk, state.images[sc])
             else:
                 verdict, t, now = screen(bi, t, now, ph, cl, geo, wk)
@@ -613,12 +640,24 @@ def _step(kind: Kind):
             wk.counters[EVENTS] += 1
             # resolve, then invalidate (the changed balls are predicted afresh at the top of the loop)
             rows_before = state.n_imp[0] if periodic else 0
-            n_pending = resolve(sc, t0 + ph.sign * now, bi, bj, code, in_place, b, ev, ph, wk)
-            if periodic and bj >= 0:
+            budget = max_events - state.work_i[sc, W_EVENTS]
+            n_pending, work, out_of_budget = resolve(
+                sc, t0 + ph.sign * now, bi, bj, code, in_place, budget, b, ev, ph, cl, geo, wk
+            )
+            state.work_i[sc, W_EVENTS] += work
+            if periodic and in_place:
+                for row in range(rows_before, state.n_imp[0]):
+                    wrap_point(wk.imp, row, ph.bounds, ph.dim)
+            elif periodic and bj >= 0:
                 cyclic.after_pair(bj, rows_before, cl, wk.event, wk, ph.bounds, ph.dim)
             if sticky:
                 rot = has_rotation(b.body, b.omega)
             invalidate(n_pending, now, ev, in_place, cl, wk)
+            # (a contact group cut short, whose contacts may still close, or one that took the step's
+            # work to the cap: the step stops here)
+            if out_of_budget or (work > 0 and state.work_i[sc, W_EVENTS] >= max_events):
+                state.capped[sc] = True
+                break
         return now, rot
 
     @njit(inline="always")

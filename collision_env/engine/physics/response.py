@@ -138,8 +138,13 @@ def body_inverse_mass(i, mass, body, sticky):
 @njit(refcount=False, forceinline=True)
 def ball_ball(i, j, pos, vel, inv_mass, e, u_min):
     """Apply the impulse between balls ``i`` and ``j``. Returns the closing speed (0: no impulse)."""
-    dx = pos[j, 0] - pos[i, 0]
-    dy = pos[j, 1] - pos[i, 1]
+    return ball_ball_along(i, j, pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1], vel, inv_mass, e, u_min)
+
+
+@njit(refcount=False, forceinline=True)
+def ball_ball_along(i, j, dx, dy, vel, inv_mass, e, u_min):
+    """:func:`ball_ball` for balls ``i`` and ``j`` whose centres are ``(dx, dy)`` apart (``j``'s from
+    ``i``'s: in a periodic cell, through the nearest image)."""
     d = math.sqrt(dx * dx + dy * dy)
     # "approaching" is decided by the same expression as in toi.toi_pair, so that the predictor
     # and the response can never disagree about it through round-off

@@ -46,8 +46,13 @@ def coordinate_size(i, pos):
 def balls_touch(a, k, pos, radius):
     """Balls ``a`` and ``k`` touch within the contact tolerance (:func:`contact_tolerance`: 1e-9 of
     the radii, or the round-off of their coordinates)."""
-    dx = pos[k, 0] - pos[a, 0]
-    dy = pos[k, 1] - pos[a, 1]
+    return touching_at(a, k, pos[k, 0] - pos[a, 0], pos[k, 1] - pos[a, 1], pos, radius)
+
+
+@njit(refcount=False, forceinline=True)
+def touching_at(a, k, dx, dy, pos, radius):
+    """:func:`balls_touch` for balls whose centres are ``(dx, dy)`` apart (``k``'s from ``a``'s: in
+    a periodic cell, through the nearest image)."""
     sigma = radius[a] + radius[k]
     tol = contact_tolerance(sigma, max(coordinate_size(a, pos), coordinate_size(k, pos)), CONTACT_RTOL)
     return math.sqrt(dx * dx + dy * dy) - sigma <= tol

@@ -1,0 +1,194 @@
+"""Contact networks at e < 1 in exact mode: the cost of a step, its memory, and whether the clock gets through.
+
+Run it as::
+
+    python -m collision_env.bench.networks            # every row (about a minute once compiled)
+    python -m collision_env.bench.networks --quick    # smaller scenes, fewer steps
+
+Each row builds a scene through the public API (:class:`~collision_env.engine.Simulator`), steps it
+in frames of 1/60 s and reports the slowest step and the median one (wall-clock milliseconds, the
+kernels compiled beforehand by a small run of the same kind of scene), the growth of the process's
+peak resident memory over the row's steps (MB; 0 when it stays below an earlier peak, so rows run
+in order of size), and whether the clock reached the end of every step (no step stopped at the
+event cap). The rows:
+
+- ``row``: a row of touching balls (10^4) struck at one end by one more, at e = 0 and 0.5, in a box
+  and in a periodic cell; the strike lands in the first step. Target: every step within 50 ms.
+- ``pile``: 400 balls stacked in hexagonal rows on the floor of a box, each step's velocities nudged
+  down by g dt first (gravity, as an env does it). Target: every step within 20 ms, memory within
+  50 MB.
+- ``cluster``: 144 balls on a square lattice, a tenth of a diameter apart, all moving towards the
+  centre, at e = 0.3 and 0, in a box and in a periodic cell; it collapses into one contact network.
+- ``cooling``: a periodic gas of 200 disks at area fraction 0.5 and e = 0 (inelastic cooling), 600
+  steps, and the same gas in a box.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import resource
+import time
+
+import numpy as np
+
+from ..engine import Scene, Simulator
+
+FRAME = 1.0 / 60.0
+GRAVITY = 9.81
+#: Targets of the rows (ms per step; MB).
+ROW_MS, PILE_MS, PILE_MB = 50.0, 20.0, 50.0
+
+
+def row(n: int, e: float, periodic: bool) -> tuple[Scene, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``n`` touching balls of radius 5 mm in a row along x, and one more 1 m/s towards its low end,
+    arriving after half a frame; a box (or cell) four times as long as the row."""
+    r = 0.005
+    x = np.arange(n) * 2.0 * r
+    pos = np.vstack([[-r - FRAME / 2 - r, 0.0], np.stack([x, np.zeros(n)], 1)])
+    vel = np.zeros((n + 1, 2))
+    vel[0, 0] = 1.0
+    length = 4.0 * (x[-1] + 2 * r) + 1.0
+    scene = Scene(bounds=(-0.5, -0.25, length - 0.5, 0.25), elasticity=e, periodic=periodic)
+    return scene, pos, vel, np.ones(n + 1), np.full(n + 1, r)
+
+
+def pile(n: int, e: float, hexagonal: bool = False) -> tuple[Scene, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``n`` balls of radius 1 cm at rest in rows of 20 on the floor of a box twice as wide, each
+    touching its neighbours (within round-off): stacked in columns (a square lattice), or with
+    ``hexagonal`` in the dips of the row below (rows of 20 and 19, a frictionless heap that spreads)."""
+    r = 0.01
+    d = 2.0 * r * (1.0 + 1e-12)  # (a hair apart: touching within the contact tolerance, no overlap)
+    rise = d * math.sqrt(3.0) / 2.0 if hexagonal else d
+    places: list[tuple[float, float]] = []
+    k = 0
+    while len(places) < n:
+        odd = hexagonal and k % 2 == 1
+        places.extend(((j + (0.5 if odd else 0.0)) * d, r + k * rise) for j in range(19 if odd else 20))
+        k += 1
+    pos = np.array(places[:n], dtype=np.float64)
+    scene = Scene(bounds=(-0.2, 0.0, 0.6, 1.0), elasticity=e)
+    return scene, pos, np.zeros((n, 2)), np.ones(n), np.full(n, r)
+
+
+def cluster(side: int, e: float, periodic: bool) -> tuple[Scene, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``side`` x ``side`` balls of radius 1 cm on a square lattice 2.2 cm apart, each moving at
+    1 m/s towards the centre, in a box (or cell) of 1 m."""
+    r = 0.01
+    k = (np.arange(side) - (side - 1) / 2.0) * 2.2 * r
+    pos = np.stack(np.meshgrid(k, k), -1).reshape(-1, 2)
+    dist = np.hypot(pos[:, 0], pos[:, 1])
+    vel = -pos / np.where(dist > 0.0, dist, 1.0)[:, None]
+    n = len(pos)
+    scene = Scene(bounds=(-0.5, -0.5, 0.5, 0.5), elasticity=e, periodic=periodic)
+    return scene, pos, vel, np.ones(n), np.full(n, r)
+
+
+def cooling(
+    n: int, phi: float, periodic: bool, seed: int = 0
+) -> tuple[Scene, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``n`` disks at area fraction ``phi`` in a unit cell (or box), on a jittered square lattice,
+    random velocities of unit mean square speed, e = 0."""
+    rng = np.random.default_rng(seed)
+    r = math.sqrt(phi / (n * math.pi))
+    side = math.ceil(math.sqrt(n))
+    h = 1.0 / side
+    cells = np.stack(np.meshgrid(np.arange(side), np.arange(side)), -1).reshape(-1, 2)[:n]
+    pos = h * (cells + 0.5) + rng.uniform(-1, 1, (n, 2)) * max(0.0, 0.5 * h - r) * 0.9
+    vel = rng.normal(size=(n, 2)) / math.sqrt(2.0)
+    scene = Scene(bounds=(0.0, 0.0, 1.0, 1.0), elasticity=0.0, periodic=periodic)
+    return scene, pos, vel, np.ones(n), np.full(n, r)
+
+
+def _peak_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def measure(build: tuple, steps: int, nudge: float = 0.0) -> dict:
+    """Step a scene ``steps`` frames (each velocity nudged by ``-nudge`` along y first): the slowest
+    and median step (ms), the peak memory's growth (MB), steps that reached their end, the clock."""
+    scene, pos, vel, mass, radius = build
+    sim = Simulator(scene, pos, vel, mass, radius)
+    dv = np.zeros((len(pos), 2))
+    dv[:, 1] = -nudge
+    times = []
+    reached = 0
+    before = _peak_mb()
+    for _ in range(steps):
+        if nudge:
+            sim.nudge(dv)
+        t_start = sim.time
+        start = time.perf_counter()
+        sim.step(FRAME)
+        times.append(1e3 * (time.perf_counter() - start))
+        reached += bool(math.isclose(sim.time - t_start, FRAME, rel_tol=1e-9)) and not sim.cap_reached
+    return {
+        "balls": len(pos),
+        "steps": steps,
+        "max_ms": max(times),
+        "median_ms": float(np.median(times)),
+        "peak_mb_growth": _peak_mb() - before,
+        "steps_reaching_their_end": reached,
+        "clock_s": sim.time,
+    }
+
+
+def _warm_up() -> None:
+    """Compile the kernels the rows use (small scenes of the same kinds)."""
+    for e in (0.0, 0.5):
+        for periodic in (False, True):
+            measure(row(40, e, periodic), 2)
+    measure(pile(60, 0.0), 2, GRAVITY * FRAME)
+
+
+def run(quick: bool = False) -> dict:
+    """Every row (smaller scenes with ``quick``)."""
+    _warm_up()
+    n_row, n_pile, side, n_gas, gas_steps = (1000, 100, 6, 50, 60) if quick else (10_000, 400, 12, 200, 600)
+    rows = {}
+    rows["pile e=0"] = measure(pile(n_pile, 0.0), 60, GRAVITY * FRAME)
+    rows["pile e=0.5"] = measure(pile(n_pile, 0.5), 60, GRAVITY * FRAME)
+    for periodic in (False, True):
+        where = "cell" if periodic else "box"
+        for e in (0.0, 0.5):
+            rows[f"row e={e:g} {where}"] = measure(row(n_row, e, periodic), 10)
+        for e in (0.3, 0.0):
+            rows[f"cluster e={e:g} {where}"] = measure(cluster(side, e, periodic), 60)
+        rows[f"cooling e=0 {where}"] = measure(cooling(n_gas, 0.5, periodic), gas_steps)
+    return rows
+
+
+def render(rows: dict) -> str:
+    """A markdown table of the rows, with the targets."""
+    lines = [
+        "| scene | balls | steps | slowest step (ms) | median step (ms) | peak memory growth (MB) "
+        "| steps reaching their end |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for name, r in rows.items():
+        lines.append(
+            f"| {name} | {r['balls']} | {r['steps']} | {r['max_ms']:.1f} | {r['median_ms']:.2f} | "
+            f"{r['peak_mb_growth']:.1f} | {r['steps_reaching_their_end']} of {r['steps']} |"
+        )
+    lines.append("")
+    lines.append(f"Targets: a row step within {ROW_MS:g} ms; a pile step within {PILE_MS:g} ms and {PILE_MB:g} MB; ")
+    lines.append("every step reaching its end.")
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m collision_env.bench.networks", description=__doc__.split("\n")[0])
+    parser.add_argument("--quick", action="store_true", help="smaller scenes, fewer steps")
+    parser.add_argument("--json", help="write the raw figures here")
+    args = parser.parse_args(argv)
+    rows = run(args.quick)
+    print(render(rows))
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(rows, f, indent=1)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
