@@ -444,7 +444,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--substeps", type=int, help="sub-steps per control step for naive/posteriori")
     p.add_argument("--env-kwargs", nargs="*", metavar="KEY=VALUE", help="more env keywords, e.g. dt=0.1")
     p.add_argument("--output", default="runs", help="folder for run folders (default: %(default)s)")
-    p.add_argument("--run-name", help="run folder name (default: <env>-<mode>-s<seed>-<time>, as train_ppo's)")
+    p.add_argument(
+        "--run-name",
+        help="run folder name (default: <env>-<mode><k>-s<seed>-<time>, k the sub-steps if not 1, as PPO's)",
+    )
     p.add_argument("--overwrite", action="store_true", help="replace an existing run folder")
     p.add_argument("--hyperparams", default=str(HYPERPARAMS), help="hyperparameter YAML (default: the shipped file)")
     p.add_argument("--threads", type=int, default=1, help="torch threads of the learner (default: %(default)s)")

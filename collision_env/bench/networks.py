@@ -2,7 +2,7 @@
 
 Run it as::
 
-    python -m collision_env.bench.networks            # every row (about a minute once compiled)
+    python -m collision_env.bench.networks            # every row (some seconds once compiled)
     python -m collision_env.bench.networks --quick    # smaller scenes, fewer steps
 
 Each row builds a scene through the public API (:class:`~collision_env.engine.Simulator`), steps it

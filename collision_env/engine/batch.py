@@ -174,10 +174,12 @@ class BatchSimulator:
         :data:`MAX_SUBSTEPS` (1e5: a compiled step cannot be interrupted, so this bounds a step's
         work). Exact mode is exact at any step, so it takes only 1.
     max_events:
-        Cap on events per scene per step in exact mode. A scene that reaches it stops at its last
-        event, in a valid state; :attr:`cap_reached` flags it and an :class:`EventCapWarning` is
-        issued. The default, ``None``, is :func:`default_event_cap` of the ball count: a budget per
-        ball, far above what a gas spends in a frame, so that only a cascade reaches it.
+        Cap on events per scene per step in exact mode: collisions, a contact group's sweeps,
+        iterations and impulses (at e < 1), and a periodic cell's cell crossings all count. A scene
+        that reaches it stops at its last event, in a valid state; :attr:`cap_reached` flags it and
+        an :class:`EventCapWarning` is issued. The default, ``None``, is :func:`default_event_cap`
+        of the ball count: a budget per ball, far above what a gas spends in a frame, so that only
+        a cascade reaches it.
     collapse_ratio, collapse_floor:
         The inelastic-collapse regulariser: a collision whose normal closing speed is at most
         ``u_min = max(collapse_ratio * s, collapse_floor)`` leaves the pair separating at ``u_min``,

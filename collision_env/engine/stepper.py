@@ -336,8 +336,9 @@ class Stepper:
         write them, it stays there.
 
         The fast path takes forward steps up to ``_fast_dt``: with a border, steps that need no
-        check but ``dt``'s own; in a periodic cell, those whose laps round the cell a checked step
-        bounded (see :meth:`_checked_step`)."""
+        check but ``dt``'s own; in a periodic cell in exact mode, any (the event cap bounds the laps);
+        in a periodic cell in a cheap mode, those whose laps round the cell a checked step bounded
+        (see :meth:`_checked_step`)."""
         if 0.0 < dt <= self._fast_dt:  # the common case, checked in one test
             rows = self._kernel(self._pack, dt, self.start)
             if rows >= 0:  # no scene stalled or reached the event cap
@@ -349,8 +350,8 @@ class Stepper:
         return self._checked_step(dt, stacklevel + 1)
 
     def _checked_step(self, dt: float, stacklevel: int) -> np.ndarray:
-        """:meth:`step` off its fast path: backwards, without a border, in a periodic cell, or of a
-        step checked for the first time."""
+        """:meth:`step` off its fast path: backwards, without a border, in a periodic cell in a
+        cheap mode, or of a step checked for the first time."""
         label = self.label
         check_seconds(dt, "dt")
         if self.scene.bounds is None:
@@ -416,7 +417,7 @@ class Stepper:
         f = 0
         buffer = None  # the compiled loop's copy of the impacts
         size = len(self._imp)
-        if self._bounds_laps:  # (the run's laps, checked once: a periodic step has no fast path)
+        if self._bounds_laps:  # (the run's laps, checked once: a cheap periodic step has no fast path)
             check_laps(self.scene, self.mass, self.vel, dt * n, self.label)
         while f < n:
             forward = self._sign > 0.0 and self.scene.bounds is not None

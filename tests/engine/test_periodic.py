@@ -475,6 +475,19 @@ def test_laps_are_counted_exactly_and_bounded_by_the_event_cap():
     assert np.isfinite(capped.positions).all() and (0.0 <= capped.positions).all() and (capped.positions <= 1.0).all()
 
 
+def test_a_step_whose_crossings_reach_the_cap_exactly_is_not_capped():
+    """The cap stops a step only when there is more to do: a last cell crossing that brings the
+    count to exactly ``max_events``, with no event left in the step, ends it normally."""
+    crossings = _lapping(1.0)
+    crossings.step(2.5)
+    counted = crossings.stats["cell_crossings"] + crossings.stats["events"]
+    assert counted >= 2  # (a lap a crossing: the two balls make one cell)
+    sim = _lapping(1.0, max_events=counted)
+    sim.step(2.5)
+    assert not sim.cap_reached and sim.time == 2.5
+    np.testing.assert_array_equal(sim.positions, crossings.positions)
+
+
 def test_the_cheap_modes_still_bound_laps():
     """Their sub-steps wrap positions by floor division: a step may lap the cell ``MAX_LAPS`` times."""
     scene = Scene(bounds=(0.0, 0.0, 1.0, 1.0), periodic=True)

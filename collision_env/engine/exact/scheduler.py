@@ -580,7 +580,6 @@ def _step(kind: Kind):
         else:
             n_pending = 0
         walk = -1  # (see calendar.walk_next_bucket)
-        crossed = False  # (the last event popped was a cell crossing of a periodic scene)
         while True:
             # predict (the one place where predictions are made: what begin or the last event listed)
             for q in range(n_pending):
@@ -589,9 +588,6 @@ def _step(kind: Kind):
                 build(n, now, cl.rec, cl.ci, cl.q)
                 state.work_i[sc, W_CALENDAR_VALID] = True
                 whole = False
-            if crossed and state.work_i[sc, W_EVENTS] >= max_events:  # (laps count: see below)
-                state.capped[sc] = True
-                break
             # pop and screen
             bi = first(cl.rec, cl.ci, cl.q)
             if bi < 0:
@@ -603,7 +599,12 @@ def _step(kind: Kind):
                 break
             if periodic:
                 # a cell crossing counts toward the cap: a step's laps round the cell are bounded by it
+                # (checked here, within the step's horizon: a step whose last crossing reaches the cap
+                # exactly, with nothing left to run, is not capped)
                 crossed = cal.is_crossing(cl.ci[bi, C_EVENT_OTHER])
+                if crossed and state.work_i[sc, W_EVENTS] >= max_events:
+                    state.capped[sc] = True
+                    break
                 state.work_i[sc, W_EVENTS] += crossed
                 verdict, t, now = cyclic.screen(bi, t, now, ph, cl, geo, wk, state.images[sc])
             else:
