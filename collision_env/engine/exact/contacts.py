@@ -95,10 +95,11 @@ SETTLE_RTOL = 1e-8
 MIN_SETTLE_ITERATIONS = 256
 
 #: Columns of ``Work.c_f``, per contact: its separation vector (from ``c_a`` to ``c_b``; 0 for a
-#: wall), its unit normal, its closing speed when the limit is sought, and the limit's impulses (the
-#: accelerated projected gradient's iterate, its extrapolated point and its candidate).
-C_F = ("dx", "dy", "nx", "ny", "closing", "lam", "y", "z")
-F_DX, F_DY, F_NX, F_NY, F_CLOSING, F_LAM, F_Y, F_Z = range(len(C_F))
+#: wall), its unit normal, its closing speed when the limit is sought (what the reports give), the
+#: limit's impulses (the accelerated projected gradient's iterate, its extrapolated point and its
+#: candidate) and its shortfall from separating at ``u_min`` at the start of that pass (``h``).
+C_F = ("dx", "dy", "nx", "ny", "closing", "lam", "y", "z", "shortfall")
+F_DX, F_DY, F_NX, F_NY, F_CLOSING, F_LAM, F_Y, F_Z, F_SHORTFALL = range(len(C_F))
 #: How a phase of a cascade ended: every contact separating, still running, or out of budget.
 DONE, OPEN, CAPPED = range(3)
 #: Columns of ``Work.g_f`` in the accelerated limit, per group place: velocities before it, and at
@@ -329,8 +330,8 @@ def _sweep(sc, t_abs, n_contacts, u_min, sweeps, budget, b, ph, wk):
 
 
 @njit(inline="always")
-def _contact_normal(c, c_a, c_b, c_f):
-    """Unit normal of contact ``c``, pointing from ball ``c_a[c]`` to its partner (ball or wall)."""
+def _contact_normal(c, c_f):
+    """Unit normal of contact ``c``, pointing from its ball ``c_a[c]`` to its partner (ball or wall)."""
     return c_f[c, F_NX], c_f[c, F_NY]
 
 
@@ -352,7 +353,7 @@ def _record_contact(sc, t_abs, c, speed, impulse, b, ph, wk):
     other = wk.c_b[c]
     pos, radius = b.pos, b.radius
     if other >= 0:
-        nx, ny = _contact_normal(c, wk.c_a, wk.c_b, wk.c_f)
+        nx, ny = _contact_normal(c, wk.c_f)
         x = pos[a, 0] + radius[a] * nx
         y = pos[a, 1] + radius[a] * ny
         record(wk.imp, wk.n_imp, sc, t_abs, a, other, -1, x, y, speed, impulse)
@@ -478,7 +479,7 @@ def settle(size, n_contacts, u_min, b, wk):
     for c in range(n_contacts):
         a = c_a[c]
         other = c_b[c]
-        nx, ny = _contact_normal(c, c_a, c_b, wk.c_f)
+        nx, ny = _contact_normal(c, wk.c_f)
         # separation speed of the contact = G_c . y with y = sqrt(m) v (mass-weighted velocities)
         qa = slot[a]
         g_mat[c, 2 * qa] = -nx * root_w[qa]
@@ -641,6 +642,8 @@ def _settle_accelerated(size, n_contacts, u_min, accuracy, iterations, budget, b
     for c in range(n_contacts):
         c_f[c, F_LAM] = 0.0
         c_f[c, F_Y] = 0.0
+        # (h from this pass's own start: a second pass starts where the first left the velocities)
+        c_f[c, F_SHORTFALL] = u_min - _separation(c, vel, wk)
     step = 1.0 / _lipschitz(size, n_contacts, inv_mass, wk)
     t = 1.0
     work = 0
@@ -659,7 +662,7 @@ def _settle_accelerated(size, n_contacts, u_min, accuracy, iterations, budget, b
         turn = 0.0
         for c in range(n_contacts):
             z = c_f[c, F_Z]
-            f_z -= z * (u_min + c_f[c, F_CLOSING])
+            f_z -= z * c_f[c, F_SHORTFALL]
             turn += (c_f[c, F_Y] - z) * (z - c_f[c, F_LAM])
             if z != 0.0:
                 _push(c, z, vel, inv_mass, wk)
@@ -716,7 +719,7 @@ def _separation(c, vel, wk):
     """The normal speed at which contact ``c`` separates (m/s; negative: it closes)."""
     a = wk.c_a[c]
     other = wk.c_b[c]
-    nx, ny = _contact_normal(c, wk.c_a, wk.c_b, wk.c_f)
+    nx, ny = _contact_normal(c, wk.c_f)
     sep = -(vel[a, 0] * nx + vel[a, 1] * ny)
     if other >= 0:
         sep += vel[other, 0] * nx + vel[other, 1] * ny
