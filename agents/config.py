@@ -365,6 +365,12 @@ def run_label(env_id: str, mode: str, substeps: int, seed: int) -> str:
     return f"{name}-{knob}-s{seed}"
 
 
+def engine_mode(env_kwargs: dict) -> tuple[str, int]:
+    """The engine mode and sub-steps a run's merged env keywords give (the env's defaults where
+    they give none: exact, 1)."""
+    return env_kwargs.get("mode", "exact"), int(env_kwargs.get("substeps", 1))
+
+
 def default_run_name(env_id: str, mode: str, substeps: int, seed: int) -> str:
     """:func:`run_label` and the time: ``oneballtarget-exact-s0-20260101-120000``."""
     return f"{run_label(env_id, mode, substeps, seed)}-{time.strftime('%Y%m%d-%H%M%S')}"
@@ -376,7 +382,7 @@ def make_run_dir(
     """The run folder ``output/run_name`` (default :func:`default_run_name` of the run's mode and
     substeps in ``env_kwargs``), made empty: an existing non-empty one is a UsageError unless
     ``overwrite``, and then nothing of the earlier run survives into this one."""
-    mode, substeps = env_kwargs.get("mode", "exact"), int(env_kwargs.get("substeps", 1))
+    mode, substeps = engine_mode(env_kwargs)
     run_dir = Path(output) / (run_name or default_run_name(env_id, mode, substeps, seed))
     if run_dir.exists() and any(run_dir.iterdir()):
         if not overwrite:

@@ -49,6 +49,7 @@ from agents.config import (
     add_progress_flags,
     as_int,
     check_env_id,
+    engine_mode,
     episode_steps,
     hyperparams_for,
     is_run_config,
@@ -423,8 +424,7 @@ def train(
     eval_episodes = as_int("eval_episodes", eval_episodes)
     threads = as_int("threads", threads)
     kwargs, n_envs, timesteps, norm = settings.env_kwargs, settings.n_envs, settings.timesteps, settings.normalize
-    mode = kwargs.get("mode", "exact")
-    substeps = int(kwargs.get("substeps", 1))
+    mode, substeps = engine_mode(kwargs)
 
     run_dir = make_run_dir(output, run_name, env_id, kwargs, seed, overwrite)
 
@@ -513,7 +513,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--substeps", type=int, help="sub-steps per control step for naive/posteriori")
     p.add_argument("--env-kwargs", nargs="*", metavar="KEY=VALUE", help="more env keywords, e.g. dt=0.1")
     p.add_argument("--output", default="runs", help="folder for run folders (default: %(default)s)")
-    p.add_argument("--run-name", help="run folder name (default: <env>-<mode>-s<seed>-<time>)")
+    p.add_argument(
+        "--run-name", help="run folder name (default: <env>-<mode><k>-s<seed>-<time>, k the sub-steps if not 1)"
+    )
     p.add_argument("--overwrite", action="store_true", help="replace an existing run folder")
     p.add_argument(
         "--hyperparams",

@@ -41,6 +41,7 @@ from agents.config import (
     UsageError,
     as_int,
     check_env_id,
+    engine_mode,
     episode_steps,
     hyperparams_for,
     log_tee,
@@ -319,7 +320,7 @@ def train(
         raise UsageError(f"target_success: expected a share in (0, 1], got {target!r}")
     kwargs = merge_env_kwargs(hp.get("env_kwargs"), env_kwargs, mode, substeps)
     steps = episode_steps(env_id, kwargs)  # validates every env kwarg
-    mode = kwargs.get("mode", "exact")
+    mode, _ = engine_mode(kwargs)
     kwargs_env = {**kwargs, "max_episode_steps": steps}
     require("distributed", "agents.train_rllib", checkout=True)
     config = build_config(
