@@ -88,8 +88,8 @@ class ExactScratch(NamedTuple):
     event: np.ndarray  #: (1, 2, len(BALL)) float64: the two balls of an event, laid out as ``BALL``
     event_body: np.ndarray  #: (2,) int64: their cluster roots (the rows' own indices)
     slot: np.ndarray  #: (N,) int64: a ball's place in the contact group being resolved (-1: none)
-    near: np.ndarray  #: (N,) int64: the balls touching one ball of a contact group
-    g_i: np.ndarray  #: (N, 2) int64: per group place, its neighbours along a row (or pooled blocks)
+    near: np.ndarray  #: (N,) int64: the balls touching one ball of a contact group (or its new order)
+    g_i: np.ndarray  #: (N, 2) int64: per group place, its neighbours along a row, pooled blocks or degree
     g_f: np.ndarray  #: (N, 4) float64: per group place, pooled blocks or velocities (``contacts``)
     c_f: np.ndarray  #: (C, 8) float64: per contact, its geometry and impulses (``contacts.F_*``)
 

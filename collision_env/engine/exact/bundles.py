@@ -41,8 +41,8 @@ class Work(NamedTuple):
     c_hit: np.ndarray  #: ... and whether it was reported already
     c_f: np.ndarray  #: ... and its separation (dx, dy), closing speed and impulse (``contacts``)
     slot: np.ndarray  #: a ball's place in the contact group (-1: none)
-    near: np.ndarray  #: the balls touching one ball of the group
-    g_i: np.ndarray  #: per group place: neighbours along a row, pooled blocks (``contacts``)
+    near: np.ndarray  #: the balls touching one ball of the group; a group's new order when reordered
+    g_i: np.ndarray  #: per group place: neighbours along a row, pooled blocks, contact degrees (``contacts``)
     g_f: np.ndarray  #: per group place: pooled blocks' weights and sums
     ki: np.ndarray  #: a rotating cluster member's kinematics (``layout.KINEMATICS``)
     kj: np.ndarray  #: ... and its partner's
