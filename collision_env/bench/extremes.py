@@ -10,7 +10,7 @@ the origin, slow pairs beside a fast ball, inputs at the edge of float64 (and ju
 must be refused) and balls as tall as the box (refused), rows and lattices of touching balls that
 span the box along x or y (2 to 4,096 balls, e = 1, 0.5 and 0; refused, and run with room to
 move), ``set_state`` with each kind of bad field (refused, the state untouched) and 1e9 sub-steps
-(refused), and every other way in (issue 39): a stick cluster glued 1 m across and a misspelt key
+(refused), and every other way in: a stick cluster glued 1 m across and a misspelt key
 (refused in every mode), a position a round-off outside a periodic cell (back bit for bit), an
 env's task state with an index out of its array, a NaN or a misspelt key (refused, the env
 untouched) and its round trip, env configs beyond what is counted (refused), impacts indexed by
@@ -936,7 +936,7 @@ def _add_state_cells(add):
 
 
 # --------------------------------------------------------------------------- refusals and round trips
-# Every way in besides the constructor (issue 39): engine and env states (a refusal names the field
+# Every way in besides the constructor: engine and env states (a refusal names the field
 # and changes nothing; a state goes back bit for bit), env configs, impacts' indices, compression
 # and the observables. Each cell steps the three balls once in the mode, then makes its check there.
 def _stick_cluster_apart(mode):

@@ -139,13 +139,14 @@ class Labels:
 
 def refuse_first(
     mask: np.ndarray,
-    label: Labels,
+    label: Callable[[int, int], str],
     message: Callable[[int, int], str],
     scenes: np.ndarray | None = None,
     field: str = "",
 ) -> None:
-    """Raise a ValueError for the first ``True`` of a ``(K, N)`` ``mask`` of scenes and balls, if
-    any: ``"{field}: {label}{message(s, i)}"``, ``s`` and ``i`` the row and column of the mask
+    """Raise a ValueError for the first ``True`` of a ``(K, N)`` ``mask`` of scenes and balls (or
+    other items of a scene), if any: ``"{field}: {label(s, i)}{message(s, i)}"`` (``label``: a
+    :class:`Labels`, or any namer of a scene's item), ``s`` and ``i`` the row and column of the mask
     (``scenes[s]`` the scene the label names, if the rows are a pick of the batch's scenes)."""
     if not mask.any():  # (the common case: several times cheaper than argwhere)
         return

@@ -1,4 +1,4 @@
-"""The extremes report's cells of refusals and round trips (issue 39): exact mode passes them all,
+"""The extremes report's cells of refusals and round trips: exact mode passes them all,
 and a cell fails when what it checks is missing."""
 
 import pytest

@@ -61,7 +61,7 @@ def test_impacts_is_a_sequence_of_impact_tuples_over_the_records():
 
 @pytest.mark.parametrize("key", [None, True, False, np.True_, (None,), [[0, 1]], np.zeros((2, 2), dtype=int)])
 def test_impacts_refuse_an_index_that_is_not_one_of_rows(key):
-    # issue 39: impacts[None] and impacts[True] gave 2-D arrays of records, which no Impacts is
+    # (on d8ab1a0 impacts[None] and impacts[True] gave 2-D arrays of records)
     imp = _box_gas().step(1.0)
     with pytest.raises(TypeError, match="impacts: index with an integer, a slice, a field name, a bool mask"):
         imp[key]

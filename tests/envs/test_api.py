@@ -330,7 +330,7 @@ def test_episode_lengths_and_event_caps_beyond_what_is_counted_exactly_are_refus
     "field", ["max_dv", "max_speed", "hit_reward", "success_bonus", "miss_penalty", "action_cost", "shaping"]
 )
 def test_speeds_and_reward_weights_beyond_the_engines_range_are_refused_by_name(field):
-    # issue 39: max_dv=1e300 squared to inf in the nudge's size, and the reward was -inf
+    # (on d8ab1a0 max_dv=1e300 squared to inf in the nudge's size, and the reward was -inf)
     with pytest.raises(ValueError, match=rf"{field}: must be <= 1e\+150, got 1e\+300"):
         gym.make("CollisionEnv/OneBallTarget-v0", **{field: 1e300})
     if field not in ("max_dv", "max_speed"):

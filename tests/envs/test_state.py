@@ -1,4 +1,4 @@
-"""The envs' set_state checks the task state's values as the engine checks its own (issue 39):
+"""The envs' set_state checks the task state's values as the engine checks its own:
 finite floats in range, indices within their arrays, flags of the right kind, no unknown key.
 A refusal names the field and leaves the env as it was; a state it takes steps to finite outputs."""
 

@@ -51,7 +51,7 @@ def test_henderson_agrees_with_kolafa_rottner_where_it_should():
 @pytest.mark.parametrize("function", [henderson_g, henderson_z, kolafa_rottner_z])
 @pytest.mark.parametrize("packing", [1.0, 2.0, -0.1, math.nan, math.pi / (2 * math.sqrt(3)), True, "0.3"])
 def test_area_fractions_without_meaning_are_refused(function, packing):
-    # issue 39: henderson_g divided by zero at 1 and returned a number at 2
+    # (on d8ab1a0 henderson_g divided by zero at 1 and returned a number at 2)
     with pytest.raises(ValueError, match="packing"):
         function(packing)
 

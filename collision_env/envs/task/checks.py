@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from collision_env.engine.scene import MAX_MAGNITUDE, WALL_NAMES
+from collision_env.engine.validation import refuse_first
 from collision_env.envs._config import MAX_EPISODE_STEPS
 
 from .layout import SCENE_FLOATS, SCENE_INTS, TARGET_GEOMETRY, TARGET_INTS
@@ -74,12 +75,29 @@ def _rules(n_targets: int, n_balls: int, walls: tuple[int, ...]) -> list[_Rule]:
 _LAYOUTS = {"scene_f": SCENE_FLOATS, "scene_i": SCENE_INTS, "targets": TARGET_INTS, "target_geo": TARGET_GEOMETRY}
 
 
-def _where(index: tuple, field: str, batch: int) -> str:
-    """``"scene b, target k: "`` of an element of a field's values (its column taken off)."""
-    parts = [f"scene {index[0]}"] if batch > 1 else []
-    if len(index) > 1:
-        parts.append(f"{'ball' if field == 'body' else 'target'} {index[1]}")
+def _where(scene: int, item: int | None, field: str, batch: int) -> str:
+    """``"scene b, target k: "`` of an element of a field's values (its column taken off; ``item``
+    None where a value is the scene's own)."""
+    parts = [f"scene {scene}"] if batch > 1 else []
+    if item is not None:
+        parts.append(f"{'ball' if field == 'body' else 'target'} {item}")
     return ", ".join(parts) + ": " if parts else ""
+
+
+def _refuse_first(bad: np.ndarray, values: np.ndarray, name: str, column: str | None, must: str) -> None:
+    """The engine's ``refuse_first`` over a rule's ``bad`` mask of ``values`` (per scene, or per
+    scene and target or ball), the field named as ``name`` and ``column``."""
+    batch = values.shape[0]
+    flat = values.reshape(batch, -1)  # (scenes x their targets or balls: refuse_first's grid)
+
+    def where(s: int, k: int) -> str:
+        return _where(s, k if values.ndim > 1 else None, name, batch)
+
+    def message(s: int, k: int) -> str:
+        return f"{must}, got {flat[s, k].item()!r}"
+
+    field = f"set_state: {name if column is None else f'{name} {column}'}"
+    refuse_first(bad.reshape(batch, -1), where, message, field=field)
 
 
 def checked_task_state(
@@ -104,8 +122,5 @@ def checked_task_state(
         values = arrays[name] if column is None else arrays[name][..., getattr(_LAYOUTS[name], column)]
         with np.errstate(invalid="ignore"):
             bad = ~good(values, arrays[name])
-        if bad.any():
-            index = tuple(int(i) for i in np.argwhere(bad)[0])
-            label = name if column is None else f"{name} {column}"
-            raise ValueError(f"set_state: {label}: {_where(index, name, batch)}{must}, got {values[index].item()!r}")
+        _refuse_first(bad, values, name, column, must)
     return {name: arr.astype(current[name].dtype) for name, arr in arrays.items()}
