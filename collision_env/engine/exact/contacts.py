@@ -68,6 +68,7 @@ from ..physics.tolerance import balls_touch, touching_at
 from ..physics.walls import is_low_wall, wall_axis, wall_contact, wall_count, wall_normal, wall_point
 from . import grid
 from .periodic import neighbour
+from .trajectories import take_in_place
 
 #: Sweeps of sequential impulses over a contact group in one instant before the cascade is replaced
 #: by its limit. Cascades among comparable masses end within a few dozen sweeps; the criterion is a
@@ -83,6 +84,12 @@ MIN_SWEEPS = 8
 #: one pass (plastic sequential impulses along a row of L balls need about L^2 sweeps per digit,
 #: and end where the limit is, up to the regulariser's ``u_min``).
 PLASTIC_ROW_BALLS = 3
+#: A contact whose normal is within this slope of an axis lies along it, for a row
+#: (:func:`_row_axis`): balls stacked in a column drift apart sideways by round-off (a position
+#: moved in one long stretch and one moved in many short ones round differently), and the row's
+#: limit takes the tilt into account in its contacts' separations (its impulses, along the axis,
+#: leave out their share of ``ROW_SLOPE`` across it).
+ROW_SLOPE = 2.0**-40
 #: Groups of up to this many balls go to their limit by the dense least-distance solve.
 DENSE_BALLS = 32
 #: Contact visits (each of a few passes) the accelerated limit of one group may take (at least
@@ -105,6 +112,9 @@ DONE, OPEN, CAPPED = range(3)
 #: Columns of ``Work.g_f`` in the accelerated limit, per group place: velocities before it, and at
 #: its last iterate (x and y each).
 _V0, _V_LAM = 0, 2
+#: Columns of ``Work.g_f`` in a row's limit, per group place: its contact with the next ball's
+#: slope off the axis and 1 / its normal's component along it (:func:`_row_axis`).
+_TILT = 2
 #: In a row's neighbour links: a wall.
 _WALL = -2
 
@@ -121,15 +131,17 @@ _CASCADES: dict = {}
 
 def cascade_kernel(periodic: bool) -> Any:
     """The contact-group kernel of scenes in a box (``periodic`` False) or a periodic cell:
-    ``cascade(sc, t_abs, i0, j0, budget, b, ph, cl, geo, wk) -> (size, work, capped)``.
+    ``cascade(sc, t_abs, now, i0, j0, budget, b, ph, cl, geo, wk) -> (size, work, capped)``.
 
     It resolves, at one instant, every contact of the group of touching balls an impact started
     (see the module doc). The impact was between ball ``i0`` and ball ``j0``, or the wall
     ``-1 - j0`` when ``j0 < 0``; the caller has applied and reported it, so that contact is not
     reported again here (one collision, one report, even when round-off leaves it closing at
     ~1e-16 m/s after a plastic impulse). The group's regulariser speed comes from its own balls when
-    it is formed (``response.group_threshold``). ``b`` is the whole ball state of the scene, synced
-    with the calendar ``cl`` (whose grid ``geo`` finds neighbours). Returns the group size (its
+    it is formed (``response.group_threshold``). ``b`` is the whole ball state of the scene, ``now``
+    the impact's step time: the impact's balls are there in ``b`` (resolved), and every ball the
+    group looks at is brought there from its record in the calendar ``cl`` (whose grid ``geo``
+    finds neighbours), so that an impact costs the balls around it, not the scene. Returns the group size (its
     balls are listed in ``wk.pending``), the work done (sweeps and impulses) and whether ``budget``
     ran out before the cascade ended."""
     if periodic in _CASCADES:
@@ -144,8 +156,11 @@ def cascade_kernel(periodic: bool) -> Any:
         return pos[k, 0] - pos[a, 0], pos[k, 1] - pos[a, 1]
 
     @njit(inline="always")
-    def touching(a, b, ph, cl, geo, wk):
-        """The balls touching ball ``a``, each once, into ``wk.near``; returns how many."""
+    def touching(a, now, b, ph, cl, geo, wk):
+        """The balls touching ball ``a``, each once, into ``wk.near``; returns how many. Each ball
+        looked at that is not in the group yet is first brought to step time ``now`` in its record
+        and in its row of ``b`` (the group's balls are there already: the impact's two, resolved,
+        and every other one since it joined)."""
         pos, radius, near = b.pos, b.radius, wk.near
         count = 0
         if periodic:
@@ -158,6 +173,7 @@ def cascade_kernel(periodic: bool) -> Any:
                     while k >= 0:
                         # (with one or two cells along an axis a cell comes round more than once)
                         if k != a and not wk.in_group[k]:
+                            _bring(k, now, b, cl, wk)
                             dx, dy = separation(a, k, pos, ph.bounds, ph.dim)
                             if touching_at(a, k, dx, dy, pos, radius):
                                 wk.in_group[k] = True
@@ -172,19 +188,21 @@ def cascade_kernel(periodic: bool) -> Any:
                 for cx in range(cx0, cx1 + 1):
                     k = cl.heads[cy * geo.nx + cx]
                     while k >= 0:
+                        _bring(k, now, b, cl, wk)
                         if k != a and balls_touch(a, k, pos, radius):
                             near[count] = k
                             count += 1
                         k = cl.rec[k]["cell_next"]
         else:
             for k in range(pos.shape[0]):
+                _bring(k, now, b, cl, wk)
                 if k != a and balls_touch(a, k, pos, radius):
                     near[count] = k
                     count += 1
         return count
 
     @njit(inline="always")
-    def gather(i0, j0, b, ph, cl, geo, wk):
+    def gather(i0, j0, now, b, ph, cl, geo, wk):
         """Every ball connected to the impact's balls through contacts, into ``wk.pending``, breadth
         first (a ball's new neighbours in index order), each with its place in ``wk.slot``; returns
         how many."""
@@ -199,7 +217,7 @@ def cascade_kernel(periodic: bool) -> Any:
         while q < size and ph.pairs:
             a = group[q]
             q += 1
-            m = touching(a, b, ph, cl, geo, wk)
+            m = touching(a, now, b, ph, cl, geo, wk)
             _sort_by(wk.near, m, slot, False)
             for t in range(m):
                 k = wk.near[t]
@@ -210,7 +228,7 @@ def cascade_kernel(periodic: bool) -> Any:
         return size
 
     @njit(inline="always")
-    def list_contacts(i0, j0, size, b, ph, cl, geo, wk):
+    def list_contacts(i0, j0, size, now, b, ph, cl, geo, wk):
         """The group's contacts, each once, in a fixed order (``wk.c_a``, ``wk.c_b``; ``wk.c_hit``
         marks the impact's own), each ball's partners of later place in the group in the order of
         their places, then its walls; each with its separation (``wk.c_f[:, :2]``, from ``c_a`` to
@@ -220,7 +238,7 @@ def cascade_kernel(periodic: bool) -> Any:
         for qa in range(size):
             a = group[qa]
             if ph.pairs:
-                m = touching(a, b, ph, cl, geo, wk)
+                m = touching(a, now, b, ph, cl, geo, wk)
                 later = 0
                 for t in range(m):
                     if slot[near[t]] > qa:
@@ -254,9 +272,9 @@ def cascade_kernel(periodic: bool) -> Any:
         return n_contacts
 
     @njit(refcount=False, python=False)
-    def cascade(sc, t_abs, i0, j0, budget, b, ph, cl, geo, wk):
-        size = gather(i0, j0, b, ph, cl, geo, wk)
-        n_contacts = list_contacts(i0, j0, size, b, ph, cl, geo, wk)
+    def cascade(sc, t_abs, now, i0, j0, budget, b, ph, cl, geo, wk):
+        size = gather(i0, j0, now, b, ph, cl, geo, wk)
+        n_contacts = list_contacts(i0, j0, size, now, b, ph, cl, geo, wk)
         u_min = group_threshold(wk.pending, size, b.vel, b.inv_mass, ph.ratio, ph.floor)
         small = size <= DENSE_BALLS
         # (a plastic row's sweeps end only after about its length squared: it goes to its limit at once)
@@ -293,6 +311,14 @@ def _sort_by(items, count, slot, by_slot):
             items[u + 1] = items[u]
             u -= 1
         items[u + 1] = item
+
+
+@njit(refcount=False, forceinline=True)
+def _bring(k, now, b, cl, wk):
+    """Ball ``k``, if not in the group being gathered, moved in its record to step time ``now`` and
+    into its row of the ball state (events leave the rows of the balls they do not touch behind)."""
+    if wk.slot[k] < 0:
+        take_in_place(k, now, cl.rec, b)
 
 
 @njit(inline="always")
@@ -506,8 +532,11 @@ def settle(size, n_contacts, u_min, b, wk):
 def _row_axis(size, n_contacts, wk):
     """The axis (0: x, 1: y) along which the group is a row, with each place's neighbours along it
     in ``wk.g_i`` (low side, high side; -1: none, ``_WALL``: a wall), or -1 if it is not one: a
-    contact off the axis, a wall across it, or a ball with two neighbours on one side."""
-    links, slot = wk.g_i, wk.slot
+    contact more than :data:`ROW_SLOPE` off the axis, a wall across it, or a ball with two
+    neighbours on one side. Each place with a ball on its high side gets that contact's normal
+    (from low to high) in ``wk.g_f[:, _TILT]``: its slope off the axis and ``1 / its component
+    along it`` (0 and 1 for a contact right along it)."""
+    links, slot, g_f = wk.g_i, wk.slot, wk.g_f
     for q in range(size):
         links[q, 0] = -1
         links[q, 1] = -1
@@ -516,18 +545,22 @@ def _row_axis(size, n_contacts, wk):
         a = wk.c_a[c]
         other = wk.c_b[c]
         if other >= 0:
-            dx = wk.c_f[c, F_DX]
-            dy = wk.c_f[c, F_DY]
-            along = 0 if dy == 0.0 else 1 if dx == 0.0 else -1
-            ahead = (dx if along == 0 else dy) > 0.0  # (the partner on the high side)
+            nx, ny = _contact_normal(c, wk.c_f)
+            along = 0 if abs(ny) <= ROW_SLOPE * abs(nx) else 1 if abs(nx) <= ROW_SLOPE * abs(ny) else -1
+            if along < 0:
+                return -1
+            ahead = (nx if along == 0 else ny) > 0.0  # (the partner on the high side)
             low = slot[a] if ahead else slot[other]
             high = slot[other] if ahead else slot[a]
+            n_along = abs(nx if along == 0 else ny)
+            g_f[low, _TILT] = (ny if along == 0 else nx) * (1.0 if ahead else -1.0) / n_along
+            g_f[low, _TILT + 1] = 1.0 / n_along
         else:
             wall = -1 - other
             along = wall_axis(wall)
             low = _WALL if is_low_wall(wall) else slot[a]
             high = slot[a] if is_low_wall(wall) else _WALL
-        if along < 0 or (axis >= 0 and along != axis):
+        if axis >= 0 and along != axis:
             return -1
         axis = along
         if (low >= 0 and links[low, 1] != -1) or (high >= 0 and links[high, 0] != -1):
@@ -537,6 +570,17 @@ def _row_axis(size, n_contacts, wk):
         if high >= 0:
             links[high, 0] = low
     return axis
+
+
+@njit(inline="always")
+def _row_gap(k, u, axis, order, vel, wk):
+    """How much faster than ball ``order[k]`` the next ball along a row must move along its axis for
+    their contact to separate at ``u``, given their velocities across it (which the row's limit
+    keeps): ``(u - dv_across * n_across) / n_along``, minus ``u`` (0 for a contact right along it)."""
+    q = wk.slot[order[k]]
+    tilt = wk.g_f[q, _TILT]
+    across = 1 - axis
+    return u * (wk.g_f[q, _TILT + 1] - 1.0) - (vel[order[k + 1], across] - vel[order[k], across]) * tilt
 
 
 @njit(python=False)
@@ -570,26 +614,34 @@ def _settle_row(size, n_contacts, u_min, b, wk):
         u = 0.0
     lo = u if low_wall else -math.inf
     hi = -length * u if high_wall else math.inf
-    # pool adjacent violators: blocks of (weight, weighted sum, first place along the row)
+    # pool adjacent violators: blocks of (weight, weighted sum, first place along the row); the
+    # offset of place k is k u plus the tilted contacts' gaps before it (``tilted``)
     weight, total = wk.g_f[:, 0], wk.g_f[:, 1]
     first = wk.g_i[:, 0]  # (the links are read no more)
     blocks = 0
+    tilted = 0.0
     for k in range(length):
         i = order[k]
         m = 1.0 / inv_mass[i]
         weight[blocks] = m
-        total[blocks] = m * (vel[i, axis] - k * u)
+        total[blocks] = m * (vel[i, axis] - (k * u + tilted))
         first[blocks] = k
         blocks += 1
         while blocks > 1 and total[blocks - 2] / weight[blocks - 2] > total[blocks - 1] / weight[blocks - 1]:
             weight[blocks - 2] += weight[blocks - 1]
             total[blocks - 2] += total[blocks - 1]
             blocks -= 1
+        if k + 1 < length:
+            tilted += _row_gap(k, u, axis, order, vel, wk)
+    hi -= tilted  # (the high wall bounds the last place, whose offset has the whole row's gaps)
+    tilted = 0.0
     for blk in range(blocks):
         z = min(max(total[blk] / weight[blk], lo), hi)
         end = first[blk + 1] if blk + 1 < blocks else length
         for k in range(first[blk], end):
-            vel[order[k], axis] = z + k * u
+            gap = _row_gap(k, u, axis, order, vel, wk) if k + 1 < length else 0.0
+            vel[order[k], axis] = z + (k * u + tilted)
+            tilted += gap
     return True
 
 

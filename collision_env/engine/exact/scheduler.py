@@ -106,7 +106,7 @@ from . import calendar as cal
 from . import clusters, contacts, grid
 from . import periodic as cyclic
 from .bundles import SceneCalendar, work
-from .trajectories import load, not_before, pair_gap, pair_time, store, sync_all, take, wall_time
+from .trajectories import load, not_before, pair_gap, pair_time, store, take, take_in_place, wall_time
 
 
 class Kind(NamedTuple):
@@ -510,7 +510,6 @@ def _step(kind: Kind):
     argument, which would cost as much as a small scene's events.
     """
     sticky, cascades, periodic = kind.sticky, kind.cascades, kind.periodic
-    whole_state = sticky or cascades  # (events may be resolved on the whole ball state)
     # (the two-level queue works as a heap of every ball when a scene has no buckets; stick scenes never do)
     build, schedule, first, rebase, walk_ahead = cal.HEAP_QUEUE if kind.sticky else cal.BUCKET_QUEUE
     cascade = contacts.cascade_kernel(periodic)  # (compiled only where called: scenes with cascades)
@@ -529,7 +528,7 @@ def _step(kind: Kind):
             schedule(i, cl.rec, cl.ci, cl.q)
 
     @njit(inline="always")
-    def resolve(sc, t_abs, bi, bj, code, in_place, budget, b, ev, ph, cl, geo, wk):
+    def resolve(sc, t_abs, now, bi, bj, code, in_place, budget, b, ev, ph, cl, geo, wk):
         """Resolve the event of balls ``bi`` and ``bj`` (``bj < 0``: the wall of ``code``); returns
         how many balls' motion it changed (listed in ``wk.pending``), the work of a contact group it
         started (beyond the event itself) and whether that ran out of ``budget``."""
@@ -554,7 +553,7 @@ def _step(kind: Kind):
         if cascades:
             if in_place and speed > 0.0:
                 j0 = -1 - (cal.EV_WALL - code) if bj < 0 else bj
-                return cascade(sc, t_abs, bi, j0, budget, b, ph, cl, geo, wk)
+                return cascade(sc, t_abs, now, bi, j0, budget, b, ph, cl, geo, wk)
         return n_changed, 0, False
 
     @njit(inline="always")
@@ -629,8 +628,11 @@ def _step(kind: Kind):
             bi = min(bi, code) if code >= 0 else bi
             if sticky:
                 clusters.sync_all(now, b, rot, cl.rec)
-            elif whole_state and in_place:
-                sync_all(now, b.pos, b.vel, cl.rec)
+            elif in_place:
+                # (a contact group brings in the balls it reaches itself: see contacts.touching)
+                take_in_place(bi, now, cl.rec, b)
+                if bj >= 0:
+                    take_in_place(bj, now, cl.rec, b)
             else:
                 take(bi, 0, now, cl, wk.event)
                 if bj >= 0:
@@ -643,7 +645,7 @@ def _step(kind: Kind):
             rows_before = state.n_imp[0] if periodic else 0
             budget = max_events - state.work_i[sc, W_EVENTS]
             n_pending, work, out_of_budget = resolve(
-                sc, t0 + ph.sign * now, bi, bj, code, in_place, budget, b, ev, ph, cl, geo, wk
+                sc, t0 + ph.sign * now, now, bi, bj, code, in_place, budget, b, ev, ph, cl, geo, wk
             )
             state.work_i[sc, W_EVENTS] += work
             if periodic and in_place:

@@ -6,10 +6,13 @@ their records (and the calendar's inverse masses) into two rows laid out as ball
 (``Work.event`` of the scheduler), the response kernels resolve them there, and the records take
 back what changed; the engine's ball state (what the caller reads) is brought up to date from the
 records for every ball when the step ends. So an event reads and writes the calendar alone: in a
-large scene the ball state's rows stay out of the cache. Stick scenes and inelastic forward steps
-are the exception: clusters move as a whole and a contact group may take in any ball, so the whole
-ball state is advanced at once (:func:`sync_all`, or :func:`~.clusters.sync_all` with rotating
-clusters), resolved in place, and the records are loaded from it.
+large scene the ball state's rows stay out of the cache. Two kinds of scene resolve events
+in the ball state itself instead (in place), and the records are loaded from it: stick scenes,
+whose clusters move as a whole, so that every ball is advanced at once
+(:func:`~.clusters.sync_all`); and inelastic forward steps, whose contact groups may take in any
+ball, so that an event's balls, and every ball its contact group looks at, are brought to the
+event's time in their own rows (:func:`take_in_place`), and the other rows stay behind until the
+step ends.
 
 Every prediction and every re-verification of a pair uses one formula on the records alone
 (:func:`pair_time`), so the answer does not depend on when it is asked: a calendar kept for many
@@ -72,12 +75,11 @@ def take(k, row, t, cl, ev):
 
 
 @njit(refcount=False, forceinline=True)
-def sync_all(t, pos, vel, rec):
-    """Bring every ball to step time ``t`` in straight-line motion, in the records and in the ball
-    state alike."""
-    for k in range(pos.shape[0]):
-        sync(k, t, rec)
-        store(k, rec, pos, vel, k)
+def take_in_place(k, t, rec, b):
+    """Ball ``k``, moved in its record to step time ``t``, into its own row of the ball state ``b``
+    (an event resolved in place: see the module doc)."""
+    sync(k, t, rec)
+    store(k, rec, b.pos, b.vel, k)
 
 
 @njit(refcount=False, forceinline=True)
