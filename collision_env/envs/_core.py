@@ -22,7 +22,7 @@ from collision_env.engine.modes import MODES
 from collision_env.engine.scene import WALL_NAMES
 from collision_env.envs._config import TaskConfig
 from collision_env.envs.task.arrays import Engine, TaskParams, TaskState, pack
-from collision_env.envs.task.checks import checked_task_state
+from collision_env.envs.task.checks import check_cluster_mirror, checked_task_state
 from collision_env.envs.task.episodes import block_size, build_episodes
 from collision_env.envs.task.finish import task_kernel
 from collision_env.envs.task.layout import (
@@ -455,11 +455,14 @@ class TaskCore:
 
     def set_state(self, state: dict) -> None:
         """Restore a state from :meth:`get_state`: its keys, the task's values
-        (:func:`~collision_env.envs.task.checks.checked_task_state`) and the engine's state are all
-        checked before anything changes (raises ValueError or TypeError naming the field)."""
+        (:func:`~collision_env.envs.task.checks.checked_task_state`), the task's cluster mirror
+        against the engine's clusters (:func:`~collision_env.envs.task.checks.check_cluster_mirror`)
+        and the engine's state are all checked before anything changes (raises ValueError or
+        TypeError naming the field)."""
         check_state_keys(state, (*self._TASK_FIELDS, "engine"), "as get_state gives")
         current = {name: getattr(self.state, name) for name in self._TASK_FIELDS}
         arrays = checked_task_state(state, current, self.cfg.n_targets, tuple(self.sampler.walls.tolist()))
+        check_cluster_mirror(arrays["body"], state["engine"])
         self.batch.set_state(state["engine"])
         for name, arr in arrays.items():
             np.copyto(current[name], arr)

@@ -111,9 +111,30 @@ def test_a_cluster_root_must_be_its_own_root():
     bad = copy.deepcopy(state)
     bad["core"]["body"][0] = [1, 2, 2]  # (ball 0's root, ball 1, has its root elsewhere)
     refused(env, bad, "set_state: body: ball 0: must be a ball index whose cluster root is its own, got 1")
-    bad["core"]["body"][0] = [2, 2, 2]  # (one cluster rooted at ball 2: taken)
-    env.set_state(bad)
-    np.testing.assert_array_equal(env.core.body[0], [2, 2, 2])
+
+
+def test_the_cluster_mirror_must_be_the_engine_states_clusters():
+    """A task state and an engine state from two snapshots (a stick cluster in one, none in the
+    other) are refused together, naming the first ball that differs; the matching pairs are taken."""
+    env = gym.make("CollisionEnv/InelasticCluster-v0").unwrapped
+    env.reset(seed=0)
+    env.action_space.seed(0)
+    free = env.get_state()
+    for _ in range(2000):  # (random nudges stick two balls within a few episodes)
+        _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+        if (env.core.body[0] != np.arange(len(env.core.body[0]))).any():
+            break
+        if terminated or truncated:
+            env.reset()
+    stuck = env.get_state()
+    ball = int(np.flatnonzero(stuck["core"]["body"][0] != np.arange(len(stuck["core"]["body"][0])))[0])
+    for task, engine in ((free, stuck), (stuck, free)):
+        mixed = copy.deepcopy(task)
+        mixed["core"]["engine"] = copy.deepcopy(engine["core"]["engine"])
+        refused(env, mixed, f"set_state: body: ball {ball}: must be the ball's cluster root in the engine's state")
+    for whole in (free, stuck):
+        env.set_state(whole)
+        np.testing.assert_array_equal(env.core.body, whole["core"]["body"])
 
 
 @pytest.mark.parametrize(

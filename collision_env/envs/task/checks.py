@@ -124,3 +124,18 @@ def checked_task_state(
             bad = ~good(values, arrays[name])
         _refuse_first(bad, values, name, column, must)
     return {name: arr.astype(current[name].dtype) for name, arr in arrays.items()}
+
+
+def check_cluster_mirror(body: np.ndarray, engine: Any) -> None:
+    """The task's cluster mirror ``body`` (checked by :func:`checked_task_state`) against the
+    clusters of the engine state ``engine`` handed over with it: at the end of every step the two
+    are equal (the task replays the step's merges and splits onto its mirror, in every mode), so a
+    state pieced together from two snapshots is refused, naming the ball (raises ValueError). An
+    engine state without clusters of the mirror's shape and kind is left to the engine's checks."""
+    try:
+        clusters = np.asarray(engine["clusters"])
+    except (KeyError, TypeError, IndexError):
+        return
+    if clusters.shape != body.shape or clusters.dtype.kind not in "iu":
+        return
+    _refuse_first(clusters != body, body, "body", None, "must be the ball's cluster root in the engine's state")
