@@ -16,25 +16,36 @@ event cap). The rows:
   and in a periodic cell; the strike lands in the first step. Target: every step within 50 ms.
 - ``pile``: 400 balls stacked in columns of touching balls (a square lattice, rows of 20) on the
   floor of a box, each step's velocities nudged down by g dt first (gravity, as an env does it).
-  Target: every step within 20 ms, memory within 50 MB. ``heap``: the same 400 balls in hexagonal
+  Target: every step within 20 ms, memory within 50 MB. Frictionless balls stacked in columns
+  stand in an unstable equilibrium: a sideways offset grows about as ``exp(t sqrt(g / r))`` (31 per
+  second here), so round-off of 1e-16 m tips the columns over within ten frames or so, and the
+  pile collapses into a heap over the next half second (some tens of millions of contact impulses
+  a frame, at the event cap) before it comes to rest. ``heap``: the same 400 balls in hexagonal
   rows (each in the dips of the row below), a frictionless heap that spreads while it settles, so
   that its contact network changes and collides at every step.
 - ``cluster``: 144 balls on a square lattice, a tenth of a diameter apart, all moving towards the
   centre, at e = 0.3 and 0, in a box and in a periodic cell; it collapses into one contact network.
 - ``cooling``: a periodic gas of 200 disks at area fraction 0.5 and e = 0 (inelastic cooling), 600
   steps, and the same gas in a box.
+
+A second table puts a granular gas beside the same gas elastic: 10^3 and 10^4 disks at area
+fraction 0.3 (``disk_gas``), in a box and in a periodic cell, at e = 0.9 and at e = 1, stepped in
+frames of 1/60 s (the engine's own time unit: disks of unit diameter and temperature), CPU
+microseconds per event. An inelastic gas resolves its events where contact groups can see them
+(:mod:`collision_env.engine.exact.contacts`); what that costs over the elastic path is the ratio.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import resource
 import time
 
 import numpy as np
 
-from ..engine import Scene, Simulator
+from ..engine import Scene, Simulator, disk_gas
 from .machine import machine, timestamp
 from .readme import write_outputs
 
@@ -104,6 +115,39 @@ def cooling(
     return scene, pos, vel, np.ones(n), np.full(n, r)
 
 
+def granular(n: int, e: float, periodic: bool, frames: int) -> dict:
+    """CPU microseconds per event of ``disk_gas(n, 0.3)`` at elasticity ``e`` over ``frames`` frames
+    of 1/60 s (after one frame to warm up)."""
+    gas = disk_gas(n, 0.3, periodic=periodic, seed=1)
+    scene = dataclasses.replace(gas.scene, elasticity=e)
+    sim = Simulator(scene, gas.positions, gas.velocities, gas.masses, gas.radii)
+    sim.step(FRAME)
+    events = sim.stats["events"]
+    start = time.process_time()
+    for _ in range(frames):
+        sim.step(FRAME)
+    events = sim.stats["events"] - events
+    return {"events": events, "us_per_event": 1e6 * (time.process_time() - start) / max(events, 1)}
+
+
+def granular_rows(quick: bool = False) -> dict:
+    """The granular gas beside the elastic one, alternating, for each size and wall kind."""
+    frames = 60 if quick else 300
+    rows = {}
+    for n in (1000,) if quick else (1000, 10_000):
+        for periodic in (False, True):
+            inelastic = granular(n, 0.9, periodic, frames)
+            elastic = granular(n, 1.0, periodic, frames)
+            rows[f"{n} disks {'cell' if periodic else 'box'}"] = {
+                "disks": n,
+                "events_inelastic": inelastic["events"],
+                "us_per_event_inelastic": inelastic["us_per_event"],
+                "us_per_event_elastic": elastic["us_per_event"],
+                "ratio": inelastic["us_per_event"] / elastic["us_per_event"],
+            }
+    return rows
+
+
 def _peak_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
@@ -143,6 +187,9 @@ def _warm_up() -> None:
         for periodic in (False, True):
             measure(row(40, e, periodic), 2)
     measure(pile(60, 0.0), 2, GRAVITY * FRAME)
+    for e in (0.9, 1.0):
+        for periodic in (False, True):
+            granular(50, e, periodic, 2)
 
 
 def run(quick: bool = False) -> dict:
@@ -162,6 +209,20 @@ def run(quick: bool = False) -> dict:
             rows[f"cluster e={e:g} {where}"] = measure(cluster(side, e, periodic), 60)
         rows[f"cooling e=0 {where}"] = measure(cooling(n_gas, 0.5, periodic), gas_steps)
     return rows
+
+
+def render_granular(rows: dict) -> str:
+    """A markdown table of the granular gas beside the elastic one."""
+    lines = [
+        "| gas | events (e = 0.9) | us per event, e = 0.9 | us per event, e = 1 | ratio |",
+        "|---|---|---|---|---|",
+    ]
+    for name, r in rows.items():
+        lines.append(
+            f"| {name} | {r['events_inelastic']} | {r['us_per_event_inelastic']:.2f} | "
+            f"{r['us_per_event_elastic']:.2f} | {r['ratio']:.2f} |"
+        )
+    return "\n".join(lines)
 
 
 def render(rows: dict) -> str:
@@ -192,14 +253,19 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     started = time.perf_counter()
     rows = run(args.quick)
+    gases = granular_rows(args.quick)
     how = (
         f"`python -m collision_env.bench.networks{' --quick' if args.quick else ''}` on {machine()}, "
         f"{timestamp()}, {time.perf_counter() - started:.0f} s; wall-clock milliseconds per 1/60 s step "
         "through `Simulator.step`, the kernels compiled beforehand."
     )
+    granular_how = (
+        "A granular gas (e = 0.9) beside the same gas elastic, alternating in the same run: "
+        "`disk_gas(n, 0.3)` stepped in 1/60 s frames through `Simulator.step`, CPU microseconds per event."
+    )
     write_outputs(
-        how + "\n\n" + render(rows),
-        rows,
+        how + "\n\n" + render(rows) + "\n\n" + granular_how + "\n\n" + render_granular(gases),
+        {"networks": rows, "granular": gases},
         json_path=args.json,
         markdown=args.markdown,
         title="# Contact networks at e < 1",

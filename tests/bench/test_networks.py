@@ -10,7 +10,8 @@ from collision_env.bench import networks
 def test_quick_run_writes_every_row_and_the_struck_rows_reach_every_step_end(tmp_path):
     page, raw = tmp_path / "networks.md", tmp_path / "networks.json"
     assert networks.main(["--quick", "--json", str(raw), "--markdown", str(page)]) == 0
-    rows = json.loads(raw.read_text())
+    raw_rows = json.loads(raw.read_text())
+    rows, gases = raw_rows["networks"], raw_rows["granular"]
     for where in ("box", "cell"):
         for e in ("0", "0.5"):
             row = rows[f"row e={e} {where}"]
@@ -20,3 +21,9 @@ def test_quick_run_writes_every_row_and_the_struck_rows_reach_every_step_end(tmp
     text = page.read_text()
     assert text.startswith("# Contact networks at e < 1\n")
     assert all(f"| {name} |" in text for name in rows)
+    # the granular gas beside the elastic one: the same number of disks, events counted, a ratio
+    assert set(gases) == {"1000 disks box", "1000 disks cell"}
+    for gas in gases.values():
+        assert gas["events_inelastic"] > 0
+        assert gas["ratio"] == gas["us_per_event_inelastic"] / gas["us_per_event_elastic"]
+        assert f"| {gas['events_inelastic']} |" in text
