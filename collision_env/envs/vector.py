@@ -197,6 +197,8 @@ class CollisionTargetVectorEnv(VectorEnv):
         a = np.asarray(actions, dtype=np.float64)
         if a.shape != self.action_space.shape:
             raise ValueError(f"actions: expected shape {self.action_space.shape}, got {a.shape}")
+        if not a.flags.c_contiguous:  # (the nudge kernel takes C-contiguous actions: see TaskCore._bind)
+            a = np.ascontiguousarray(a)
         core = self._core
         B = self.num_envs
         cap_limit = self.max_episode_steps
