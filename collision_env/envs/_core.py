@@ -107,6 +107,11 @@ class EpisodeSampler:
         self.ctrl_mask = np.zeros(n, dtype=bool)
         """``(n_balls,)`` bool: the controlled balls."""
         self.ctrl_mask[list(cfg.controlled)] = True
+        assert cfg.others_mass_range is not None  # (None only as an argument of TaskConfig)
+        self.mass_low = np.where(self.ctrl_mask, cfg.mass_range[0], cfg.others_mass_range[0])
+        """``(n_balls,)``: each ball's lightest mass."""
+        self.mass_high = np.where(self.ctrl_mask, cfg.mass_range[1], cfg.others_mass_range[1])
+        """``(n_balls,)``: each ball's heaviest mass."""
         assert cfg.bounds is not None and cfg.target_walls is not None  # (None only as arguments of TaskConfig)
         self.walls = np.array([WALL_NAMES.index(w) for w in cfg.target_walls], dtype=np.int64)
         """The wall codes targets may sit on."""
@@ -142,9 +147,7 @@ class EpisodeSampler:
     def _build(self, uniforms: np.ndarray) -> tuple[Episodes, np.ndarray]:
         cfg = self.cfg
         r, n, k = uniforms.shape[0], cfg.n_balls, cfg.n_targets
-        assert cfg.others_mass_range is not None  # (None only as an argument of TaskConfig)
-        lo = np.where(self.ctrl_mask, cfg.mass_range[0], cfg.others_mass_range[0])
-        hi = np.where(self.ctrl_mask, cfg.mass_range[1], cfg.others_mass_range[1])
+        lo, hi = self.mass_low, self.mass_high
         masses = lo + (hi - lo) * uniforms[:, :n]
         radii = cfg.radius_of(masses)
         pos = np.zeros((r, n, 2))
@@ -172,7 +175,7 @@ class EpisodeSampler:
         """One episode's start state per generator of ``rngs`` (each draws its own blocks)."""
         uniforms = np.empty((len(rngs), self.block))
         for i, rng in enumerate(rngs):
-            uniforms[i] = rng.random(self.block)
+            rng.random(out=uniforms[i])
         eps, ok = self._build(uniforms)
         for row in np.flatnonzero(~ok):  # rare: draw fresh blocks for the rows that did not fit
             for _ in range(MAX_ATTEMPTS):
