@@ -68,6 +68,21 @@ def best_rate(chunk: Callable[[], int], seconds: float, slices: int) -> float:
     return best
 
 
+def best_rates(chunks: list[Callable[[], int]], seconds: float, slices: int) -> list[float]:
+    """:func:`best_rate` of each of ``chunks``, their slices interleaved (one slice of each in turn,
+    ``slices`` rounds): a busy machine slows them alike, so their ratios hold.
+
+    >>> rates = best_rates([lambda: 1, lambda: 2], 0.002, 2)
+    >>> len(rates), rates[1] > 0.0
+    (2, True)
+    """
+    best = [0.0] * len(chunks)
+    for _ in range(slices):
+        for k, chunk in enumerate(chunks):
+            best[k] = max(best[k], best_rate(chunk, seconds / slices, 1))
+    return best
+
+
 def add_timer(obj: object, name: str, totals: MutableMapping[str, float], key: str) -> None:
     """Time every call of ``obj.name``: each adds its duration (s) to ``totals[key]``.
 
