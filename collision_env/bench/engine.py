@@ -7,12 +7,13 @@ Run it as::
     python -m collision_env.bench.engine --json bench.json --markdown bench.md
     python -m collision_env.bench.engine --render bench.json --markdown bench.md   # tables only
 
-It is not a test: it measures and prints. Three parts, each printed as a Markdown table:
+It is not a test: it measures and prints. Four parts, each printed as a Markdown table:
 
 1. **Gas**: exact mode's events per second against the ``billiards`` package (PyPI 0.5.0, pure
    Python, event-driven) on a 50-disk elastic gas (r = 0.02 in [-1, 1]^2, T = 20 s; the full run
    adds a 200-disk gas over 5 s), both from the same initial state,
-   once as a single long step and once in frames of 1/60 s. The same section checks the
+   once as a single long step and once in frames of 1/60 s (ours alternating, with the frames'
+   share of the long step's event rate: what the calls from Python cost). The same section checks the
    trajectories: over a short horizon (about 3 collisions per ball, before chaos amplifies
    round-off) the collision sequences must be the same, and it reports the largest position
    difference; at the full horizon (tens of collisions per ball) it only reports how far the two
@@ -20,12 +21,15 @@ It is not a test: it measures and prints. Three parts, each printed as a Markdow
 2. **Per step**: microseconds per ``Simulator.step(1/60)`` for each mode (naive, posteriori with
    1 and 4 substeps, exact) at 1, 2, 4, 16 and 64 balls in the default play area, with pymunk
    (a C engine, impulse solver, no time of impact) stepping the same balls as a peer.
+3. **Calls**: nanoseconds per ``Simulator.step`` and ``BatchSimulator.step`` with nothing to do
+   (one ball at rest in a box), against an empty compiled kernel called through numba's dispatch
+   with a stepping kernel's arguments and an empty Python function, alternating.
+4. **Batch**: scene-steps per second of one :class:`BatchSimulator` of 1024 scenes of 4 balls
+   against a Python loop over 1024 single :class:`Simulator` objects holding the same scenes
+   (and a check that both end in the same state).
 
 The peers are the benchmark package's adapters (:mod:`collision_env.bench.peers`), the same
 set-ups the study measures.
-3. **Batch**: scene-steps per second of one :class:`BatchSimulator` of 1024 scenes of 4 balls
-   against a Python loop over 1024 single :class:`Simulator` objects holding the same scenes
-   (and a check that both end in the same state).
 
 The machine is shared and noisy, so every figure is the best (and the median) of several
 repeats, and the figures that matter are the ratios, measured in the same run. Numba compile
@@ -46,14 +50,14 @@ from typing import Any
 import numpy as np
 
 from collision_env.bench.readme import write_outputs
-from collision_env.engine import PLAY_AREA_2D, BatchSimulator, Scene, Simulator
+from collision_env.engine import BACKEND, PLAY_AREA_2D, BatchSimulator, Scene, Simulator
 from collision_env.precompile import precompile
 
 from .machine import cpus, machine, timestamp, versions
 from .metrics import as_impacts
 from .peers import make_peer
 from .scenes import Case
-from .timing import repeat, summary
+from .timing import alternating, repeat, summary
 
 GAS_CASES = ((50, 20.0),)  # (disks, horizon in s); the full run adds GAS_CASES_FULL
 GAS_CASES_FULL = ((200, 5.0),)  # billiards manages about 1 k events/s here: seconds per run
@@ -65,6 +69,7 @@ STEP_BALLS = (1, 2, 4, 16, 64)
 STEP_RADIUS = 0.05  # 64 balls of r = 0.05 fill 6 % of the 4 m x 2 m play area
 MODE_CONFIGS = (("naive", 1), ("posteriori", 1), ("posteriori", 4), ("exact", 1))
 BATCH_SCENES = 1024
+PARTS = ("gas", "per_step", "calls", "batch")  #: the benchmark's parts, in the order it runs them
 BATCH_BALLS = 4
 
 
@@ -148,12 +153,16 @@ def bench_gas(quick: bool, n: int = 50, horizon: float = 20.0) -> dict:
     peer_events = peer.impact_count
     peer_frame_t = repeat(peer_frames, max(1, peer_repeats - 1), lambda: peer.start(case))
     peer_frame_events = peer.impact_count
-    our_t = repeat(our_one_step, our_repeats, lambda: new_sim(10**7))
+    # (ours alternating, so that the frames' share of the long step's rate holds on a busy machine)
+    runs = {"long": our_one_step, "frames": our_frames}
+    timed = alternating(runs, our_repeats, {"long": lambda: new_sim(10**7), "frames": new_sim})
+    our_t, our_frame_t = timed["long"], timed["frames"]
+    our_frame_events = ours["sim"].stats["events"]  # (the frames ran last)
+    new_sim(10**7)
+    our_one_step()
     our_events = ours["sim"].stats["events"]
     long_ours = _pairs(ours["impacts"])
     long_our_positions = ours["sim"].positions
-    our_frame_t = repeat(our_frames, our_repeats, new_sim)
-    our_frame_events = ours["sim"].stats["events"]
 
     # the peer's impacts over the full horizon, recorded (untimed)
     peer.start(case)
@@ -216,11 +225,15 @@ def bench_gas(quick: bool, n: int = 50, horizon: float = 20.0) -> dict:
                 "speedup_median": (ours_n / o["median"]) / (peer_n / p["median"]),
             }
         )
+    long_rate, frames_rate = (summary(t) for t in (our_t, our_frame_t))
     return {
         "n": n,
         "radius": GAS_RADIUS,
         "box": [-GAS_HALF, GAS_HALF],
         "rows": rows,
+        # the frames' event rate over the long step's: what the calls from Python cost
+        "frames_share_best": (our_frame_events / frames_rate["best"]) / (our_events / long_rate["best"]),
+        "frames_share_median": (our_frame_events / frames_rate["median"]) / (our_events / long_rate["median"]),
         "check": check,
         "full_horizon": full,
     }
@@ -329,6 +342,56 @@ def bench_batch(quick: bool) -> dict:
     return {"scenes": b, "balls": n, "steps": steps, "dt": FRAME, "rows": rows}
 
 
+# ---------------------------------------------------------------------------------------- 4. calls
+def _nothing(h, dt, start):
+    """What the empty kernel of :func:`bench_calls` does (nothing), with a stepping kernel's arguments."""
+    return 0
+
+
+def _call_loop(fn: Callable, args: tuple, calls: int) -> Callable[[], None]:
+    """``calls`` calls of ``fn(*args)`` (of one or three arguments), unpacked outside the loop."""
+    if len(args) == 1:
+        (a,) = args
+
+        def loop() -> None:
+            for _ in range(calls):
+                fn(a)
+
+    else:
+        a, b, c = args
+
+        def loop() -> None:
+            for _ in range(calls):
+                fn(a, b, c)
+
+    return loop
+
+
+def bench_calls(quick: bool) -> dict:
+    """Nanoseconds per call from Python with nothing to do: ``Simulator.step(1/60)`` and
+    ``BatchSimulator.step(1/60)`` of one ball at rest in a box, beside an empty compiled kernel
+    called through numba's dispatch with the arguments a stepping kernel takes (an int64 array, a
+    float, an int) and an empty Python function of the same arguments. They alternate in every
+    repeat, so that a busy machine slows them alike."""
+    calls, repeats = (20_000, 5) if quick else (100_000, 15)
+    sim = Simulator(Scene(bounds=(-1.0, -1.0, 1.0, 1.0)), [[0.0, 0.0]], [[0.0, 0.0]], [1.0], [0.1])
+    pack = np.zeros(4, dtype=np.int64)
+    subjects: dict[str, tuple[Callable, tuple]] = {
+        "Simulator.step": (sim.step, (FRAME,)),
+        "BatchSimulator.step": (sim.batch.step, (FRAME,)),
+    }
+    if BACKEND == "numba":
+        import numba
+
+        subjects["empty kernel, numba's dispatch"] = (numba.jit(nopython=True)(_nothing), (pack, FRAME, 1))
+    subjects["empty Python function"] = (_nothing, (pack, FRAME, 1))
+    for fn, args in subjects.values():  # warm-up (the empty kernel compiles)
+        _call_loop(fn, args, 100)()
+    timed = alternating({name: _call_loop(fn, args, calls) for name, (fn, args) in subjects.items()}, repeats)
+    rows = {name: summary(t, per=calls / 1e9) for name, t in timed.items()}
+    return {"calls": calls, "dt": FRAME, "rows": rows}
+
+
 # ---------------------------------------------------------------------------------------- tables
 def _fmt(x, digits=3):
     if x is None:
@@ -381,6 +444,13 @@ def render_markdown(results: dict) -> str:
             )
         c = gas["check"]
         f = gas["full_horizon"]
+        if "frames_share_best" in gas:
+            lines += [
+                "",
+                f"In frames of 1/60 s, one `Simulator.step` call from Python each, exact mode keeps "
+                f"**{gas['frames_share_best']:.2f}** ({gas['frames_share_median']:.2f}) of its event rate in one long "
+                "step (the two runs alternate).",
+            ]
         lines += [
             "",
             f"Same trajectories: over the first {c['horizon_s']:.3g} s ({c['collisions_per_ball']:.1f} "
@@ -418,6 +488,26 @@ def render_markdown(results: dict) -> str:
             "stepping the same balls, set up as the study's `pymunk it=10`.",
             "",
         ]
+    calls = results.get("calls")
+    if calls:
+        anchor = calls["rows"].get("empty kernel, numba's dispatch")
+        lines += [
+            "### The cost of a call: nothing to do (one ball at rest in a box, dt = 1/60 s)",
+            "",
+            "| call | ns per call | × an empty kernel's call |",
+            "|---|---:|---:|",
+        ]
+        for name, r in calls["rows"].items():
+            ratio = f"{r['best'] / anchor['best']:.2f}" if anchor else "n/a"
+            lines.append(f"| `{name}` | {r['best']:.0f} ({r['median']:.0f}) | {ratio} |")
+        lines += [
+            "",
+            "The empty kernel takes a stepping kernel's arguments (an int64 array, a float, an int) through "
+            "numba's dispatch, which types each of them at every call; the simulators call their kernel's "
+            "compiled version directly. Each figure is the best of alternating repeats of "
+            f"{_fmt(calls['calls'])} calls.",
+            "",
+        ]
     bt = results.get("batch")
     if bt:
         lines += [
@@ -438,7 +528,9 @@ def render_markdown(results: dict) -> str:
 
 # ---------------------------------------------------------------------------------------- main
 def run(
-    quick: bool = False, parts: Iterable[str] = ("gas", "per_step", "batch"), log: Callable[[str], None] = print
+    quick: bool = False,
+    parts: Iterable[str] = PARTS,
+    log: Callable[[str], None] = print,
 ) -> dict:
     """Run the benchmark; returns the raw figures as a JSON-ready dict."""
     t0 = time.perf_counter()
@@ -453,6 +545,9 @@ def run(
     if "per_step" in parts:
         log("per-step cost of each mode ...")
         results["per_step"] = bench_per_step(quick)
+    if "calls" in parts:
+        log("the cost of a call with nothing to do ...")
+        results["calls"] = bench_calls(quick)
     if "batch" in parts:
         log("batch of 1024 against a loop ...")
         results["batch"] = bench_batch(quick)
@@ -489,9 +584,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--json", metavar="PATH", help="write the raw figures to PATH")
     parser.add_argument("--markdown", metavar="PATH", help="write the tables to PATH")
     parser.add_argument("--render", metavar="JSON", help="do not measure: render the tables of a --json file")
-    parser.add_argument(
-        "--only", choices=("gas", "per_step", "batch"), action="append", help="run only this part (repeatable)"
-    )
+    parser.add_argument("--only", choices=PARTS, action="append", help="run only this part (repeatable)")
     args = parser.parse_args(argv)
 
     if args.render:
@@ -501,7 +594,7 @@ def main(argv: list[str] | None = None) -> int:
         results = _jsonable(
             run(
                 quick=args.quick,
-                parts=tuple(args.only or ("gas", "per_step", "batch")),
+                parts=tuple(args.only or PARTS),
                 log=lambda msg: print(msg, file=sys.stderr, flush=True),
             )
         )

@@ -10,6 +10,10 @@ Prints two Markdown tables (ratios, not pass/fail tests); ``--markdown`` also wr
 * the native vector env at ``--num-envs`` sub-envs (next-step autoreset, random actions), in
   env-steps/s and as a fraction of Gymnasium's ``CartPoleVectorEnv``.
 
+Each env's slices alternate with CartPole's (:func:`~collision_env.bench.timing.best_rates`), and
+its ratio is to the CartPole slices timed beside it, so that a machine busy with other work slows
+both alike.
+
 The "engine" column is the part of a step spent in the engine's own calls: for the single env,
 ``nudge`` and ``step`` of the ``BatchSimulator`` timed on a copy of the env's engine in the same
 state; for the vector env, the share of the env's run spent in its engines' ``step`` calls.
@@ -20,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import time
+from collections.abc import Callable
 from typing import cast
 
 import gymnasium as gym
@@ -31,13 +36,19 @@ from collision_env.engine import MODES
 from collision_env.envs import CollisionTargetEnv, CollisionTargetVectorEnv
 
 from .machine import cpus, machine, timestamp, versions
-from .timing import add_timer, best_rate
+from .timing import add_timer, best_rate, best_rates
 
 REPEATS = 5  # each figure is the best of this many equal slices of --seconds (robust to a busy machine)
 
 
 def single_env_us(env: gym.Env, seconds: float, slices: int = REPEATS) -> float:
     """Microseconds per ``env.step`` (random actions, resets included): the best of ``slices`` slices."""
+    return 1e6 / best_rate(_single_steps(env), seconds, slices)
+
+
+def _single_steps(env: gym.Env) -> Callable[[], int]:
+    """A chunk of ``env.step`` calls for :func:`best_rate` (random actions, resets included), after
+    a warm-up (which compiles the kernels on a first run)."""
     env.reset(seed=0)
     env.action_space.seed(0)
     actions = [env.action_space.sample() for _ in range(1024)]
@@ -49,12 +60,18 @@ def single_env_us(env: gym.Env, seconds: float, slices: int = REPEATS) -> float:
                 env.reset()
         return count
 
-    steps(300)  # warm-up (compiles the kernels on a first run)
-    return 1e6 / best_rate(steps, seconds, slices)
+    steps(300)  # warm-up
+    return steps
 
 
 def vector_env_steps_per_s(venv: gym.vector.VectorEnv, seconds: float, slices: int = REPEATS) -> float:
     """Env-steps per second of a vector env (random actions, its own autoreset): the best of ``slices``."""
+    return best_rate(_vector_steps(venv), seconds, slices)
+
+
+def _vector_steps(venv: gym.vector.VectorEnv) -> Callable[[], int]:
+    """A chunk of ``venv.step`` calls for :func:`best_rate` (random actions, its own autoreset),
+    after a warm-up."""
     venv.reset(seed=0)
     venv.action_space.seed(0)
     actions = [venv.action_space.sample() for _ in range(16)]
@@ -65,7 +82,7 @@ def vector_env_steps_per_s(venv: gym.vector.VectorEnv, seconds: float, slices: i
         return count * venv.num_envs
 
     steps()  # warm-up
-    return best_rate(steps, seconds, slices)
+    return steps
 
 
 def _engine_us(core, seconds: float, steps: int = 200) -> float:
@@ -123,29 +140,31 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
 
     started = time.perf_counter()
-    cart = single_env_us(gym.make("CartPole-v1"), args.seconds)
-    cart = min(cart, single_env_us(gym.make("CartPole-v1"), args.seconds))  # twice: the first may warm the CPU
-    single = [f"| `CartPole-v1` | | {cart:.2f} | | 1.00 |"]
+    # each env's slices alternate with CartPole's, whose best over the run heads the table
+    cart_steps = _single_steps(gym.make("CartPole-v1"))
+    single, cart = [], float("inf")
     for env_id in args.ids:
         for mode in args.modes:
             env = gym.make(env_id, mode=mode)
-            us = single_env_us(env, args.seconds)
+            rate, cart_rate = best_rates([_single_steps(env), cart_steps], args.seconds, REPEATS)
+            us, cart = 1e6 / rate, min(cart, 1e6 / cart_rate)
             eng = _engine_us(cast(CollisionTargetEnv, env.unwrapped).core, args.seconds / 2)
-            single.append(f"| `{env_id}` | {mode} | {us:.2f} | {eng:.2f} | {us / cart:.2f} |")
+            single.append(f"| `{env_id}` | {mode} | {us:.2f} | {eng:.2f} | {us * cart_rate / 1e6:.2f} |")
             env.close()
+    single.insert(0, f"| `CartPole-v1` | | {cart:.2f} | | 1.00 |")
 
     n = args.num_envs
-    cart_vec = vector_env_steps_per_s(
-        gym.make_vec("CartPole-v1", n, vectorization_mode="vector_entry_point"), args.seconds
-    )
-    vector = [f"| `CartPoleVectorEnv` | | {_fmt_rate(cart_vec)} | | 1.000 |"]
+    cart_vec_steps = _vector_steps(gym.make_vec("CartPole-v1", n, vectorization_mode="vector_entry_point"))
+    vector, cart_vec = [], 0.0
     for env_id in args.ids:
         for mode in args.modes:
             venv = gym.make_vec(env_id, n, vectorization_mode="vector_entry_point", mode=mode)
-            sps = vector_env_steps_per_s(venv, args.seconds)
+            sps, cart_sps = best_rates([_vector_steps(venv), cart_vec_steps], args.seconds, REPEATS)
+            cart_vec = max(cart_vec, cart_sps)
             share = _engine_share(venv, args.seconds / 2)
-            vector.append(f"| `{env_id}` | {mode} | {_fmt_rate(sps)} | {share:.0%} | {sps / cart_vec:.3f} |")
+            vector.append(f"| `{env_id}` | {mode} | {_fmt_rate(sps)} | {share:.0%} | {sps / cart_sps:.3f} |")
             venv.close()
+    vector.insert(0, f"| `CartPoleVectorEnv` | | {_fmt_rate(cart_vec)} | | 1.000 |")
 
     v = versions(["gymnasium"])
     text = "\n".join(
@@ -153,7 +172,8 @@ def main(argv: list[str] | None = None) -> None:
             f"`python -m collision_env.bench.envs` on {machine()}, {cpus()} CPUs, "
             f"Python {v['python']}, gymnasium {v['gymnasium']}, numpy {v['numpy']}, engine backend "
             f"`{v['backend']}`; {timestamp()}, {time.perf_counter() - started:.0f} s. Each figure is the "
-            f"best of {REPEATS} slices of {args.seconds:g} s, measured in the same run as CartPole: "
+            f"best of {REPEATS} slices of {args.seconds:g} s, each env's slices alternating with CartPole's "
+            "(its ratio is to the CartPole slices beside it; CartPole's row is its best over the run): "
             "compare the ratios.",
             "",
             "Single env via `gym.make` (default wrappers, random actions, resets included); *engine* is the part "

@@ -24,6 +24,24 @@ def repeat(fn: Callable[[], object], repeats: int, reset: Callable[[], object] |
     return out
 
 
+def alternating(
+    runs: dict[str, Callable[[], object]], repeats: int, resets: dict[str, Callable[[], object]] | None = None
+) -> dict[str, list[float]]:
+    """Run each of ``runs`` in turn, ``repeats`` rounds, each run after its untimed reset (if
+    ``resets`` has one); return every run's durations (s). Alternating, the runs share whatever
+    the machine does meanwhile, so their ratios hold on a busy machine.
+
+    >>> out = alternating({"a": lambda: None, "b": lambda: None}, 3)
+    >>> sorted(out), [len(v) for v in out.values()]
+    (['a', 'b'], [3, 3])
+    """
+    out: dict[str, list[float]] = {name: [] for name in runs}
+    for _ in range(repeats):
+        for name, fn in runs.items():
+            out[name] += repeat(fn, 1, (resets or {}).get(name))
+    return out
+
+
 def summary(durations: list[float], per: float = 1.0) -> dict:
     """Best and median of ``durations`` divided by ``per`` (e.g. seconds per step).
 
@@ -47,6 +65,21 @@ def best_rate(chunk: Callable[[], int], seconds: float, slices: int) -> float:
             if elapsed >= seconds / slices:
                 break
         best = max(best, done / elapsed)
+    return best
+
+
+def best_rates(chunks: list[Callable[[], int]], seconds: float, slices: int) -> list[float]:
+    """:func:`best_rate` of each of ``chunks``, their slices interleaved (one slice of each in turn,
+    ``slices`` rounds): a busy machine slows them alike, so their ratios hold.
+
+    >>> rates = best_rates([lambda: 1, lambda: 2], 0.002, 2)
+    >>> len(rates), rates[1] > 0.0
+    (2, True)
+    """
+    best = [0.0] * len(chunks)
+    for _ in range(slices):
+        for k, chunk in enumerate(chunks):
+            best[k] = max(best[k], best_rate(chunk, seconds / slices, 1))
     return best
 
 

@@ -55,6 +55,11 @@ about 10 ns per array per call, which costs more than the arithmetic of a small 
 compiled so must only borrow the arrays it is passed (slices of them included) and allocate none;
 the kernels it calls that do allocate (a contact group's least-distance solve) keep their own
 counting, since every other kernel is compiled with it explicitly.
+
+The kernels keep the GIL while they run (numba's ``nogil`` off): releasing and taking it back costs
+some 35 ns a call, a tenth of a small scene's step from Python, and the package runs work in
+parallel in processes (:mod:`collision_env.bench.parallel`, vector envs' subprocesses), never in
+threads.
 """
 
 from __future__ import annotations
@@ -404,11 +409,20 @@ def _in_package(func: Callable[..., Any]) -> bool:
         return False
 
 
-def compile_for(kernel: Any, *example_args: Any) -> None:
+def compile_for(kernel: Any, *example_args: Any) -> Callable[..., Any]:
     """Compile ``kernel`` now for the types of ``example_args`` (or load it from the cache), rather
-    than at its first call; without numba, nothing to do."""
-    if HAVE_NUMBA:
-        kernel.compile(tuple(_numba.typeof(a) for a in example_args))
+    than at its first call. Returns that compiled version as a function that Python calls directly
+    (``kernel`` itself without numba).
+
+    A call of the kernel itself pays numba's dispatch: the type of every argument is worked out
+    and matched against the compiled versions, about 30 ns an array and 0.2 us a structured array,
+    as much as a small scene's whole step. The direct function skips it: it must be called with
+    arguments of exactly the example's types (dtype, dimensions, C-contiguous layout; scalars of
+    the same kind), which it does not check, so only code that owns the arrays it passes (a
+    simulator's pack, an env's own buffers) may call it."""
+    if not HAVE_NUMBA:
+        return kernel
+    return kernel.compile(tuple(_numba.typeof(a) for a in example_args))
 
 
 def njit(
@@ -435,7 +449,7 @@ def njit(
     options["_nrt"] = bool(refcount)
     options.setdefault("forceinline", False)
     if not (_in_package(func) or Path(func.__code__.co_filename).is_file()):
-        return _numba.njit(nogil=True, **options)(func)  # (no file to key a cache on: ``python -c``)
+        return _numba.njit(**options)(func)  # (no file to key a cache on: ``python -c``)
     if python is None:
         python = not options["forceinline"]
     if not python:
@@ -443,7 +457,7 @@ def njit(
     dispatcher = (_KernelDispatcher if python else _InnerKernel)(
         py_func=func,
         locals=options.pop("locals", {}),
-        targetoptions={"nopython": True, "nogil": True, "boundscheck": None, **options},
+        targetoptions={"nopython": True, "boundscheck": None, **options},
     )
     dispatcher.label = label
     dispatcher.enable_caching()

@@ -16,7 +16,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ._jit import BACKEND
+from ._jit import BACKEND, compile_for
 from .broadphase import GRID_MIN_BALLS, PERIODIC_GRID_MIN_BALLS, grid_geometry
 from .frames import copy_impacts, record_frame
 from .layout import (
@@ -106,6 +106,11 @@ NO_IMPACTS.flags.writeable = False
 MAX_IMPACT_ROWS = 1 << 20
 
 
+#: Each stepping kernel called so far -> its compiled version, which steppers call directly (see
+#: ``Stepper._first_call``).
+_DIRECT: dict[Any, Any] = {}
+
+
 class EventCapWarning(RuntimeWarning):
     """A scene reached the cap on events per step and stopped early (in a valid state)."""
 
@@ -192,6 +197,7 @@ class Stepper:
         # space), and its kernel for this kind of scene
         self.mode_arrays = spec.arrays(scene, n_scenes, n)
         self._kernel = spec.kernel(scene, n)
+        self._call = _DIRECT.get(self._kernel, self._first_call)
         self.start = START_STEP  # how the next kernel call starts (see step)
         self._after_step = START_NEXT
         self._alloc_work()
@@ -340,7 +346,7 @@ class Stepper:
         in a periodic cell in a cheap mode, those whose laps round the cell a checked step bounded
         (see :meth:`_checked_step`)."""
         if 0.0 < dt <= self._fast_dt:  # the common case, checked in one test
-            rows = self._kernel(self._pack, dt, self.start)
+            rows = self._call(self._pack, dt, self.start)
             if rows >= 0:  # no scene stalled or reached the event cap
                 self.start = self._after_step
                 return self._take_impacts(rows) if rows else NO_IMPACTS
@@ -463,7 +469,7 @@ class Stepper:
         request[FRAME_FIRST] = first
         request[FRAME_LAST] = len(out.times)
         bundle = FramesOut(request, out.times, *out.rows(self.scene.periodic), buffer)
-        self._kernel(with_frames(self._pack, self.spec.frames_slot, bundle), dt, RUN_FRAMES)
+        self._call(with_frames(self._pack, self.spec.frames_slot, bundle), dt, RUN_FRAMES)
         return int(request[FRAME_STOPPED_AT]), bool(request[FRAME_STEPPED]), int(request[FRAME_ROWS])
 
     def _finish(self, chunks: list[np.ndarray], sign: float, stacklevel: int) -> np.ndarray:
@@ -490,7 +496,7 @@ class Stepper:
         one per call (a call stops the scenes that find the impact buffer full, which the next
         call resumes). ``first_done``: the step's first call was made already."""
         chunks = []
-        kernel, n_imp = self._kernel, self._n_imp
+        kernel, n_imp = self._call, self._n_imp
         if not first_done:
             kernel(self._pack, dt_abs, START_STEP)
         while True:  # each call resets n_imp[0] and fills the impact buffer from row 0
@@ -506,6 +512,18 @@ class Stepper:
                 self._alloc_work(2 * len(self._imp))
                 n_imp = self._n_imp
             kernel(self._pack, dt_abs, RESUME)
+
+    def _first_call(self, pack: np.ndarray | tuple, dt: float, start: int) -> int:
+        """The kernel's first call in this process, through numba's dispatcher (which compiles it,
+        or loads it from the cache); ``_call`` is then the compiled version itself
+        (``_jit.compile_for``, kept in :data:`_DIRECT` for every later stepper of the kernel), which
+        a call enters without the dispatch's checks: a stepper always hands its kernel a pack, a
+        float and an int."""
+        rows = self._kernel(pack, dt, start)
+        if self._kernel not in _DIRECT:
+            _DIRECT[self._kernel] = compile_for(self._kernel, pack, dt, start)
+        self._call = _DIRECT[self._kernel]
+        return rows
 
     def _take_impacts(self, rows: int) -> np.ndarray:
         """A copy of the first ``rows`` impact records. Exact mode records each scene's impacts in
@@ -588,8 +606,8 @@ class Stepper:
 
     #: What a copy or a pickle rebuilds rather than carries: work space, and what is bound to it.
     _REBUILT = (
-        "_imp", "_imp_bytes", "_n_imp", "_kernel", "_pack", "_sign", "_fast_dt", "_shared", "live", "pos", "vel",
-        "mass", "inv_mass", "radius", "omega", "spec", "start", "_after_step",
+        "_imp", "_imp_bytes", "_n_imp", "_kernel", "_call", "_pack", "_sign", "_fast_dt", "_shared", "live", "pos",
+        "vel", "mass", "inv_mass", "radius", "omega", "spec", "start", "_after_step",
     )  # fmt: skip
 
     def __getstate__(self) -> dict[str, Any]:
@@ -607,6 +625,7 @@ class Stepper:
         kept = tuple(type(b)(*(aligned_copy(a) for a in b)) for b in self.mode_arrays)
         self.mode_arrays = kept + fresh[len(kept) :]
         self._kernel = self.spec.kernel(self.scene, self.n)
+        self._call = _DIRECT.get(self._kernel, self._first_call)
         self.start = START_STEP
         self._after_step = START_NEXT
         self._bind_views()

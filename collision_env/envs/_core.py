@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import DTypeLike
 
 from collision_env.engine import MAX_SUBSTEPS
+from collision_env.engine.compiled import compile_for
 from collision_env.engine.keywords import close_matches
 from collision_env.engine.modes import MODES
 from collision_env.engine.scene import WALL_NAMES
@@ -106,6 +107,11 @@ class EpisodeSampler:
         self.ctrl_mask = np.zeros(n, dtype=bool)
         """``(n_balls,)`` bool: the controlled balls."""
         self.ctrl_mask[list(cfg.controlled)] = True
+        assert cfg.others_mass_range is not None  # (None only as an argument of TaskConfig)
+        self.mass_low = np.where(self.ctrl_mask, cfg.mass_range[0], cfg.others_mass_range[0])
+        """``(n_balls,)``: each ball's lightest mass."""
+        self.mass_high = np.where(self.ctrl_mask, cfg.mass_range[1], cfg.others_mass_range[1])
+        """``(n_balls,)``: each ball's heaviest mass."""
         assert cfg.bounds is not None and cfg.target_walls is not None  # (None only as arguments of TaskConfig)
         self.walls = np.array([WALL_NAMES.index(w) for w in cfg.target_walls], dtype=np.int64)
         """The wall codes targets may sit on."""
@@ -141,9 +147,7 @@ class EpisodeSampler:
     def _build(self, uniforms: np.ndarray) -> tuple[Episodes, np.ndarray]:
         cfg = self.cfg
         r, n, k = uniforms.shape[0], cfg.n_balls, cfg.n_targets
-        assert cfg.others_mass_range is not None  # (None only as an argument of TaskConfig)
-        lo = np.where(self.ctrl_mask, cfg.mass_range[0], cfg.others_mass_range[0])
-        hi = np.where(self.ctrl_mask, cfg.mass_range[1], cfg.others_mass_range[1])
+        lo, hi = self.mass_low, self.mass_high
         masses = lo + (hi - lo) * uniforms[:, :n]
         radii = cfg.radius_of(masses)
         pos = np.zeros((r, n, 2))
@@ -171,7 +175,7 @@ class EpisodeSampler:
         """One episode's start state per generator of ``rngs`` (each draws its own blocks)."""
         uniforms = np.empty((len(rngs), self.block))
         for i, rng in enumerate(rngs):
-            uniforms[i] = rng.random(self.block)
+            rng.random(out=uniforms[i])
         eps, ok = self._build(uniforms)
         for row in np.flatnonzero(~ok):  # rare: draw fresh blocks for the rows that did not fit
             for _ in range(MAX_ATTEMPTS):
@@ -314,21 +318,34 @@ class TaskCore:
             ahead_substeps = cfg.substeps * max(1, round(cfg.lookahead / cfg.dt)) if MODES[cfg.mode].substeps else 1
             ahead_substeps = min(ahead_substeps, MAX_SUBSTEPS)
             self.ahead = engine(ahead_substeps)
-        self._pack = self._make_pack()
+        self._bind()
 
-    def _make_pack(self):
-        """The kernels' pack of the engine's arrays, the task state and its parameters."""
+    def _bind(self) -> None:
+        """The kernels' pack of the engine's arrays, the task state and its parameters, and the
+        kernels' compiled versions for the arguments :meth:`advance`, :meth:`finish` and
+        :meth:`_predict` hand them (``compile_for``), which they call without numba's dispatch (its
+        type checks cost more than a small scene's task): always this pack, ``(B, A)`` float64
+        actions, ``(B,)`` bool and int8 rows, the engine's impact records and ``(B, obs_dim)``
+        float32 observations, all C-contiguous."""
         live = self.batch.live_arrays()
-        return pack(Engine(live.balls, live.time, live.clusters), self.state, self.params)
+        self._pack = pack(Engine(live.balls, live.time, live.clusters), self.state, self.params)
+        b = self.num_scenes
+        rows = np.zeros(b, dtype=np.int8)
+        imp = self.empty_impacts()
+        obs = np.zeros((b, self.obs_dim), dtype=np.float32)
+        self._nudge = compile_for(nudge_kernel, self._pack, np.zeros((b, self.action_dim)), np.ones(b, dtype=bool))
+        self._task = compile_for(task_kernel, self._pack, rows, imp, obs)
+        self._look = None if self.ahead is None else compile_for(predict_kernel, self._pack, rows, imp, obs)
+
+    #: What a copy or a pickle makes again rather than carries: addresses, and compiled code.
+    _BOUND = ("_pack", "_nudge", "_task", "_look")
 
     def __getstate__(self):
-        state = self.__dict__.copy()
-        del state["_pack"]  # (addresses: made again for the copy's arrays)
-        return state
+        return {key: value for key, value in self.__dict__.items() if key not in self._BOUND}
 
     def __setstate__(self, state):
         self.__dict__.update(state)
-        self._pack = self._make_pack()
+        self._bind()
 
     @property
     def engines(self) -> tuple:
@@ -369,7 +386,11 @@ class TaskCore:
     def reset_scenes(self, idx: np.ndarray, rngs: list) -> None:
         """Draw a new episode for scenes ``idx`` (one generator each) and load it into the engine."""
         eps = self.sampler.sample(rngs)
-        self.batch.set_scenes(idx, eps.positions, eps.velocities, masses=eps.masses, radii=eps.radii, time=0.0)
+        # (unchecked: the episode builder places the balls apart from each other and the walls, and the
+        # constructor checked the config's balls, so the checks would cost more than the reset)
+        self.batch.set_scenes(
+            idx, eps.positions, eps.velocities, masses=eps.masses, radii=eps.radii, time=0.0, check=False
+        )
         self._write_episode(idx, eps)
 
     @staticmethod
@@ -388,12 +409,12 @@ class TaskCore:
                 raise ValueError(f"{field}: expected real numbers, got {x!r} ({type(x).__name__}) in {actions!r}")
 
     def advance(self, actions: np.ndarray, active: np.ndarray, dt: float) -> np.ndarray:
-        """Nudge (actions (B, A) float64; inactive rows get none) and step the engine by dt.
+        """Nudge (actions (B, A) float64, C-contiguous; inactive rows get none) and step the engine by dt.
 
         Returns the engine's impact records (read-only); the nudge's size per scene is in
         ``scene_f`` (``nudge``, m/s). An action with NaN raises ValueError and changes nothing.
         """
-        bad = nudge_kernel(self._pack, actions, active)
+        bad = self._nudge(self._pack, actions, active)
         if bad >= 0:
             where = f"sub-env {bad}: " if self.num_scenes > 1 else ""
             raise ValueError(f"{where}action contains NaN: {actions[bad].tolist()}")
@@ -407,7 +428,7 @@ class TaskCore:
         ``flags``: one ``task.layout.ROW_*`` code per scene. Reward, energy, targets hit and the end
         flags are then in ``scene_f`` and ``scene_i`` (see :meth:`outputs`).
         """
-        task_kernel(self._pack, flags, imp, obs)
+        self._task(self._pack, flags, imp, obs)
         if self.ahead is not None:
             self._predict(self.ahead, flags, obs)
         return obs
@@ -423,7 +444,9 @@ class TaskCore:
             warnings.simplefilter("ignore", EventCapWarning)
             imp = ahead.step(self.cfg.lookahead).array
         imp.flags.writeable = False
-        predict_kernel(self._pack, flags, imp, obs)
+        look = self._look
+        assert look is not None  # (bound whenever there is a look-ahead engine)
+        look(self._pack, flags, imp, obs)
 
     def outputs(self) -> tuple:
         """Fresh ``(reward, terminated, truncated, success, targets_hit, energy, nudge)`` arrays (B,)."""

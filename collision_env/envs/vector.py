@@ -185,7 +185,9 @@ class CollisionTargetVectorEnv(VectorEnv):
         return obs, info
 
     def _fresh_obs(self):
-        return np.zeros((self.num_envs, self._core.obs_dim), dtype=np.float32)
+        # (not zeroed: the task kernel writes every entry of every row it is given to observe, and
+        # each call the fresh array is given to observes every row)
+        return np.empty((self.num_envs, self._core.obs_dim), dtype=np.float32)
 
     def step(self, actions: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         """Step every sub-env (one row of ``actions`` each) in one call of the batched engine:
@@ -197,6 +199,8 @@ class CollisionTargetVectorEnv(VectorEnv):
         a = np.asarray(actions, dtype=np.float64)
         if a.shape != self.action_space.shape:
             raise ValueError(f"actions: expected shape {self.action_space.shape}, got {a.shape}")
+        if not a.flags.c_contiguous:  # (the nudge kernel takes C-contiguous actions: see TaskCore._bind)
+            a = np.ascontiguousarray(a)
         core = self._core
         B = self.num_envs
         cap_limit = self.max_episode_steps

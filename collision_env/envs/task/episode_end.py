@@ -30,7 +30,7 @@ from .layout import (
     TARGET_INTS,
     TARGET_PENDING,
 )
-from .scoring import aim_distance, in_cluster
+from .scoring import aim_squared, in_cluster
 
 
 @njit(refcount=False, forceinline=True)
@@ -64,20 +64,17 @@ def advance_episodes(flags, engine, state, params):  # pragma: no cover - numba
 
 @njit(inline="always")
 def border_contact(x, y, vx, vy, r, xmin, ymin, xmax, ymax):  # pragma: no cover - numba
-    """Where a ball at (x, y) of radius r would touch the border flying straight on at (vx, vy) != 0."""
-    tx = math.inf
-    ty = math.inf
-    if vx > 0.0:
-        tx = (xmax - r - x) / vx
-    elif vx < 0.0:
-        tx = (xmin + r - x) / vx
-    if vy > 0.0:
-        ty = (ymax - r - y) / vy
-    elif vy < 0.0:
-        ty = (ymin + r - y) / vy
-    if tx <= ty:
-        return xmax if vx > 0.0 else xmin, y + vy * max(tx, 0.0)
-    return x + vx * max(ty, 0.0), ymax if vy > 0.0 else ymin
+    """Where a ball at (x, y) of radius r would touch the border flying straight on at (vx, vy) != 0.
+    (Walls and results are selected, not branched to: the directions of a batch's balls are random,
+    which a processor's branch prediction cannot follow.)"""
+    ex = xmax - r if vx > 0.0 else xmin + r
+    ey = ymax - r if vy > 0.0 else ymin + r
+    tx = (ex - x) / vx if vx != 0.0 else math.inf
+    ty = (ey - y) / vy if vy != 0.0 else math.inf
+    at_x = tx <= ty
+    cx = (xmax if vx > 0.0 else xmin) if at_x else x + vx * max(ty, 0.0)
+    cy = y + vy * max(tx, 0.0) if at_x else (ymax if vy > 0.0 else ymin)
+    return cx, cy
 
 
 @njit(inline="always")
@@ -97,7 +94,7 @@ def _straight_aim(b, views, diag, state, params, seq, cluster):  # pragma: no co
     if p[PARAMS.shaping] == 0.0:
         return -1.0
     pos, vel, _, _, radii, _ = views
-    best = 1.0
+    best = math.inf  # (the least squared distance: see scoring.aim_squared)
     for i in range(pos.shape[1]):
         if not (params.scoring[i] and (not cluster or in_cluster(state.body, b, i))):
             continue
@@ -116,8 +113,8 @@ def _straight_aim(b, views, diag, state, params, seq, cluster):  # pragma: no co
             p[PARAMS.xmax],
             p[PARAMS.ymax],
         )
-        best = min(best, aim_distance(cx, cy, b, state, seq, params) / diag)
-    return -best
+        best = min(best, aim_squared(cx, cy, b, state, seq, params))
+    return -min(1.0, math.sqrt(best) / diag)
 
 
 @njit(refcount=False, forceinline=True)

@@ -60,7 +60,8 @@ def _draw_velocities(uniforms, ctrl_mask, episode_f, dim, vel):  # pragma: no co
 
 @njit(inline="always")
 def _place_on_line(uniforms, off, radii, episode_f, pos, ok):  # pragma: no cover - numba
-    """Balls left to right by index, the free length split at sorted uniform points (always fits)."""
+    """Balls left to right by index, the free length split at sorted uniform points; ``ok[r]`` False
+    when the balls and their gaps do not fit the line."""
     N = pos.shape[1]
     xmin = episode_f[EPISODE_FLOATS.xmin]
     xmax = episode_f[EPISODE_FLOATS.xmax]
@@ -68,6 +69,9 @@ def _place_on_line(uniforms, off, radii, episode_f, pos, ok):  # pragma: no cove
         free = (xmax - xmin) - _GAP * (N + 1)
         for i in range(N):
             free -= 2.0 * radii[r, i]
+        if free < 0.0:
+            ok[r] = False
+            continue
         us = _sorted(uniforms[r, off : off + N] * free)
         edge = xmin
         for i in range(N):
@@ -80,8 +84,9 @@ def _place_on_line(uniforms, off, radii, episode_f, pos, ok):  # pragma: no cove
 
 @njit(inline="always")
 def _place_in_box(uniforms, off, tries, ctrl_mask, rack, radii, episode_f, pos, ok):  # pragma: no cover - numba
-    """Each ball at the first of its tries that overlaps no ball placed before it; ``ok[r]`` False
-    when some ball of row r found no such place."""
+    """Each ball at the first of its tries that overlaps no ball placed before it, each at least
+    ``_GAP`` from the others and the walls; ``ok[r]`` False when some ball of row r found no such
+    place (or its range of places is empty)."""
     xmin = episode_f[EPISODE_FLOATS.xmin]
     ymin = episode_f[EPISODE_FLOATS.ymin]
     xmax = episode_f[EPISODE_FLOATS.xmax]
@@ -100,6 +105,9 @@ def _place_in_box(uniforms, off, tries, ctrl_mask, rack, radii, episode_f, pos, 
             lo_y = ymin + rad + _GAP
             hi_y = ymax - rad - _GAP
             placed = False
+            if lo_x > hi_x or lo_y > hi_y:
+                ok[r] = False
+                break
             for t in range(tries):
                 px = lo_x + (hi_x - lo_x) * uniforms[r, off + 2 * (i * tries + t)]
                 py = lo_y + (hi_y - lo_y) * uniforms[r, off + 2 * (i * tries + t) + 1]

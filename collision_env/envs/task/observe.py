@@ -6,7 +6,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 from collision_env.engine.compiled import ball_views, njit
-from collision_env.engine.scene import WALL_BOTTOM, WALL_LEFT, WALL_NAMES, WALL_RIGHT
+from collision_env.engine.scene import WALL_BOTTOM, WALL_LEFT, WALL_NAMES
 
 from .layout import (
     BALL_OBS,
@@ -23,7 +23,7 @@ from .layout import (
     TARGET_PENDING,
 )
 from .nudge import clip1
-from .scoring import in_cluster
+from .scoring import in_cluster, on_side_wall
 
 
 @njit(inline="always")
@@ -58,14 +58,13 @@ def scales(p):  # pragma: no cover - numba
 
 @njit(inline="always")
 def _observed_point(wall, centre, xc, yc, xh, yh):  # pragma: no cover - numba
-    """A target's centre point in observation coordinates, and the half length of its wall."""
-    if wall == WALL_LEFT:
-        return -1.0, (centre - yc) / yh, yh
-    if wall == WALL_RIGHT:
-        return 1.0, (centre - yc) / yh, yh
-    if wall == WALL_BOTTOM:
-        return (centre - xc) / xh, -1.0, xh
-    return (centre - xc) / xh, 1.0, xh
+    """A target's centre point in observation coordinates, and the half length of its wall (selected,
+    not branched to: see ``scoring._squared_distance_to_target``)."""
+    side = on_side_wall(wall)
+    half = yh if side else xh
+    along = (centre - (yc if side else xc)) / half
+    edge = -1.0 if wall == WALL_LEFT or wall == WALL_BOTTOM else 1.0
+    return (edge if side else along), (along if side else edge), half
 
 
 @njit(refcount=False, forceinline=True)

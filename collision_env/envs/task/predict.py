@@ -22,7 +22,7 @@ from .layout import (
 )
 from .nudge import clip1
 from .observe import centre_and_half_size
-from .scoring import aim_distance, next_wall_impact, target_hit
+from .scoring import aim_squared, next_wall_impact, target_hit
 
 
 @njit(label="the environments' predicted observation")
@@ -66,7 +66,7 @@ def predict_kernel(h, flags, imp, obs):  # pragma: no cover - numba
             o += len(PREDICTED_OBS)
     seen = np.zeros(body.shape, dtype=np.bool_)
     found = np.zeros(body.shape, dtype=np.bool_)  # (a scoring impact is in the ball's block)
-    best = np.ones(body.shape[0])
+    best = np.full(body.shape[0], np.inf)  # (each scene's least squared aim distance)
     for b in range(flags.shape[0]):
         if flags[b] == ROW_SKIP:
             continue
@@ -89,7 +89,7 @@ def predict_kernel(h, flags, imp, obs):  # pragma: no cover - numba
             x = imp[j]["x"]
             y = imp[j]["y"]
             if aim and scores:
-                best[b] = min(best[b], aim_distance(x, y, b, state, seq, params) / diag)
+                best[b] = min(best[b], aim_squared(x, y, b, state, seq, params))
             if observe and shown[i]:
                 hits = scores and target_hit(j, imp, state, seq) >= 0
                 if first or hits:
@@ -103,9 +103,8 @@ def predict_kernel(h, flags, imp, obs):  # pragma: no cover - numba
     if aim:
         for b in range(flags.shape[0]):
             f = flags[b]
+            phi = -min(1.0, math.sqrt(best[b]) / diag)
             if f == ROW_STEPPED and state.scene_i[b, SCENE_INTS.hits] == 0:
-                state.scene_f[b, SCENE_FLOATS.reward] += p[PARAMS.shaping] * (
-                    -best[b] - state.scene_f[b, SCENE_FLOATS.phi]
-                )
+                state.scene_f[b, SCENE_FLOATS.reward] += p[PARAMS.shaping] * (phi - state.scene_f[b, SCENE_FLOATS.phi])
             if f == ROW_STEPPED or f == ROW_RESET:
-                state.scene_f[b, SCENE_FLOATS.phi] = -best[b]
+                state.scene_f[b, SCENE_FLOATS.phi] = phi

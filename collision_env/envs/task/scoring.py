@@ -118,34 +118,40 @@ def target_hit(j, imp, state, seq):  # pragma: no cover - numba
 
 
 @njit(inline="always")
-def _distance_to_target(cx, cy, wall, centre, hw, xmin, ymin, xmax, ymax):  # pragma: no cover - numba
-    """Distance from (cx, cy) to the target segment of half width hw centred at ``centre`` on ``wall``."""
-    if wall == WALL_LEFT:
-        x0, y0, x1, y1 = xmin, centre - hw, xmin, centre + hw
-    elif wall == WALL_RIGHT:
-        x0, y0, x1, y1 = xmax, centre - hw, xmax, centre + hw
-    elif wall == WALL_BOTTOM:
-        x0, y0, x1, y1 = centre - hw, ymin, centre + hw, ymin
-    else:
-        x0, y0, x1, y1 = centre - hw, ymax, centre + hw, ymax
+def _squared_distance_to_target(cx, cy, wall, centre, hw, xmin, ymin, xmax, ymax):  # pragma: no cover - numba
+    """Squared distance from (cx, cy) to the target segment of half width hw centred at ``centre`` on
+    ``wall``. (The segment's ends are selected, not branched to: a batch's targets sit on walls at
+    random, which a processor's branch prediction cannot follow.)"""
+    lo = centre - hw
+    hi = centre + hw
+    side = on_side_wall(wall)
+    wx = xmin if wall == WALL_LEFT else xmax
+    wy = ymin if wall == WALL_BOTTOM else ymax
+    x0 = wx if side else lo
+    x1 = wx if side else hi
+    y0 = lo if side else wy
+    y1 = hi if side else wy
     sx = x1 - x0
     sy = y1 - y0
     u = ((cx - x0) * sx + (cy - y0) * sy) / (sx * sx + sy * sy)
     u = min(max(u, 0.0), 1.0)
     dx = cx - (x0 + u * sx)
     dy = cy - (y0 + u * sy)
-    return math.sqrt(dx * dx + dy * dy)
+    return dx * dx + dy * dy
 
 
 @njit(refcount=False, forceinline=True)
-def aim_distance(cx, cy, b, state, seq, params):  # pragma: no cover - numba
-    """Distance from a wall point (cx, cy) to the nearest visible pending target of scene b (inf if none)."""
+def aim_squared(cx, cy, b, state, seq, params):  # pragma: no cover - numba
+    """Squared distance from a wall point (cx, cy) to the nearest visible pending target of scene b
+    (inf if none). The distance is its square root, taken once for the nearest: a square root (and
+    a division by a positive scale) keeps the order of its arguments, so the root of the least
+    square is the least root, bit for bit, for one root instead of one per target."""
     best = math.inf
     targets, geo, p = state.targets, state.target_geo, params.params
     k0, k1 = visible_targets(state.scene_i[b, SCENE_INTS.current], targets.shape[1], seq)
     for k in range(k0, k1):
         if targets[b, k, TARGET_INTS.status] == TARGET_PENDING:
-            d = _distance_to_target(
+            d = _squared_distance_to_target(
                 cx,
                 cy,
                 targets[b, k, TARGET_INTS.wall],
