@@ -118,9 +118,9 @@ class TaskConfig:
     """Where balls start: ``"random"`` (anywhere without overlap; left to right by index in 1D) or
     ``"rack"`` (controlled balls in the left 40 % of the area, the others in the right half) or
     ``"fence"`` (2D: controlled balls as in ``"rack"``; the others fixed, in a column across the
-    area's vertical centre line, half of them upward from the bottom wall and half downward from the
-    top wall, centres ``FENCE_SPACING`` radii of the largest of them apart and the outermost half a
-    spacing from its wall, so that an opening is left in the middle; the lower half takes the odd one)."""
+    area's vertical centre line downward from the top wall, centres ``FENCE_SPACING`` radii of the
+    largest of them apart and the first half a spacing from the wall, so that an opening is left
+    above the bottom wall)."""
     speed_range: tuple = (0.3, 0.8)
     """Initial speed of each controlled ball, drawn from this ``(low, high)`` range (m/s), in a random direction."""
     others_speed_range: tuple = (0.0, 0.0)

@@ -10,23 +10,23 @@ class FenceEnv(CollisionTargetEnv):
     """
     ## Description
 
-    A small, fast ball (ball 0, 1 kg, radius 0.05 m) and a fence of 10 pegs: balls of the same
-    radius but 50 kg, at rest in a column across the middle of PhET's 4 m x 2 m play area (x = 0),
-    0.16 m apart (a 0.06 m gap, which the ball does not pass), five up from the bottom wall and five
-    down from the top wall, leaving an opening at |y| < 0.28 m (peg centres), elastic (e = 1). The
+    A small, fast ball (ball 0, 1 kg, radius 0.05 m) and a fence of 9 pegs: balls of the same
+    radius but 50 kg, at rest in a column down the middle of PhET's 4 m x 2 m play area (x = 0) from
+    the top wall, 0.16 m apart (a 0.06 m gap, which the ball does not pass), leaving an opening of
+    0.54 m above the bottom wall (the lowest peg's centre at y = -0.36 m); elastic (e = 1). The
     agent has one shot: its first action sets the ball's velocity, up to 5 m/s; the target is a
     0.3 m segment of the right wall, and the shot scores if the ball's first impact on the right
-    wall lands on it. The straight line from the ball to the target mostly crosses the fence, so a
-    shot goes through the opening directly or off the top or bottom wall.
+    wall lands on it. The straight line from the ball to the target mostly crosses the fence; a
+    shot off the bottom wall through the opening reaches the target from most starts.
 
     Committing the whole outcome to one action makes this the preset where training in a cheap
     engine mode costs: at 5 m/s a 0.1 s control step moves the ball 0.5 m, more than the 0.12 to 0.2 m
     across which it overlaps a peg as it crosses the fence, so naive and posteriori steps with one
     sub-step, which look for contacts only at a step's end, mostly let it through the fence
-    (tunnelling), and a naive step reports each wall impact where the step ends. A policy trained
-    there can shoot straight at the target through the pegs, and loses those shots when the impacts
-    are exact (`tests/envs/test_fence.py`; `agents.study` measures what training cheaply costs).
-    `CollisionEnv/Fence-v0`; the generic env with `preset="fence"`.
+    (tunnelling), and a naive step reports each wall impact where the step ends (it bounces the ball
+    late). A policy trained there can shoot straight at the target through the pegs, and loses those
+    shots when the impacts are exact (`tests/envs/test_fence.py`; `agents.study` measures what
+    training cheaply costs). `CollisionEnv/Fence-v0`; the generic env with `preset="fence"`.
 
     ## Action Space
 
@@ -80,7 +80,7 @@ class FenceEnv(CollisionTargetEnv):
         config=dict(
             dimension=2,
             elasticity=1.0,
-            n_balls=11,
+            n_balls=10,
             mass_range=(1.0, 1.0),
             others_mass_range=(50.0, 50.0),
             radius=0.05,

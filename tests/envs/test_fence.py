@@ -24,7 +24,7 @@ from .test_vector import run_pair
 
 ID = "CollisionEnv/Fence-v0"
 MODES = [("naive", 1), ("posteriori", 1), ("posteriori", 4), ("exact", 1)]
-PEG_Y = (-0.92, -0.76, -0.6, -0.44, -0.28, 0.92, 0.76, 0.6, 0.44, 0.28)
+PEG_Y = (0.92, 0.76, 0.6, 0.44, 0.28, 0.12, -0.04, -0.2, -0.36)
 
 
 def placed(env, ball=None, target=None):
@@ -45,16 +45,18 @@ def placed(env, ball=None, target=None):
     return env
 
 
-def test_the_fence_stands_across_the_middle_with_an_opening():
+def test_the_fence_hangs_from_the_top_wall_with_an_opening_above_the_bottom_one():
     for seed in range(5):
         env = gym.make(ID).unwrapped
         env.reset(seed=seed)
         pos = env.core.pos[0]
         np.testing.assert_allclose(pos[1:], [(0.0, y) for y in PEG_Y], atol=1e-12)
         assert -2.0 < pos[0, 0] < -0.4 - 0.05  # the ball in the left 40 %
-        assert env.core.radii[0].tolist() == [0.05] * 11 and env.core.masses[0, 1:].tolist() == [50.0] * 10
-    gaps = np.diff(sorted(PEG_Y)) - 0.1  # between the pegs' surfaces: 0.06 m, less than the ball's 0.1 m
-    assert np.allclose(gaps[gaps < 0.1], 0.06) and (gaps < 0.1).sum() == 8 and gaps.max() == pytest.approx(0.56 - 0.1)
+        assert env.core.radii[0].tolist() == [0.05] * 10 and env.core.masses[0, 1:].tolist() == [50.0] * 9
+    # between the pegs' surfaces 0.06 m, less than the ball's 0.1 m; 0.03 m from the top wall
+    np.testing.assert_allclose(-np.diff(PEG_Y) - 0.1, 0.06, atol=1e-12)
+    assert 1.0 - PEG_Y[0] - 0.05 == pytest.approx(0.03)
+    assert PEG_Y[-1] - 0.05 - (-1.0) == pytest.approx(0.59)  # the opening
 
 
 def test_a_fence_needs_2d_and_room_for_its_opening():
@@ -100,8 +102,8 @@ def test_a_bounce_off_another_wall_does_not_end_the_shot():
 
 
 def one_step_at_the_fence(mode: str, substeps: int):
-    """Ball 0 0.3 m left of the peg at y = -0.6, shot straight at it at 5 m/s: one 0.1 s step."""
-    env = placed(gym.make(ID, mode=mode, substeps=substeps).unwrapped, ball=(-0.3, -0.6))
+    """Ball 0 0.3 m left of the peg at y = 0.6, shot straight at it at 5 m/s: one 0.1 s step."""
+    env = placed(gym.make(ID, mode=mode, substeps=substeps).unwrapped, ball=(-0.3, 0.6))
     _, _, _, _, info = env.step(np.array([1.0, 0.0], np.float32))
     return env, info["impacts"].array
 
@@ -145,17 +147,19 @@ def straight(env) -> np.ndarray:
 
 def test_straight_shots_succeed_through_the_fence_in_the_cheap_modes_only():
     # the exploit a policy trained cheap can learn: measured over 100 starts, straight shots hit
-    # 86 % naive k=1, 85 % posteriori k=1, 36 % posteriori k=4, 35 % exact (the fence in the way)
+    # 82 % naive k=1, 72 % posteriori k=1, 17 % posteriori k=4, 17 % exact (the fence in the way)
     seeds = range(100)
     share = {m: np.mean([play(*m, s, straight) for s in seeds]) for m in MODES}
-    assert share["naive", 1] > 0.8 and share["posteriori", 1] > 0.75, share
-    assert share["exact", 1] < 0.45 and abs(share["posteriori", 4] - share["exact", 1]) < 0.05, share
+    assert share["naive", 1] > 0.75 and share["posteriori", 1] > 0.65, share
+    assert share["exact", 1] < 0.25 and abs(share["posteriori", 4] - share["exact", 1]) < 0.05, share
 
 
-def test_the_scripted_bank_shots_go_through_the_opening():
+def test_the_scripted_bank_shots_go_through_the_opening_when_the_impacts_are_exact():
+    # off the bottom wall through the opening: measured over 100 starts, 96 % exact and 51 % naive
+    # k=1, whose step bounces the ball off the wall where the step ends, late
     seeds = range(100)
-    hits = [play("exact", 1, s, lambda env: scripted_policy(env)(None)) for s in seeds]
-    assert np.mean(hits) >= 0.65  # (measured: 69 %; the rest have no clear path within four bounces)
+    share = {m: np.mean([play(*m, s, lambda env: scripted_policy(env)(None)) for s in seeds]) for m in MODES[::3]}
+    assert share["exact", 1] >= 0.9 and share["naive", 1] < 0.7, share
     env = gym.make(ID)
     env.reset(seed=0)
     assert isinstance(scripted_policy(env), BankShotPolicy)

@@ -84,27 +84,22 @@ def _place_on_line(uniforms, off, radii, episode_f, pos, ok):  # pragma: no cove
 @njit(inline="always")
 def _place_fence(ctrl_mask, radii, episode_f, pos):  # pragma: no cover - numba
     """The balls not controlled, fixed in a column across the vertical centre line (``TaskConfig.layout``
-    ``"fence"``): the first half (the odd one included) upward from the bottom wall, the rest downward
-    from the top wall, ``FENCE_SPACING`` radii of the largest of them apart, the outermost half a
-    spacing from its wall; the opening is left between the halves."""
+    ``"fence"``), downward from the top wall, ``FENCE_SPACING`` radii of the largest of them apart,
+    the first half a spacing from the wall; the opening is left between the last and the bottom wall."""
     xc = 0.5 * (episode_f[EPISODE_FLOATS.xmin] + episode_f[EPISODE_FLOATS.xmax])
-    ymin = episode_f[EPISODE_FLOATS.ymin]
     ymax = episode_f[EPISODE_FLOATS.ymax]
     for r in range(pos.shape[0]):
-        n_pegs = 0
         r_peg = 0.0
         for i in range(pos.shape[1]):
             if not ctrl_mask[i]:
-                n_pegs += 1
                 r_peg = max(r_peg, radii[r, i])
         spacing = FENCE_SPACING * r_peg
-        lower = (n_pegs + 1) // 2
         k = 0
         for i in range(pos.shape[1]):
             if ctrl_mask[i]:
                 continue
             pos[r, i, 0] = xc
-            pos[r, i, 1] = ymin + (k + 0.5) * spacing if k < lower else ymax - (k - lower + 0.5) * spacing
+            pos[r, i, 1] = ymax - (k + 0.5) * spacing
             k += 1
 
 
