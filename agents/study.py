@@ -13,8 +13,8 @@ share of it, so the trade is read off directly: is a policy trained on a cheaper
 as good when the impacts are exact, and how much training time did the cheaper engine save? The
 trade table sums it up per preset, the Pareto figure (``pareto.png``) sets training time against
 exact-evaluated success, and the rule says, from the same figures, where training cheap pays and
-where it costs points (``Pegs``, the preset built for it: small, fast balls, narrow targets, long
-control steps).
+where it costs points (``Pegs`` and ``Fence``, the presets built for it: small, fast balls, narrow
+targets, long control steps; in ``Fence`` the one shot commits the outcome before any impact is seen).
 
 Part **presets**: every registered preset is trained in exact mode over the same seeds and set
 beside the random and the scripted (exact-aim) baselines on the same evaluation episodes; a preset

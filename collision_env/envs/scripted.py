@@ -187,12 +187,12 @@ def _clear(p: np.ndarray, q: np.ndarray, centres: np.ndarray, reach: np.ndarray)
 
 class BankShotPolicy(ScriptedPolicy):
     """One shot (``control="shot"``), aimed by plane geometry alone (no engine): at points across
-    the current target (its centre first, then further out to ``spread`` of its half width), sent
-    directly or off the two walls along the target's wall, up to ``bounces`` times (aimed at the
-    point's mirror image, the path unfolded), at ``max_speed``; the first whose unfolded straight
-    path passes every other ball's mirror images with ``margin`` m to spare is taken, else the direct
-    shot at the centre. For one scoring ball among balls at rest (``Fence``): it never plans a
-    bounce off a ball (a ball in the way rules a path out).
+    the current target (its centre, and out to ``spread`` of its half width), sent directly or off
+    the two walls along the target's wall (aimed at the point's mirror images in them, the path
+    unfolded, out to ``bounces`` periods of the mirroring), at ``max_speed``; the shortest unfolded
+    straight path that passes every other ball's mirror images with ``margin`` m to spare is taken,
+    else the direct shot at the centre. For one scoring ball among balls at rest (``Fence``): it
+    never plans a bounce off a ball (a ball in the way rules a path out).
     """
 
     def __init__(self, env: gym.Env, spread: float = 0.8, margin: float = 0.01, bounces: int = 4) -> None:
@@ -204,6 +204,7 @@ class BankShotPolicy(ScriptedPolicy):
     def shot(self) -> np.ndarray:
         """The shot's velocity (m/s) for the current state."""
         core, cfg = self.env.core, self.env.config
+        assert cfg.bounds is not None  # (None only as an argument of TaskConfig)
         xmin, ymin, xmax, ymax = cfg.bounds
         i = cfg.controlled[0]
         pos, r = core.pos[0], core.radii[0]
@@ -231,14 +232,10 @@ class BankShotPolicy(ScriptedPolicy):
         ghosts = np.concatenate(mirrored)
         reach = np.tile(r[others] + r[i] + self.margin, len(mirrored))
         offsets = [0.0] + [sign * f * half for f in np.linspace(0.2, self.spread, 3) for sign in (1.0, -1.0)]
-        paths = []
-        for n in range(self.bounces + 1):
-            for off in offsets:
-                for image in images(np.array(centre + off), n):
-                    aim = goal.copy()
-                    aim[axis] = image
-                    paths.append((abs(image - pos[i, axis]), aim))
-        for _, aim in sorted(paths, key=lambda p: p[0]):  # the shortest paths first
+        along = [image for off in offsets for image in images(np.array(centre + off), self.bounces)]
+        for image in sorted(along, key=lambda a: abs(a - pos[i, axis])):  # the shortest paths first
+            aim = goal.copy()
+            aim[axis] = image
             if _clear(pos[i], aim, ghosts, reach):
                 return cfg.max_speed * (aim - pos[i]) / np.linalg.norm(aim - pos[i])
         return cfg.max_speed * (goal - pos[i]) / np.linalg.norm(goal - pos[i])
