@@ -13,7 +13,7 @@ class FenceEnv(CollisionTargetEnv):
     A small, fast ball (ball 0, 1 kg, radius 0.05 m) and a fence of 9 pegs: balls of the same
     radius but 50 kg, at rest in a column down the middle of PhET's 4 m x 2 m play area (x = 0) from
     the top wall, 0.16 m apart (a 0.06 m gap, which the ball does not pass), leaving an opening of
-    0.54 m above the bottom wall (the lowest peg's centre at y = -0.36 m); elastic (e = 1). The
+    0.59 m above the bottom wall (the lowest peg's centre at y = -0.36 m); elastic (e = 1). The
     agent has one shot: its first action sets the ball's velocity, up to 5 m/s; the target is a
     0.3 m segment of the right wall, and the shot scores if the ball's first impact on the right
     wall lands on it. The straight line from the ball to the target mostly crosses the fence; a
