@@ -13,8 +13,8 @@ share of it, so the trade is read off directly: is a policy trained on a cheaper
 as good when the impacts are exact, and how much training time did the cheaper engine save? The
 trade table sums it up per preset, the Pareto figure (``pareto.png``) sets training time against
 exact-evaluated success, and the rule says, from the same figures, where training cheap pays and
-where it costs points (``Pegs``, the preset built for it: small, fast balls, narrow targets, long
-control steps).
+where it costs points (``Pegs`` and ``Fence``, the presets built for it: small, fast balls, narrow
+targets, long control steps; in ``Fence`` the one shot commits the outcome before any impact is seen).
 
 Part **presets**: every registered preset is trained in exact mode over the same seeds and set
 beside the random and the scripted (exact-aim) baselines on the same evaluation episodes; a preset
@@ -107,7 +107,7 @@ def train_and_evaluate(task: dict) -> dict:
         "timesteps_done": run["timesteps_done"],
         "time_split": run["time_split"],
         "observe": _observation(run["env_kwargs"]),
-        "control": run["env_kwargs"].get("control", "nudge"),
+        "control": _control(task["env_id"], run["env_kwargs"]),
     }
     exact = evaluate(run_dir, episodes=task["episodes"], mode="exact", baselines=())
     out["exact"] = exact["policies"]["ppo"]
@@ -310,7 +310,17 @@ def _entry_setting(env_id: str) -> str | None:
         entry = hyperparams_for(env_id).get("env_kwargs") or {}
     except UsageError:
         return None
-    return _setting({**entry, "observe": _observation(entry)})
+    return _setting({**entry, "observe": _observation(entry), "control": _control(env_id, entry)})
+
+
+def _control(env_id: str, env_kwargs: dict) -> str:
+    """The control a run of ``env_id`` trains with: its ``control`` keyword, else its preset's."""
+    from collision_env.envs import REGISTERED, make_config
+
+    if "control" in env_kwargs:
+        return env_kwargs["control"]
+    reg = REGISTERED.get(env_id)
+    return make_config(reg.single.preset).control if reg is not None else "nudge"
 
 
 def _shipped(row: dict) -> bool:
@@ -357,7 +367,8 @@ def presets_table(rows: list, base: list) -> str:
         'with `predicted_impact="scoring"`, a scoring ball\'s first predicted impact that lands on a pending '
         "target within the look-ahead, however many bounces ahead, else its next) and nudges where the "
         "entry uses velocity control (`nudge`: the action is each step's velocity change; `velocity`: the env's "
-        '`control="velocity"`, the velocity to steer to and an engage flag). The other rows keep the rest of '
+        '`control="velocity"`, the velocity to steer to and an engage flag; `shot`: the env\'s `control="shot"`, '
+        "one velocity, set in the first step, for the whole episode). The other rows keep the rest of "
         "the entry as it stood when they were trained (such as an aiming term taken from the prediction; the "
         "steps column gives their length). The random and scripted baselines play the env's defaults (plain "
         "observation, nudges; in the presets trained with velocity control the scripted policy plays alike "

@@ -21,7 +21,7 @@ from collision_env.envs import TaskConfig as _TaskConfig
 ENV_IDS = tuple(_REGISTERED)
 
 #: Control steps per episode of the default task (10 s of simulated time at dt = 0.05 s), which
-#: every shipped task keeps.
+#: every shipped task keeps but ``Fence`` (one shot, decided within 15 steps of 0.1 s).
 MAX_EPISODE_STEPS = _TaskConfig().n_steps
 
 __all__ = ["ENV_IDS", "MAX_EPISODE_STEPS", "__version__"]

@@ -17,6 +17,7 @@ from collision_env.envs.inelastic_cluster import InelasticClusterEnv, InelasticC
 from collision_env.envs.multi_ball import MultiBallEnv, MultiBallVectorEnv
 from collision_env.envs.crowd import CrowdEnv, CrowdVectorEnv
 from collision_env.envs.pegs import PegsEnv, PegsVectorEnv
+from collision_env.envs.fence import FenceEnv, FenceVectorEnv
 from collision_env.envs.registry import PRESET_IDS, REGISTERED, Task, register_env, register_task
 from collision_env.envs.target_env import CollisionTargetEnv
 from collision_env.envs.vector import CollisionTargetVectorEnv
@@ -41,6 +42,8 @@ __all__ = [
     "CollisionTargetVectorEnv",
     "CrowdEnv",
     "CrowdVectorEnv",
+    "FenceEnv",
+    "FenceVectorEnv",
     "InelasticClusterEnv",
     "InelasticClusterVectorEnv",
     "Line1DEnv",

@@ -24,6 +24,7 @@ from collision_env.engine import MAX_SUBSTEPS, MODES
 from collision_env.engine.keywords import check_keywords
 from collision_env.engine.scene import MAX_MAGNITUDE, PLAY_AREA_1D, PLAY_AREA_2D, WALL_NAMES, radius_from_mass
 from collision_env.engine.validation import MAX_EVENT_CAP
+from collision_env.envs.task.episodes import FENCE_SPACING
 from collision_env.envs.task.layout import BALL_OBS, GLOBAL_OBS, PREDICTED_OBS, TARGET_OBS
 
 OBSERVATIONS = ("plain", "predicted")
@@ -32,9 +33,9 @@ AIMS = ("straight", "predicted")
 #: Which predicted wall impact of a scoring ball the prediction reports (see TaskConfig).
 PREDICTED_IMPACTS = ("next", "scoring")
 #: What an action component means: a velocity change, or a velocity the ball is steered to (see TaskConfig).
-CONTROLS = ("nudge", "velocity")
+CONTROLS = ("nudge", "velocity", "shot")  # (in the order of task.layout's CONTROL_* codes)
 SCORERS = ("any", "controlled", "others", "cluster")
-LAYOUTS = ("random", "rack")
+LAYOUTS = ("random", "rack", "fence")
 RADIUS_RULES = ("mass", "constant")
 
 #: Number of observation entries per ball, per target slot and global (the layouts in ``task.layout``).
@@ -115,7 +116,11 @@ class TaskConfig:
     or a number in m."""
     layout: str = "random"
     """Where balls start: ``"random"`` (anywhere without overlap; left to right by index in 1D) or
-    ``"rack"`` (controlled balls in the left 40 % of the area, the others in the right half)."""
+    ``"rack"`` (controlled balls in the left 40 % of the area, the others in the right half) or
+    ``"fence"`` (2D: controlled balls as in ``"rack"``; the others fixed, in a column across the
+    area's vertical centre line downward from the top wall, centres ``FENCE_SPACING`` radii of the
+    largest of them apart and the first half a spacing from the wall, so that an opening is left
+    above the bottom wall)."""
     speed_range: tuple = (0.3, 0.8)
     """Initial speed of each controlled ball, drawn from this ``(low, high)`` range (m/s), in a random direction."""
     others_speed_range: tuple = (0.0, 0.0)
@@ -130,7 +135,11 @@ class TaskConfig:
     ``max_speed``), then an engage flag: while the flag is > 0 the env nudges the ball
     towards that velocity, by at most ``max_dv`` per axis and step along the straight line to it; while
     it is <= 0 the ball coasts. A named velocity longer than ``max_speed`` is scaled back to it; the
-    change charged (``action_cost``) is the change made."""
+    change charged (``action_cost``) is the change made. ``"shot"``: per controlled ball, one
+    component per axis, the velocity (each component over ``max_speed``, scaled back to it if
+    longer) the ball is given at once in the episode's first step; the actions of later steps are
+    ignored (no change, no cost), and a target fails when a scoring ball strikes its wall off it
+    (the episode then ends, as at a window's close)."""
     dt: float = 0.05
     """The control step: seconds of simulated time per ``env.step``."""
     max_dv: float = 0.15
@@ -243,6 +252,8 @@ class TaskConfig:
             s("radius", _number("radius", self.radius, low=0.0, strict_low=True))
         if self.layout not in LAYOUTS:
             raise ValueError(f"layout: expected one of {LAYOUTS}, got {self.layout!r}")
+        if self.layout == "fence" and self.dimension != 2:
+            raise ValueError(f"layout: 'fence' needs dimension=2, got dimension={self.dimension}")
         s("speed_range", _pair("speed_range", self.speed_range, low=0.0))
         s("others_speed_range", _pair("others_speed_range", self.others_speed_range, low=0.0))
         try:
@@ -318,11 +329,19 @@ class TaskConfig:
         r_big = float(self.radius_of(extremes).max())
         if 2 * r_big >= min(b[2] - b[0], b[3] - b[1]):
             raise ValueError(f"radius: a ball of radius {r_big:.4g} m does not fit in bounds {b}")
+        if self.layout == "fence":
+            r_peg = float(self.radius_of(np.array(others)).max())
+            n_pegs = self.n_balls - len(ctrl)
+            if FENCE_SPACING * r_peg * (n_pegs + 1) > b[3] - b[1]:
+                raise ValueError(
+                    f"n_balls: a fence of {n_pegs} balls of radius {r_peg:.4g} m, {FENCE_SPACING} radii apart, "
+                    f"leaves no opening in bounds {b}"
+                )
         if self.dimension == 1:
             if 2 * r_big * self.n_balls > 0.8 * (b[2] - b[0]):
                 raise ValueError(f"n_balls: {self.n_balls} balls of radius up to {r_big:.4g} m do not fit on the line")
         else:
-            room = 0.3 * (b[2] - b[0]) * (b[3] - b[1]) * (0.5 if self.layout == "rack" else 1.0)
+            room = 0.3 * (b[2] - b[0]) * (b[3] - b[1]) * (1.0 if self.layout == "random" else 0.5)
             if self.n_balls * math.pi * r_big**2 > room:
                 raise ValueError(
                     f"n_balls: {self.n_balls} balls of radius up to {r_big:.4g} m are too many for bounds {b}"

@@ -21,7 +21,7 @@ from collision_env.engine.compiled import compile_for
 from collision_env.engine.keywords import close_matches
 from collision_env.engine.modes import MODES
 from collision_env.engine.scene import WALL_NAMES
-from collision_env.envs._config import TaskConfig
+from collision_env.envs._config import CONTROLS, TaskConfig
 from collision_env.envs.task.arrays import Engine, TaskParams, TaskState, pack
 from collision_env.envs.task.checks import check_cluster_mirror, checked_task_state
 from collision_env.envs.task.episodes import block_size, build_episodes
@@ -139,7 +139,8 @@ class EpisodeSampler:
             dimension=cfg.dimension,
             n_balls=n,
             n_targets=k,
-            rack=int(cfg.layout == "rack"),
+            rack=int(cfg.layout in ("rack", "fence")),
+            fence=int(cfg.layout == "fence"),
             tries=PLACEMENT_TRIES,
         )
         """The episode builder's integer parameters (columns named by ``EPISODE_INTS``)."""
@@ -271,7 +272,7 @@ class TaskCore:
             sticky=int(self.scene.sticky),
             observe_predicted=int(cfg.observe == "predicted"),
             aim_predicted=int(cfg.aim == "predicted" and cfg.shaping != 0.0),
-            velocity_control=int(cfg.control == "velocity"),
+            control=CONTROLS.index(cfg.control),
             predict_scoring=int(cfg.predicted_impact == "scoring"),
         )
         controlled = np.array(cfg.controlled, dtype=np.int64)

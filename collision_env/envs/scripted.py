@@ -5,6 +5,9 @@
   if not on a target, it searches directions the same way and steers towards one that is.
 * :class:`SteeringPolicy` (one controlled ball among balls it does not control: ``Crowd``, ``Pegs``):
   it steers at the target and coasts when a copy of the engine predicts a hit.
+* :class:`BankShotPolicy` (one shot, ``control="shot"``: ``Fence``): plane geometry, no engine;
+  it aims at the target directly or off the bottom or top wall, whichever straight path clears
+  every other ball.
 * :class:`ShootingPolicy` (any preset): candidate plans (action sequences) are run ahead on a
   planning copy of the env (``copy.deepcopy``, no renderer) from the env's current state
   (``get_state``/``set_state``); the first whose predicted rollout hits a target is executed.
@@ -174,6 +177,74 @@ class SteeringPolicy(AimingPolicy):
         return action
 
 
+def _clear(p: np.ndarray, q: np.ndarray, centres: np.ndarray, reach: np.ndarray) -> bool:
+    """Does the segment from ``p`` to ``q`` keep a distance of more than ``reach`` from every centre?"""
+    d = q - p
+    u = np.clip(((centres - p) @ d) / float(d @ d), 0.0, 1.0)
+    gaps = np.linalg.norm(p + u[:, None] * d - centres, axis=1)
+    return bool((gaps > reach).all())
+
+
+class BankShotPolicy(ScriptedPolicy):
+    """One shot (``control="shot"``), aimed by plane geometry alone (no engine): at points across
+    the current target (its centre, and out to ``spread`` of its half width), sent directly or off
+    the two walls along the target's wall (aimed at the point's mirror images in them, the path
+    unfolded, out to ``bounces`` periods of the mirroring), at ``max_speed``; the shortest unfolded
+    straight path that passes every other ball's mirror images with ``margin`` m to spare is taken,
+    else the direct shot at the centre. For one scoring ball among balls at rest (``Fence``): it
+    never plans a bounce off a ball (a ball in the way rules a path out).
+    """
+
+    def __init__(self, env: gym.Env, spread: float = 0.8, margin: float = 0.01, bounces: int = 4) -> None:
+        super().__init__(env)
+        self.spread = spread
+        self.margin = margin
+        self.bounces = bounces
+
+    def shot(self) -> np.ndarray:
+        """The shot's velocity (m/s) for the current state."""
+        core, cfg = self.env.core, self.env.config
+        assert cfg.bounds is not None  # (None only as an argument of TaskConfig)
+        xmin, ymin, xmax, ymax = cfg.bounds
+        i = cfg.controlled[0]
+        pos, r = core.pos[0], core.radii[0]
+        others = [j for j in range(cfg.n_balls) if j != i]
+        k = min(int(core.cur[0]), core.t_wall.shape[1] - 1)
+        wall = int(core.t_wall[0, k])
+        centre, half = core.target_geo[0, k, TARGET_GEOMETRY.centre], core.target_geo[0, k, TARGET_GEOMETRY.half_width]
+        # the ball's centre meets the target's wall r from it, and bounces off the other walls r from them
+        axis = 1 if wall in (WALL_LEFT, WALL_RIGHT) else 0  # the axis along the target's wall
+        lo, hi = (ymin, ymax) if axis else (xmin, xmax)
+        lo, hi = lo + r[i], hi - r[i]
+        period = 2.0 * (hi - lo)
+
+        def images(s: np.ndarray, n: int) -> list:  # s's unfolded images after n bounces
+            return [s + period * q for q in range(-n, n + 1)] + [2 * lo - s + period * q for q in range(-n, n + 1)]
+
+        goal = np.array(_target_point(cfg, wall, centre), float)
+        goal[1 - axis] += r[i] * (1.0 if goal[1 - axis] < pos[i, 1 - axis] else -1.0)
+        centres = pos[others]
+        mirrored = []
+        for image in images(centres[:, axis], self.bounces + 1):
+            c = centres.copy()
+            c[:, axis] = image
+            mirrored.append(c)
+        ghosts = np.concatenate(mirrored)
+        reach = np.tile(r[others] + r[i] + self.margin, len(mirrored))
+        offsets = [0.0] + [sign * f * half for f in np.linspace(0.2, self.spread, 3) for sign in (1.0, -1.0)]
+        along = [image for off in offsets for image in images(np.array(centre + off), self.bounces)]
+        for image in sorted(along, key=lambda a: abs(a - pos[i, axis])):  # the shortest paths first
+            aim = goal.copy()
+            aim[axis] = image
+            if _clear(pos[i], aim, ghosts, reach):
+                return cfg.max_speed * (aim - pos[i]) / np.linalg.norm(aim - pos[i])
+        return cfg.max_speed * (goal - pos[i]) / np.linalg.norm(goal - pos[i])
+
+    def __call__(self, obs: np.ndarray | None = None) -> np.ndarray:
+        cfg = self.env.config
+        return (self.shot() / cfg.max_speed).astype(np.float32)
+
+
 # --------------------------------------------------------------------------------------------- #
 
 
@@ -193,7 +264,8 @@ def as_env_action(env: gym.Env, nudge: ArrayLike) -> np.ndarray:
     """A nudge action (velocity changes over ``max_dv``, as every policy here plans them) in the
     form ``env``'s ``control`` reads, as a new float32 array: the nudge itself for "nudge"; for
     "velocity", per controlled ball the velocity the nudge leads to (over ``max_speed``, after the
-    env's speed cap) and the engage flag, set when the nudge is not zero. A plan and the episode
+    env's speed cap) and the engage flag, set when the nudge is not zero; for "shot", that velocity
+    alone (the shot a nudge in the episode's first step amounts to). A plan and the episode
     that follows it convert alike, so they stay identical.
 
     The converted action moves the ball as the nudge does (to float32 rounding) except at the speed
@@ -217,7 +289,7 @@ def as_env_action(env: gym.Env, nudge: ArrayLike) -> np.ndarray:
         named /= max(1.0, float(np.linalg.norm(named)))  # no longer than max_speed, in the nudge's direction
         out[j, :dim] = np.clip(named, -1.0, 1.0)  # (float rounding)
         out[j, dim] = 1.0 if (a[j] != 0.0).any() else -1.0
-    return out.ravel()
+    return (out[:, :dim] if cfg.control == "shot" else out).ravel()
 
 
 def push(direction: ArrayLike, steps: int, delay: int = 0) -> Plan:
@@ -362,6 +434,8 @@ def scripted_policy(env: gym.Env) -> ScriptedPolicy | None:
     """
     env = _bare(env)
     cfg = env.config
+    if cfg.control == "shot" and cfg.dimension == 2 and len(cfg.controlled) == 1:
+        return BankShotPolicy(env)
     if (
         cfg.dimension == 2
         and cfg.scorers in ("any", "controlled")

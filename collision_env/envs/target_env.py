@@ -54,6 +54,12 @@ class CollisionTargetEnv(gym.Env):
     for the change it asks for, even where the cap shortens it). A ball faster than `max_speed` (after
     a collision) can only be steered towards a slower velocity.
 
+    With `control="shot"` the agent has one shot per episode: `Box(-1, 1, (len(controlled) *
+    dimension,), float32)`, per ball the velocity `u * max_speed` (scaled back to `max_speed` if
+    longer) it is given at once in the episode's first step (charged as a nudge of that change);
+    the actions of later steps are ignored. The outcome is committed before any impact is seen,
+    as a shot at a target is.
+
     ## Observation Space
 
     `Box(-1, 1, (D,), float32)` with a fixed layout, `D = 6 N + 10 S + 2` (N observed balls: every
@@ -109,8 +115,9 @@ class CollisionTargetEnv(gym.Env):
 
     ## Episode End
 
-    - Termination: every target hit (`info["is_success"] = True`), or a target's time window
-      closed before it was hit (`is_success = False`).
+    - Termination: every target hit (`info["is_success"] = True`), or a target failed
+      (`is_success = False`): its time window closed before it was hit, or, with `control="shot"`,
+      a scoring ball struck its wall off it.
     - Truncation: after `round(time_limit / dt)` control steps (also the registered
       `max_episode_steps`; if you change `dt`, pass `max_episode_steps` to `gym.make` to match).
 

@@ -159,7 +159,7 @@ def test_checkers_and_vector_equality_with_velocity_control(env_id):
 def test_a_converted_nudge_changes_the_velocity_as_the_nudge_does(env_id):
     # as_env_action names the velocity a nudge leads to: the two controls then agree to the float32
     # rounding of that velocity
-    nudge = gym.make(env_id).unwrapped
+    nudge = gym.make(env_id, control="nudge").unwrapped
     velocity = gym.make(env_id, control="velocity").unwrapped
     rng = np.random.default_rng(1)
     velocity.reset(seed=5)

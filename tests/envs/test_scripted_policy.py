@@ -37,10 +37,11 @@ def _play(env, seed):
     return hit_steps, steps
 
 
-@pytest.mark.parametrize("env_id", [e for e in collision_env.ENV_IDS if "Crowd" not in e])
+@pytest.mark.parametrize("env_id", [e for e in collision_env.ENV_IDS if "Crowd" not in e and "Fence" not in e])
 def test_the_scripted_policy_plays_alike_under_either_control(env_id):
     # the same planned nudges, converted: the same targets hit at the same steps (not in Crowd's
-    # gas of 200 balls, where the float32 rounding of a named velocity grows into another episode)
+    # gas of 200 balls, where the float32 rounding of a named velocity grows into another episode,
+    # nor in Fence, whose one shot is no nudge: tests/envs/test_fence.py)
     for seed in (2, 3):
         nudge = _play(gym.make(env_id), seed)
         assert nudge[0]  # some target hit

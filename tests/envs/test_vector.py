@@ -37,11 +37,12 @@ def assert_infos_equal(native: dict, sync: dict, n: int):
             assert data_equivalence(native[key], value, exact=True), (key, native[key], value)
 
 
-def run_pair(env_id, mode, steps, seed, **kwargs):
-    native = gym.make_vec(env_id, N_ENVS, vectorization_mode="vector_entry_point", autoreset_mode=mode, **kwargs)
-    sync = gym.make_vec(env_id, N_ENVS, vectorization_mode="sync", vector_kwargs={"autoreset_mode": mode}, **kwargs)
+def run_pair(env_id, autoreset, steps, seed, **kwargs):
+    native = gym.make_vec(env_id, N_ENVS, vectorization_mode="vector_entry_point", autoreset_mode=autoreset, **kwargs)
+    vector_kwargs = {"autoreset_mode": autoreset}
+    sync = gym.make_vec(env_id, N_ENVS, vectorization_mode="sync", vector_kwargs=vector_kwargs, **kwargs)
     assert isinstance(native.unwrapped, CollisionTargetVectorEnv)
-    assert native.metadata["autoreset_mode"] == mode
+    assert native.metadata["autoreset_mode"] == autoreset
     o1, i1 = native.reset(seed=seed)
     o2, i2 = sync.reset(seed=seed)
     assert np.array_equal(o1, o2)

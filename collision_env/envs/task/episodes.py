@@ -17,6 +17,9 @@ from .scoring import on_side_wall
 
 _GAP = 1e-3
 _NO_WINDOW = 1e300  # a target without a time window is open from -_NO_WINDOW to _NO_WINDOW
+#: The ``"fence"`` layout's centre-to-centre spacing of neighbouring balls of its column, in radii of
+#: the largest of them: a gap of 1.2 radii, which a ball as large does not pass through.
+FENCE_SPACING = 3.2
 
 
 def block_size(n_balls: int, n_targets: int, tries: int) -> int:
@@ -83,17 +86,44 @@ def _place_on_line(uniforms, off, radii, episode_f, pos, ok):  # pragma: no cove
 
 
 @njit(inline="always")
-def _place_in_box(uniforms, off, tries, ctrl_mask, rack, radii, episode_f, pos, ok):  # pragma: no cover - numba
+def _place_fence(ctrl_mask, radii, episode_f, pos):  # pragma: no cover - numba
+    """The balls not controlled, fixed in a column across the vertical centre line (``TaskConfig.layout``
+    ``"fence"``), downward from the top wall, ``FENCE_SPACING`` radii of the largest of them apart,
+    the first half a spacing from the wall; the opening is left between the last and the bottom wall."""
+    xc = 0.5 * (episode_f[EPISODE_FLOATS.xmin] + episode_f[EPISODE_FLOATS.xmax])
+    ymax = episode_f[EPISODE_FLOATS.ymax]
+    for r in range(pos.shape[0]):
+        r_peg = 0.0
+        for i in range(pos.shape[1]):
+            if not ctrl_mask[i]:
+                r_peg = max(r_peg, radii[r, i])
+        spacing = FENCE_SPACING * r_peg
+        k = 0
+        for i in range(pos.shape[1]):
+            if ctrl_mask[i]:
+                continue
+            pos[r, i, 0] = xc
+            pos[r, i, 1] = ymax - (k + 0.5) * spacing
+            k += 1
+
+
+@njit(inline="always")
+def _place_in_box(uniforms, off, tries, ctrl_mask, rack, fence, radii, episode_f, pos, ok):  # pragma: no cover
     """Each ball at the first of its tries that overlaps no ball placed before it, each at least
     ``_GAP`` from the others and the walls; ``ok[r]`` False when some ball of row r found no such
-    place (or its range of places is empty)."""
+    place (or its range of places is empty). With ``fence`` the balls not controlled are the
+    fence's (:func:`_place_fence`), the controlled ones placed as with ``rack``."""
     xmin = episode_f[EPISODE_FLOATS.xmin]
     ymin = episode_f[EPISODE_FLOATS.ymin]
     xmax = episode_f[EPISODE_FLOATS.xmax]
     ymax = episode_f[EPISODE_FLOATS.ymax]
+    if fence:
+        _place_fence(ctrl_mask, radii, episode_f, pos)
     for r in range(uniforms.shape[0]):
         ok[r] = True
         for i in range(pos.shape[1]):
+            if fence and not ctrl_mask[i]:
+                continue  # (placed; the controlled balls' region lies left of the fence)
             rad = radii[r, i]
             lo_x = xmin + rad + _GAP
             hi_x = xmax - rad - _GAP
@@ -201,6 +231,7 @@ def build_episodes(
             episode_i[EPISODE_INTS.tries],
             ctrl_mask,
             episode_i[EPISODE_INTS.rack] != 0,
+            episode_i[EPISODE_INTS.fence] != 0,
             radii,
             episode_f,
             pos,

@@ -67,7 +67,7 @@ SWITCHES = layout(
         ("sticky", "1: the engine merges colliding balls (the nudge moves whole clusters)"),
         ("observe_predicted", "1: the observation ends with the engine's predicted impacts"),
         ("aim_predicted", "1: the aiming potential phi uses the engine's predicted impacts"),
-        ("velocity_control", "1: each controlled ball's action is a velocity to steer to and an engage flag"),
+        ("control", "what an action means: the index of TaskConfig.control in CONTROLS (0 nudge, 1 velocity, 2 shot)"),
         ("predict_scoring", "1: the prediction looks past a scoring ball's next wall impact for one on a target"),
     ),
 )
@@ -132,10 +132,14 @@ EPISODE_INTS = layout(
     "EpisodeInts",
     (
         ("dimension n_balls n_targets", "the task's sizes"),
-        ("rack", "1: controlled balls in the left 40 %, the others in the right half"),
+        ("rack", "1: controlled balls in the left 40 % (the others in the right half, unless fence)"),
+        ("fence", "1: the balls not controlled in a column with an opening (TaskConfig.layout)"),
         ("tries", "placement tries per ball in one block of random numbers"),
     ),
 )
+
+#: ``SWITCHES.control`` codes: the index of ``TaskConfig.control`` in ``CONTROLS``.
+CONTROL_NUDGE, CONTROL_VELOCITY, CONTROL_SHOT = 0, 1, 2
 
 #: Target status codes (``TARGET_INTS.status``).
 TARGET_PENDING, TARGET_HIT, TARGET_FAILED = 0, 1, 2

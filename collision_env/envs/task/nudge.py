@@ -1,9 +1,10 @@
 """Phase 1 of a control step: the actions become velocity changes of the controlled balls.
 
 Each action component is clipped to [-1, 1] (:func:`requested_change` reads a ball's components as
-``TaskConfig.control`` says). The nudge never raises a ball's speed above max(max_speed, current
-speed) (:func:`capped_change`). The changes are applied with the engine's own impulse kernel, which
-moves stuck clusters as rigid bodies.
+``TaskConfig.control`` says; a shot is taken in the episode's first step, whose step count is 0).
+The nudge never raises a ball's speed above max(max_speed, current speed) (:func:`capped_change`).
+The changes are applied with the engine's own impulse kernel, which moves stuck clusters as rigid
+bodies.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ import math
 from collision_env.engine.compiled import apply_impulses, ball_views, njit
 
 from .arrays import unpack
-from .layout import PARAMS, SCENE_FLOATS, SWITCHES
+from .layout import CONTROL_NUDGE, CONTROL_SHOT, CONTROL_VELOCITY, PARAMS, SCENE_FLOATS, SCENE_INTS, SWITCHES
 
 
 @njit(refcount=False, forceinline=True)
@@ -48,21 +49,25 @@ def capped_change(vx, vy, dx, dy, max_speed):  # pragma: no cover - numba
 
 
 @njit(refcount=False, forceinline=True)
-def requested_change(a, o, dim, velocity_control, vx, vy, max_dv, max_speed):  # pragma: no cover - numba
-    """The velocity change one controlled ball's action components ``a[o:]`` ask for, each axis
-    within ``max_dv``: with nudge control the components times ``max_dv``; with velocity control the
-    step along the straight line from (vx, vy) to the named velocity (components times
-    ``max_speed``, scaled back to ``max_speed`` if longer), shortened until no axis exceeds
-    ``max_dv``, or none when the engage flag is <= 0.
+def requested_change(a, o, dim, control, first, vx, vy, max_dv, max_speed):  # pragma: no cover - numba
+    """The velocity change one controlled ball's action components ``a[o:]`` ask for: with nudge
+    control the components times ``max_dv``; with velocity control the step along the straight
+    line from (vx, vy) to the named velocity (components times ``max_speed``, scaled back to
+    ``max_speed`` if longer), shortened until no axis exceeds ``max_dv``, or none when the engage
+    flag is <= 0; with shot control the whole change to the named velocity in the episode's
+    ``first`` step, and none after it.
 
     A named velocity no longer than ``max_speed`` keeps the whole line within the speed cap of
     :func:`capped_change` (a disc holds the segment between two of its points), so under velocity
-    control the change charged is the change made."""
+    and shot control the change charged is the change made."""
     ax = clip1(a[o])
     ay = clip1(a[o + 1]) if dim == 2 else 0.0
-    if not velocity_control:
+    if control == CONTROL_NUDGE:
         return ax * max_dv, ay * max_dv
-    if not a[o + dim] > 0.0:
+    if control == CONTROL_SHOT:
+        if not first:
+            return 0.0, 0.0
+    elif not a[o + dim] > 0.0:
         return 0.0, 0.0
     length = math.sqrt(ax * ax + ay * ay)
     if length > 1.0:
@@ -71,7 +76,7 @@ def requested_change(a, o, dim, velocity_control, vx, vy, max_dv, max_speed):  #
     dx = ax * max_speed - vx
     dy = ay * max_speed - vy if dim == 2 else 0.0
     longest = max(abs(dx), abs(dy))
-    if longest > max_dv:
+    if control == CONTROL_VELOCITY and longest > max_dv:
         f = max_dv / longest
         dx *= f
         dy *= f
@@ -94,13 +99,14 @@ def nudge_kernel(h, actions, active):  # pragma: no cover - numba
     engine, state, params = unpack(h)
     balls, dv = engine.balls, state.nudge
     dim = params.switches[SWITCHES.dimension]
-    velocity_control = params.switches[SWITCHES.velocity_control] != 0
-    per_ball = dim + 1 if velocity_control else dim
+    control = params.switches[SWITCHES.control]
+    per_ball = dim + 1 if control == CONTROL_VELOCITY else dim
     max_dv = params.params[PARAMS.max_dv]
     max_speed = params.params[PARAMS.max_speed]
     _, vel, _, _, _, _ = ball_views(balls)
     for b in range(actions.shape[0]):
         requested = 0.0
+        first = state.scene_i[b, SCENE_INTS.steps] == 0
         for c in range(params.controlled.shape[0]):
             i = params.controlled[c]
             if not active[b]:
@@ -108,7 +114,7 @@ def nudge_kernel(h, actions, active):  # pragma: no cover - numba
                 dv[b, i, 1] = 0.0
                 continue
             dx, dy = requested_change(
-                actions[b], c * per_ball, dim, velocity_control, vel[b, i, 0], vel[b, i, 1], max_dv, max_speed
+                actions[b], c * per_ball, dim, control, first, vel[b, i, 0], vel[b, i, 1], max_dv, max_speed
             )
             requested += math.sqrt(dx * dx + dy * dy)
             cdx, cdy = capped_change(vel[b, i, 0], vel[b, i, 1], dx, dy, max_speed)

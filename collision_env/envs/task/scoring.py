@@ -16,11 +16,13 @@ from collision_env.engine.compiled import njit
 from collision_env.engine.scene import WALL_BOTTOM, WALL_LEFT, WALL_RIGHT
 
 from .layout import (
+    CONTROL_SHOT,
     PARAMS,
     ROW_SKIP,
     ROW_STEPPED,
     SCENE_INTS,
     SWITCHES,
+    TARGET_FAILED,
     TARGET_GEOMETRY,
     TARGET_HIT,
     TARGET_INTS,
@@ -167,11 +169,25 @@ def aim_squared(cx, cy, b, state, seq, params):  # pragma: no cover - numba
 
 
 @njit(refcount=False, forceinline=True)
+def _fail_on_wall(j, imp, state, seq):  # pragma: no cover - numba
+    """Shot control: wall impact ``j`` missed every target, so the visible pending targets on its
+    wall fail (the shot that was to hit them has struck their wall elsewhere)."""
+    b = imp[j]["scene"]
+    targets = state.targets
+    k0, k1 = visible_targets(state.scene_i[b, SCENE_INTS.current], targets.shape[1], seq)
+    for k in range(k0, k1):
+        if targets[b, k, TARGET_INTS.status] == TARGET_PENDING and targets[b, k, TARGET_INTS.wall] == imp[j]["wall"]:
+            targets[b, k, TARGET_INTS.status] = TARGET_FAILED
+
+
+@njit(refcount=False, forceinline=True)
 def score_impacts(flags, imp, state, params):  # pragma: no cover - numba
     """Count each stepped scene's target hits and off-target wall impacts of scoring balls
     (``scene_i[:, hits]`` and ``misses``), marking the targets hit (and, with sequential targets,
-    moving on to the next)."""
+    moving on to the next); with shot control an off-target impact fails the visible pending
+    targets on its wall (:func:`_fail_on_wall`)."""
     seq = params.switches[SWITCHES.sequential] != 0
+    shot = params.switches[SWITCHES.control] == CONTROL_SHOT
     cluster = params.switches[SWITCHES.cluster] != 0
     scene_i = state.scene_i
     for b in range(flags.shape[0]):
@@ -189,4 +205,6 @@ def score_impacts(flags, imp, state, params):  # pragma: no cover - numba
                 scene_i[b, SCENE_INTS.hits] += 1
             else:
                 scene_i[b, SCENE_INTS.misses] += 1
+                if shot:
+                    _fail_on_wall(j, imp, state, seq)
         j, scores = next_wall_impact(j + 1, imp, flags, True, state.body, params.scoring, cluster)
