@@ -102,7 +102,7 @@ class FenceEnv(CollisionTargetEnv):
             time_limit=1.5,
             observed_balls="controlled",
         ),
-        bench_scene="11 balls, 10 at rest (fence)",
+        bench_scene="10 balls, 9 at rest (fence)",
     )
 
 

@@ -67,6 +67,19 @@ def test_a_fence_needs_2d_and_room_for_its_opening():
     assert make_config("fence", n_balls=12).n_balls == 12
 
 
+def test_the_shooting_ball_starts_clear_of_a_fence_that_reaches_into_its_region():
+    """Balls of radius 0.12 m in a 1 m box: the fence's pegs reach 0.12 m to either side of the centre
+    line, into the left 40 % where the controlled ball starts; every start keeps it clear of them
+    (it was checked against the balls of lower index only, none of them pegs)."""
+    config = dict(bounds=(-0.5, -0.5, 0.5, 0.5), radius=0.12, n_balls=2, layout="fence", n_targets=1)
+    envs = gym.make_vec("CollisionEnv/Target-v0", num_envs=64, vectorization_mode="vector_entry_point", **config)
+    for seed in range(5):
+        envs.reset(seed=seed)
+        pos = envs.unwrapped.core.pos
+        assert (np.hypot(*(pos[:, 0] - pos[:, 1]).T) >= 0.24 + 1e-3 - 1e-12).all()
+    envs.close()
+
+
 def test_the_first_action_sets_the_velocity_and_later_ones_are_ignored():
     env = placed(gym.make(ID, action_cost=0.1).unwrapped, ball=(-1.2, 0.0))
     _, reward, _, _, info = env.step(np.array([0.6, -0.8], np.float32))

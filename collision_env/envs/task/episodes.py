@@ -112,7 +112,8 @@ def _place_in_box(uniforms, off, tries, ctrl_mask, rack, fence, radii, episode_f
     """Each ball at the first of its tries that overlaps no ball placed before it, each at least
     ``_GAP`` from the others and the walls; ``ok[r]`` False when some ball of row r found no such
     place (or its range of places is empty). With ``fence`` the balls not controlled are the
-    fence's (:func:`_place_fence`), the controlled ones placed as with ``rack``."""
+    fence's, placed first where :func:`_place_fence` says (its own spacing, not ``_GAP``), and the
+    controlled ones as with ``rack``, clear of the fence too."""
     xmin = episode_f[EPISODE_FLOATS.xmin]
     ymin = episode_f[EPISODE_FLOATS.ymin]
     xmax = episode_f[EPISODE_FLOATS.xmax]
@@ -142,7 +143,9 @@ def _place_in_box(uniforms, off, tries, ctrl_mask, rack, fence, radii, episode_f
                 px = lo_x + (hi_x - lo_x) * uniforms[r, off + 2 * (i * tries + t)]
                 py = lo_y + (hi_y - lo_y) * uniforms[r, off + 2 * (i * tries + t) + 1]
                 free_spot = True
-                for j in range(i):
+                for j in range(pos.shape[1]):
+                    if not (j < i or (fence and not ctrl_mask[j] and j != i)):
+                        continue  # (balls placed before it: those of lower index, and a fence's)
                     dx = pos[r, j, 0] - px
                     dy = pos[r, j, 1] - py
                     if math.sqrt(dx * dx + dy * dy) <= radii[r, j] + rad + _GAP:
