@@ -434,12 +434,22 @@ class BatchSimulator:
         nothing changes. ``check=False`` skips validation, for callers that pass an int64 array of
         scene indices, float64 arrays of the right shapes (masses and radii included) and a float
         time, holding balls they built valid themselves, where the checks would cost more than the
-        reset (the envs' episodes, which their builder places apart from each other and the walls).
+        reset (the envs' episodes, which their builder places apart from each other and the walls);
+        only the shapes are checked then (a ``ValueError``, nothing changed).
         """
         s = self._stepper
         if not check:
-            pos, vel, m, r = (np.asarray(a) for a in (positions, velocities, masses, radii))
-            s.put(np.asarray(index), pos, vel, m, r, time=real_number(time, "time"))
+            idx = np.asarray(index)
+            pos, vel, m, r = (np.asarray(a, dtype=np.float64) for a in (positions, velocities, masses, radii))
+            # (the shapes still, before anything is written: a refused call changes nothing)
+            k = (len(idx), s.n)
+            if idx.ndim != 1 or pos.shape != (*k, 2) or vel.shape != (*k, 2) or m.shape != k or r.shape != k:
+                raise ValueError(
+                    f"set_scenes: with check=False, index (K,) and positions, velocities (K, {s.n}, 2), "
+                    f"masses and radii (K, {s.n}) float64 arrays are expected, got index {idx.shape}, "
+                    f"positions {pos.shape}, velocities {vel.shape}, masses {m.shape}, radii {r.shape}"
+                )
+            s.put(idx, pos, vel, m, r, time=real_number(time, "time"))
             return
         idx = self._scene_index(index)
         time = real_number(time, "time")

@@ -140,6 +140,29 @@ def test_batch_errors_name_the_scene():
         np.testing.assert_array_equal(value, before[key])
 
 
+@pytest.mark.parametrize("masses", [None, np.ones((1, 3)), np.ones(2)])
+def test_unchecked_set_scenes_still_refuses_wrong_shapes_before_writing(masses):
+    """``set_scenes(check=False)`` skips the value checks only: arrays of the wrong shape (masses
+    left out, as a checked call allows) are refused before any scene changes."""
+    batch = BatchSimulator(Scene(), np.array([[[-1.0, 0.0], [1.0, 0.0]]] * 3), np.zeros((3, 2, 2)), np.ones(2))
+    before = batch.get_state()
+    with pytest.raises(ValueError, match=r"set_scenes: with check=False, .* masses \("):
+        batch.set_scenes(
+            np.array([1]), [[[-1.5, 0.0], [1.0, 0.0]]], np.zeros((1, 2, 2)), masses, np.full((1, 2), 0.1), check=False
+        )
+    for key, value in batch.get_state().items():
+        np.testing.assert_array_equal(value, before[key])
+    batch.set_scenes(
+        np.array([1]),
+        [[[-1.5, 0.0], [1.0, 0.0]]],
+        np.zeros((1, 2, 2)),
+        np.ones((1, 2)),
+        np.full((1, 2), 0.1),
+        check=False,
+    )
+    assert batch.positions[1, 0, 0] == -1.5
+
+
 @pytest.mark.parametrize("index", [[3], [-4], [0.5], [True], [[True, False, True]], "a", None, np.zeros((1, 1), int)])
 def test_set_scenes_names_a_bad_index(index):
     batch = BatchSimulator(Scene(), np.array([[[-1.0, 0.0], [1.0, 0.0]]] * 3), np.zeros((3, 2, 2)), np.ones(2))
