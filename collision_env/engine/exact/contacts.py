@@ -586,10 +586,14 @@ def _row_gap(k, u, axis, order, vel, wk):
 @njit(python=False)
 def _settle_row(size, n_contacts, u_min, b, wk):
     """The limit of a row's cascade in one pass, if the group is a row (else False, nothing changed):
-    with ``z_k = v_k - k u`` along the row (``u = u_min``), the contacts ask for ``z`` non-decreasing,
-    a wall at the low end for ``z >= u`` and one at the high end for ``z <= -L u`` (``L`` balls), so
-    the limit is the mass-weighted isotonic regression of ``z`` (pool adjacent violators) clipped to
-    those bounds. Where they cross (walls at both ends) the contacts come to rest instead (``u = 0``)."""
+    with ``z_k = v_k - U_k`` along the row, ``U_k`` the separation speeds its contacts before place
+    ``k`` ask for along the axis (``k u`` with ``u = u_min`` for contacts right along it; a tilted
+    contact's, :func:`_row_gap`, allows for the balls' velocities across the row, which the limit
+    keeps), the contacts ask for ``z`` non-decreasing, a wall at the low end for ``z >= u`` and one
+    at the high end for ``z <= -u - U_{L-1}`` (``L`` balls), so the limit is the mass-weighted
+    isotonic regression of ``z`` (pool adjacent violators) clipped to those bounds. With walls at
+    both ends the contacts come to rest instead (``u = 0``), and where tilted contacts leave no room
+    between the two walls' bounds the row is left to the general limit (False)."""
     axis = _row_axis(size, n_contacts, wk)
     if axis < 0:
         return False
@@ -634,6 +638,8 @@ def _settle_row(size, n_contacts, u_min, b, wk):
         if k + 1 < length:
             tilted += _row_gap(k, u, axis, order, vel, wk)
     hi -= tilted  # (the high wall bounds the last place, whose offset has the whole row's gaps)
+    if hi < lo:  # (walls at both ends that tilted contacts moving apart across the row cannot both keep)
+        return False
     tilted = 0.0
     for blk in range(blocks):
         z = min(max(total[blk] / weight[blk], lo), hi)
