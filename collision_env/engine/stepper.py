@@ -496,9 +496,9 @@ class Stepper:
         one per call (a call stops the scenes that find the impact buffer full, which the next
         call resumes). ``first_done``: the step's first call was made already."""
         chunks = []
-        kernel, n_imp = self._call, self._n_imp
+        n_imp = self._n_imp
         if not first_done:
-            kernel(self._pack, dt_abs, START_STEP)
+            self._call(self._pack, dt_abs, START_STEP)
         while True:  # each call resets n_imp[0] and fills the impact buffer from row 0
             rows = n_imp[0]
             if rows:
@@ -511,7 +511,7 @@ class Stepper:
             if not rows:  # not even one sub-step's worst case fits: a bigger buffer
                 self._alloc_work(2 * len(self._imp))
                 n_imp = self._n_imp
-            kernel(self._pack, dt_abs, RESUME)
+            self._call(self._pack, dt_abs, RESUME)  # (direct from the second call on: see _first_call)
 
     def _first_call(self, pack: np.ndarray | tuple, dt: float, start: int) -> int:
         """The kernel's first call in this process, through numba's dispatcher (which compiles it,

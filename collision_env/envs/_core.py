@@ -413,7 +413,9 @@ class TaskCore:
         """Nudge (actions (B, A) float64, C-contiguous; inactive rows get none) and step the engine by dt.
 
         Returns the engine's impact records (read-only); the nudge's size per scene is in
-        ``scene_f`` (``nudge``, m/s). An action with NaN raises ValueError and changes nothing.
+        ``scene_f`` (``nudge``, m/s). An action with NaN raises ValueError and changes nothing. The
+        arrays' kinds are not checked (the compiled kernel is called directly, see :meth:`_bind`):
+        the envs' ``step`` checks and converts what a user hands over.
         """
         bad = self._nudge(self._pack, actions, active)
         if bad >= 0:
@@ -428,6 +430,11 @@ class TaskCore:
 
         ``flags``: one ``task.layout.ROW_*`` code per scene. Reward, energy, targets hit and the end
         flags are then in ``scene_f`` and ``scene_i`` (see :meth:`outputs`).
+
+        Like :meth:`advance`, it calls its compiled kernel directly, without checking the arrays it
+        is handed: ``(B,)`` int8 flags, the engine's impact records and ``(B, obs_dim)`` float32
+        observations, C-contiguous, as the envs build them (see :meth:`_bind`); the envs' own
+        ``step`` and ``reset`` are the checked way in.
         """
         self._task(self._pack, flags, imp, obs)
         if self.ahead is not None:

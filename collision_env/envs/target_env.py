@@ -303,7 +303,9 @@ class CollisionTargetEnv(gym.Env):
 
     @property
     def core(self) -> TaskCore:
-        """The batched task core (a batch of one): engine in ``core.batch``, task arrays alongside."""
+        """The batched task core (a batch of one): engine in ``core.batch``, task arrays alongside. Its
+        kernel calls (``advance``, ``finish``) take the env's own buffers unchecked: drive the env
+        through ``step`` and ``reset``."""
         return self._core
 
     @property

@@ -346,5 +346,7 @@ class CollisionTargetVectorEnv(VectorEnv):
 
     @property
     def core(self) -> TaskCore:
-        """The batched task core: the engine in ``core.batch``, the task arrays alongside."""
+        """The batched task core: the engine in ``core.batch``, the task arrays alongside. Its kernel
+        calls (``advance``, ``finish``) take the env's own buffers unchecked: drive the env through
+        ``step`` and ``reset``."""
         return self._core
