@@ -240,7 +240,9 @@ def render(rows: dict) -> str:
     lines.append("")
     lines.append(
         f"Targets: a row step within {ROW_MS:g} ms; a pile step within {PILE_MS:g} ms and {PILE_MB:g} MB; "
-        "every step reaching its end."
+        "every step reaching its end. The square piles are frictionless columns, an unstable equilibrium "
+        "that round-off tips over within ten frames or so: they collapse into heaps, whose landings reach "
+        "the event cap (see this module's docstring)."
     )
     return "\n".join(lines)
 
