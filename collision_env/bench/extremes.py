@@ -1042,8 +1042,10 @@ def _no_collision(sim, count, impacts):
     return None if packing.reduced_pressure == 1.0 else f"Z = {packing.reduced_pressure} without a collision"
 
 
-def _clumped_rdf(sim, count, impacts):
-    """g(r) of 2,600 points, 600 in one 0.5 m patch, within 50 MB (it took 1.8 GB on d8ab1a0)."""
+def clumped_rdf_peak_bytes() -> int:
+    """Peak memory (bytes, tracemalloc) of ``radial_distribution`` over 2,600 points, 600 of them in
+    one 0.5 m patch of a 100 m box (it took 1.8 GB on d8ab1a0: cells x the fullest cell's count^2).
+    The extremes cell below and ``tests/observables/test_structure.py`` both measure it."""
     import tracemalloc
 
     from collision_env.observables import radial_distribution
@@ -1054,9 +1056,14 @@ def _clumped_rdf(sim, count, impacts):
     tracemalloc.start()
     try:
         radial_distribution(p, (0.0, 0.0, 100.0, 100.0), 2.0, bins=40)
-        peak = tracemalloc.get_traced_memory()[1]
+        return tracemalloc.get_traced_memory()[1]
     finally:
         tracemalloc.stop()
+
+
+def _clumped_rdf(sim, count, impacts):
+    """g(r) of a clump within 50 MB (:func:`clumped_rdf_peak_bytes`)."""
+    peak = clumped_rdf_peak_bytes()
     return None if peak < 50e6 else f"peak memory {peak / 1e6:.0f} MB"
 
 

@@ -2,7 +2,6 @@
 in a clump, the MSD of frames unwrapped by their image counts."""
 
 import math
-import tracemalloc
 from types import SimpleNamespace
 
 import numpy as np
@@ -10,6 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from collision_env.bench.extremes import clumped_rdf_peak_bytes
 from collision_env.engine import Scene, Simulator
 from collision_env.observables import mean_squared_displacement, radial_distribution, unwrapped_positions
 
@@ -64,15 +64,7 @@ def test_g_of_r_in_pieces_is_g_of_r_whole(monkeypatch):
 
 def test_g_of_r_of_points_in_a_clump_needs_memory_of_order_n():
     # (on d8ab1a0 2,600 points, 600 in one patch, took 1.8 GB: cells x the fullest cell's count^2)
-    rng = np.random.default_rng(0)
-    p = rng.uniform(0.0, 100.0, size=(2600, 2))
-    p[:600] = rng.uniform(50.0, 50.5, size=(600, 2))
-    tracemalloc.start()
-    try:
-        radial_distribution(p, (0.0, 0.0, 100.0, 100.0), 2.0, bins=40)
-        peak = tracemalloc.get_traced_memory()[1]
-    finally:
-        tracemalloc.stop()
+    peak = clumped_rdf_peak_bytes()
     assert peak < 50e6  # (about 180,000 pairs in the clump's cell: a few MB)
 
 
