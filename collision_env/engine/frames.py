@@ -61,17 +61,20 @@ def record_frame(f, balls, time, images, times, positions, velocities, frame_ima
 
 
 @njit(refcount=False, python=False)
-def _take_frame(f, rows, state, out):
-    """After frame ``f``'s step, which returned ``rows``: record the frame and its impacts (True),
-    or note where the run stops (False): a step the caller must complete (``rows < 0``), or
-    impacts that do not fit ``out``."""
+def _take_frame(f, base, end, state, out):
+    """After frame ``f``'s step, which recorded its impacts from row ``base`` of the kernel's
+    buffer and returned ``end``: record the frame and its impacts, then rewind the buffer's cursor
+    to ``base`` (True), or note where the run stops (False): a step the caller must complete
+    (``end < 0``), or impacts that do not fit ``out``."""
     request = out.request
     n_out = request[FRAME_ROWS]
-    if rows < 0 or n_out + rows > out.out.shape[0]:
+    rows = end - base
+    if end < 0 or n_out + rows > out.out.shape[0]:
         request[FRAME_STOPPED_AT] = f
-        request[FRAME_STEPPED] = rows >= 0
+        request[FRAME_STEPPED] = end >= 0
         return False
-    copy_impacts(state.imp, out.out[n_out : n_out + rows], 1.0)
+    copy_impacts(state.imp[base:end], out.out[n_out : n_out + rows], 1.0)
+    state.n_imp[0] = base
     request[FRAME_ROWS] = n_out + rows
     record_frame(f, state.balls, state.time, state.images, out.times, out.positions, out.velocities, out.images)
     return True
@@ -80,10 +83,11 @@ def _take_frame(f, rows, state, out):
 def frames_kernel(step: Any, label: str, frames_slot: int) -> Any:
     """A mode's stepping kernel, ``kernel(h, dt, start)``, from its step (an inlined function of
     the same arguments, see :mod:`~collision_env.engine.state` for ``start``): one step, whose
-    return value it returns, or with ``start = RUN_FRAMES`` forward steps of ``dt`` for the frames
-    requested in the ``state.FramesOut`` at ``frames_slot`` of the pack (``layout.FRAME_FIELDS``:
-    from ``first`` up to ``last``; its ``stopped_at`` and ``stepped`` say where the run stopped,
-    ``stopped_at = last`` when every frame was recorded). ``label``: what the compile notice calls it."""
+    return value (the impact buffer's cursor after it, or -1) it returns, or with ``start =
+    RUN_FRAMES`` forward steps of ``dt`` for the frames requested in the ``state.FramesOut`` at
+    ``frames_slot`` of the pack (``layout.FRAME_FIELDS``: from ``first`` up to ``last``; its
+    ``stopped_at`` and ``stepped`` say where the run stopped, ``stopped_at = last`` when every frame
+    was recorded). ``label``: what the compile notice calls it."""
 
     @njit(refcount=False, label=label)
     def kernel(h, dt, start):
@@ -93,13 +97,14 @@ def frames_kernel(step: Any, label: str, frames_slot: int) -> Any:
             request = unpack_frames(h, frames_slot).request
             first, last = request[FRAME_FIRST], request[FRAME_LAST]
         state = unpack_state(h)
+        base = state.n_imp[0]  # (each frame's impacts are copied out, and their rows used again)
         go = START_STEP if frames else start  # (the caller may have changed the balls since the last step)
         for f in range(first, last):
-            rows = step(h, dt, go)
+            end = step(h, dt, go)
             if not frames:
-                return rows
+                return end
             go = START_NEXT
-            if not _take_frame(f, rows, state, unpack_frames(h, frames_slot)):
+            if not _take_frame(f, base, end, state, unpack_frames(h, frames_slot)):
                 return 0
         if frames:
             request = unpack_frames(h, frames_slot).request

@@ -61,6 +61,7 @@ from .state import (
     aligned_zeros,
     pack,
     with_frames,
+    with_impacts,
 )
 from .validation import (
     MAX_MAGNITUDE,
@@ -298,11 +299,11 @@ class Stepper:
         if rows is None:
             rows = self.spec.impact_rows(self.scene, self.n, self.uses_grid())
         self._imp = np.empty(rows, dtype=IMPACT_DTYPE)
-        self._imp_bytes = self._imp.view(np.uint8).data
-        counts = getattr(self, "_n_imp", None)  # (kept when the buffer grows in the middle of a step)
-        self._n_imp = np.zeros(3, dtype=np.int64)  # rows filled, scenes that reached the cap, stalled
-        if counts is not None:
-            self._n_imp[:] = counts
+        self._views = self.spec.sorted_impacts  # (the impacts are handed over as views: see _take_impacts)
+        self._cursor = 0  # (the impact buffer's first free row)
+        self._refill_at = rows // 2
+        # the impact buffer's cursor (mirrored in _cursor), the scenes that reached the cap, stalled
+        self._n_imp = np.zeros(3, dtype=np.int64)
         # the kernel's arguments, packed once (the arrays are only ever updated in place)
         state = State(
             self.balls,
@@ -346,10 +347,19 @@ class Stepper:
         in a periodic cell in a cheap mode, those whose laps round the cell a checked step bounded
         (see :meth:`_checked_step`)."""
         if 0.0 < dt <= self._fast_dt:  # the common case, checked in one test
-            rows = self._call(self._pack, dt, self.start)
-            if rows >= 0:  # no scene stalled or reached the event cap
+            end = self._call(self._pack, dt, self.start)
+            if end >= 0:  # no scene stalled or reached the event cap
                 self.start = self._after_step
-                return self._take_impacts(rows) if rows else NO_IMPACTS
+                first = self._cursor
+                if end == first:
+                    return NO_IMPACTS
+                if self._views:  # (_take_impacts, inlined for the common case)
+                    rows = self._imp[first:end]
+                    self._cursor = end
+                    if end > self._refill_at:
+                        self._fresh_buffer(len(self._imp))
+                    return rows
+                return self._take_impacts(first, end)
             self.start = START_STEP
             return self._finish(self._run(dt, first_done=True), 1.0, stacklevel)
         self.start = START_STEP
@@ -445,7 +455,7 @@ class Stepper:
             # frame f's impacts did not fit (the next frames get a buffer twice the size), or
             # its step needs completing, as step completes it
             if stepped:
-                pieces.append(self._take_impacts(self._n_imp[0]))
+                pieces.append(self._take_impacts(self._cursor, int(self._n_imp[0])))
                 size *= 2
             else:
                 pieces.append(self._finish(self._run(dt, first_done=True), 1.0, stacklevel))
@@ -494,23 +504,26 @@ class Stepper:
     def _run(self, dt_abs: float, first_done: bool = False) -> list[np.ndarray]:
         """Run the mode's kernel until every scene has stepped ``dt_abs``; the impacts in chunks,
         one per call (a call stops the scenes that find the impact buffer full, which the next
-        call resumes). ``first_done``: the step's first call was made already."""
+        call resumes in a buffer with room). ``first_done``: the step's first call was made already."""
         chunks = []
         n_imp = self._n_imp
         if not first_done:
             self._call(self._pack, dt_abs, START_STEP)
-        while True:  # each call resets n_imp[0] and fills the impact buffer from row 0
-            rows = n_imp[0]
-            if rows:
-                chunks.append(self._take_impacts(rows))
+        while True:  # each call records from the cursor on
+            first, end = self._cursor, int(n_imp[0])
+            if end > first:
+                chunks.append(self._take_impacts(first, end))
             if not n_imp[2]:  # no scene stalled
                 if len(chunks) > 1:  # the next steps like this one fit the buffer, up to MAX_IMPACT_ROWS
                     total = sum(len(chunk) for chunk in chunks)
-                    self._alloc_work(max(len(self._imp), min(MAX_IMPACT_ROWS, 1 << (total - 1).bit_length())))
+                    size = min(MAX_IMPACT_ROWS, 1 << (total - 1).bit_length())
+                    if size > len(self._imp):
+                        self._fresh_buffer(size)
                 return chunks
-            if not rows:  # not even one sub-step's worst case fits: a bigger buffer
-                self._alloc_work(2 * len(self._imp))
-                n_imp = self._n_imp
+            if end == first == 0:  # not even one sub-step's worst case fits an empty buffer: a bigger one
+                self._fresh_buffer(2 * len(self._imp))
+            elif self._cursor:  # (rows of this buffer were handed out; the cheap modes' were copied)
+                self._fresh_buffer(len(self._imp))
             self._call(self._pack, dt_abs, RESUME)  # (direct from the second call on: see _first_call)
 
     def _first_call(self, pack: np.ndarray | tuple, dt: float, start: int) -> int:
@@ -525,16 +538,34 @@ class Stepper:
         self._call = _DIRECT[self._kernel]
         return rows
 
-    def _take_impacts(self, rows: int) -> np.ndarray:
-        """A copy of the first ``rows`` impact records. Exact mode records each scene's impacts in
-        the order they happen, scenes in order; the cheap modes' reconstructed times need sorting
-        within each scene."""
-        if self.spec.sorted_impacts:
-            # (numpy copies structured arrays slowly: a byte copy is several times cheaper)
-            return np.ndarray(rows, IMPACT_DTYPE, bytearray(self._imp_bytes[: rows * IMPACT_DTYPE.itemsize]))
-        out = np.empty(rows, dtype=IMPACT_DTYPE)
-        copy_impacts(self._imp, out, self._sign)
-        return out
+    def _take_impacts(self, first: int, end: int) -> np.ndarray:
+        """Rows ``first`` to ``end`` of the impact buffer, handed over to the caller.
+
+        Exact mode records each scene's impacts in the order they happen, scenes in order: its rows
+        are handed over as they are, a view of the buffer, which the kernel never writes again: the
+        cursor moves past them, and once it is half way along, recording goes on from the first row
+        of a new buffer (:meth:`_fresh_buffer`). So a step's impacts cost no copy, and stay as they
+        are for as long as anyone holds them, who holds the buffer they lie in with them. The cheap
+        modes' reconstructed times need sorting within each scene: their rows are sorted into a
+        copy, and used again."""
+        if not self._views:
+            out = np.empty(end - first, dtype=IMPACT_DTYPE)
+            copy_impacts(self._imp[first:end], out, self._sign)
+            self._n_imp[0] = first
+            return out
+        rows = self._imp[first:end]
+        self._cursor = end
+        if end > self._refill_at:
+            self._fresh_buffer(len(self._imp))
+        return rows
+
+    def _fresh_buffer(self, rows: int) -> None:
+        """Record impacts from the first row of a new buffer of ``rows`` rows (what was handed out of
+        the old one stays with whoever holds it; the old buffer is freed with the last of it)."""
+        self._imp = np.empty(rows, dtype=IMPACT_DTYPE)
+        self._refill_at = rows // 2
+        self._pack = with_impacts(self._pack, self._imp)
+        self._n_imp[0] = self._cursor = 0
 
     # ------------------------------------------------------------------ what it holds
     def live_arrays(self) -> LiveArrays:
@@ -606,8 +637,8 @@ class Stepper:
 
     #: What a copy or a pickle rebuilds rather than carries: work space, and what is bound to it.
     _REBUILT = (
-        "_imp", "_imp_bytes", "_n_imp", "_kernel", "_call", "_pack", "_sign", "_fast_dt", "_shared", "live", "pos",
-        "vel", "mass", "inv_mass", "radius", "omega", "spec", "start", "_after_step",
+        "_imp", "_views", "_cursor", "_refill_at", "_n_imp", "_kernel", "_call", "_pack", "_sign", "_fast_dt",
+        "_shared", "live", "pos", "vel", "mass", "inv_mass", "radius", "omega", "spec", "start", "_after_step",
     )  # fmt: skip
 
     def __getstate__(self) -> dict[str, Any]:

@@ -452,8 +452,8 @@ def finish_synced(t_end, rec):
 @njit(refcount=False, forceinline=True)
 def open_step(state, dt_abs, start):
     """Start a step of ``dt_abs`` for every scene (``start``: not :data:`RESUME`), or resume the
-    scenes a full impact buffer stopped."""
-    state.n_imp[0] = 0
+    scenes a full impact buffer stopped. Impacts are recorded from row ``n_imp[0]`` on, where the
+    caller left it (see ``Stepper``: rows it handed out are never written again)."""
     if start != RESUME:
         for sc in range(state.time.shape[0]):
             state.work_i[sc, W_ACTIVE] = True
@@ -500,11 +500,12 @@ def _step(kind: Kind):
     ``start`` is ``START_STEP`` to start a step of ``dt_abs`` for every scene, ``START_NEXT`` to
     start one right after a completed step of this kernel that nobody touched since (the balls
     need not be compared with their records), or ``RESUME`` to resume the scenes flagged active.
-    Impacts go to ``state.imp`` from row 0, ``n_imp[0]`` rows in all; a scene that finds the buffer
-    full stops where it is and is flagged stalled, so the caller can empty the buffer and call
-    again for those scenes. ``n_imp[1]`` counts the scenes that reached the event cap, ``n_imp[2]``
-    the stalled ones. Returns ``n_imp[0]`` when neither happened (the common case, read without
-    looking at ``n_imp``), else -1.
+    Impacts go to ``state.imp`` from row ``n_imp[0]`` on (the caller's cursor, which each record
+    moves on); a scene that finds the buffer full stops where it is and is flagged stalled, so the
+    caller can hand over a buffer with room and call again for those scenes. ``n_imp[1]`` counts
+    the scenes that reached the event cap, ``n_imp[2]`` the stalled ones. Returns the cursor
+    ``n_imp[0]`` when neither happened (the common case, read without looking at ``n_imp``), else
+    -1.
 
     The whole batch is one call with the scene loop inside: a call from Python checks every
     argument, which would cost as much as a small scene's events.

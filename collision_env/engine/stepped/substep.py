@@ -42,8 +42,8 @@ RESOLVERS = {"naive": naive.resolve, "posteriori": posteriori.resolve}
 
 @njit(inline="always")
 def open_step(state, start):
-    """Start a step for every scene (``start``: not ``RESUME``), or resume the stalled ones."""
-    state.n_imp[0] = 0
+    """Start a step for every scene (``start``: not ``RESUME``), or resume the stalled ones
+    (impacts are recorded from row ``n_imp[0]`` on, as in exact mode)."""
     if start != RESUME:
         for sc in range(state.time.shape[0]):
             state.work_i[sc, W_ACTIVE] = True
