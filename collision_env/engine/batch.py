@@ -23,7 +23,6 @@ from .modes import MODES as MODE_REGISTRY
 from .physics.motion import apply_impulses
 from .scene import Scene
 from .snapshot import SimulatorState
-from .stepper import NO_IMPACTS as NO_RECORDS
 from .stepper import FrameArrays, LiveArrays, Stepper, default_event_cap
 from .validation import (
     Labels,
@@ -36,9 +35,6 @@ from .validation import (
     real_number,
     state_record,
 )
-
-#: What a step without impacts returns (shared: an :class:`Impacts` is read-only).
-NO_IMPACTS = Impacts(NO_RECORDS)
 
 
 class Frames(NamedTuple):
@@ -251,8 +247,7 @@ class BatchSimulator:
         speed within the step raises a ``ValueError`` naming the ball, and changes nothing.
         """
         # (a float, real_number's common case, is taken without its call)
-        rows = self._stepper.step(dt if isinstance(dt, float) else real_number(dt, "dt"))
-        return NO_IMPACTS if rows is NO_RECORDS else Impacts(rows)
+        return self._stepper.step(dt if isinstance(dt, float) else real_number(dt, "dt"))
 
     def frames(self, dt: float, n: int, out: Frames | None = None) -> Frames:
         """Take ``n`` steps of ``dt`` seconds, recording every scene after each one.

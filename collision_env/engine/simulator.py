@@ -14,12 +14,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .batch import NO_IMPACTS, BatchSimulator, Frames, frames_of, new_stepper, snapshot
+from .batch import BatchSimulator, Frames, frames_of, new_stepper, snapshot
 from .impacts import Impacts
 from .keywords import check_keywords
 from .scene import Scene
 from .snapshot import SimulatorState
-from .stepper import NO_IMPACTS as NO_RECORDS
 from .stepper import Stepper
 from .validation import checked_balls, periodic_slack, real_number, state_record
 
@@ -94,8 +93,7 @@ class Simulator:
         as :class:`Impacts` (a sequence of :class:`Impact` over their records); see
         :meth:`BatchSimulator.step` for what ``dt`` may be."""
         # (a float, real_number's common case, is taken without its call)
-        rows = self._stepper.step(dt if isinstance(dt, float) else real_number(dt, "dt"))
-        return NO_IMPACTS if rows is NO_RECORDS else Impacts(rows)
+        return self._stepper.step(dt if isinstance(dt, float) else real_number(dt, "dt"))
 
     def frames(self, dt: float, n: int, out: Frames | None = None) -> Frames:
         """``n`` steps of ``dt`` seconds in one call, recording the state after each:

@@ -19,6 +19,7 @@ import numpy as np
 from ._jit import BACKEND, compile_for
 from .broadphase import GRID_MIN_BALLS, PERIODIC_GRID_MIN_BALLS, grid_geometry
 from .frames import copy_impacts, record_frame
+from .impacts import Impacts
 from .layout import (
     B_INV_MASS,
     B_MASS,
@@ -97,15 +98,26 @@ def default_event_cap(n: int) -> int:
 
 
 #: What a step without impacts returns: one shared array of no rows (read-only, as nothing can be
-#: written to it; a fresh empty structured array costs more than a small scene's step).
-NO_IMPACTS = np.empty(0, dtype=IMPACT_DTYPE)
-NO_IMPACTS.flags.writeable = False
+#: written to it; a fresh empty structured array costs more than a small scene's step), and its
+#: :class:`Impacts`.
+NO_RECORDS = np.empty(0, dtype=IMPACT_DTYPE)
+NO_RECORDS.flags.writeable = False
+NO_IMPACTS = Impacts(NO_RECORDS)
+
+
+def as_impacts(rows: np.ndarray) -> Impacts:
+    """``rows`` (impact records a step returned) as :class:`Impacts`."""
+    return NO_IMPACTS if rows is NO_RECORDS else Impacts(rows)
+
 
 #: The impact buffer grows to hold a step's impacts up to this many rows (72 MB): a step that fills
 #: it is run in calls that each fill it, whose impacts are then joined (a cost per row far below an
 #: event's).
 MAX_IMPACT_ROWS = 1 << 20
 
+
+#: A new object of a type, its ``__init__`` not called.
+_new = object.__new__
 
 #: Each stepping kernel called so far -> its compiled version, which steppers call directly (see
 #: ``Stepper._first_call``).
@@ -329,9 +341,9 @@ class Stepper:
         )
 
     # ------------------------------------------------------------------ stepping
-    def step(self, dt: float, stacklevel: int = 4) -> np.ndarray:
-        """Advance every scene by ``dt`` (a float: the caller made it one), the impacts as records
-        ordered by scene and time; ``stacklevel`` names the caller's caller in an
+    def step(self, dt: float, stacklevel: int = 4) -> Impacts:
+        """Advance every scene by ``dt`` (a float: the caller made it one); the impacts, ordered by
+        scene and time; ``stacklevel`` names the caller's caller in an
         :class:`EventCapWarning` (4: this, the public ``step`` and its caller, plus the warning's
         own frame).
 
@@ -358,12 +370,14 @@ class Stepper:
                     self._cursor = end
                     if end > self._refill_at:
                         self._fresh_buffer(len(self._imp))
-                    return rows
-                return self._take_impacts(first, end)
+                    impacts = _new(Impacts)  # (Impacts(rows) without the call of its __init__)
+                    impacts.array = rows
+                    return impacts
+                return Impacts(self._take_impacts(first, end))
             self.start = START_STEP
-            return self._finish(self._run(dt, first_done=True), 1.0, stacklevel)
+            return as_impacts(self._finish(self._run(dt, first_done=True), 1.0, stacklevel))
         self.start = START_STEP
-        return self._checked_step(dt, stacklevel + 1)
+        return as_impacts(self._checked_step(dt, stacklevel + 1))
 
     def _checked_step(self, dt: float, stacklevel: int) -> np.ndarray:
         """:meth:`step` off its fast path: backwards, without a border, in a periodic cell in a
@@ -380,7 +394,7 @@ class Stepper:
             )
         if dt == 0.0:
             self.capped[:] = False
-            return NO_IMPACTS
+            return NO_RECORDS
         sign = 1.0 if dt > 0.0 else -1.0
         if sign != self._sign:  # reverse steps use 1/e
             self.fparams[S_ELASTICITY] = e if sign > 0 else 1.0 / e
@@ -440,7 +454,7 @@ class Stepper:
             if not (forward and 0.0 < dt <= MAX_MAGNITUDE):
                 # backwards or without a border: a step as step takes it (which may make the next
                 # ones forward steps with a border)
-                pieces.append(self.step(dt, stacklevel + 1))
+                pieces.append(self.step(dt, stacklevel + 1).array)
                 self._record(f, out)
                 f += 1
                 continue
@@ -463,7 +477,7 @@ class Stepper:
             f += 1
         if len(pieces) == 1:
             return pieces[0]
-        return np.concatenate(pieces) if pieces else NO_IMPACTS.copy()
+        return np.concatenate(pieces) if pieces else NO_RECORDS.copy()
 
     def _record(self, f: int, out: FrameArrays) -> None:
         """Frame ``f`` of ``out``: the state now."""
@@ -493,7 +507,7 @@ class Stepper:
                 stacklevel=stacklevel,
             )
         if not chunks:
-            return NO_IMPACTS
+            return NO_RECORDS
         if len(chunks) == 1:
             return chunks[0]
         out = np.concatenate(chunks)  # a stalled step: a scene's impacts may span chunks
