@@ -30,7 +30,7 @@ from .layout import (
     TARGET_INTS,
     TARGET_PENDING,
 )
-from .scoring import aim_squared, in_cluster
+from .scoring import aim_squared, in_cluster, play_area
 
 
 @njit(refcount=False, forceinline=True)
@@ -84,14 +84,13 @@ def play_area_diagonal(p):  # pragma: no cover - numba
 
 
 @njit(refcount=False, forceinline=True)
-def _straight_aim(b, views, diag, state, params, seq, cluster):  # pragma: no cover - numba
+def _straight_aim(b, views, box, diag, shaping, state, params, seq, cluster):  # pragma: no cover - numba
     """Scene ``b``'s aiming potential phi in straight flight (``views``: the engine's ``ball_views``,
-    ``diag``: the play area's diagonal):
+    ``box`` and ``diag``: the play area's ``scoring.Box`` and diagonal, ``shaping``: the parameter):
     minus the distance, over the play-area diagonal, from each scoring ball's straight-line border
     contact point to the nearest visible pending target, at its smallest (-1 when nothing is aimed,
     or when the task does not shape): a heuristic that ignores other balls."""
-    p = params.params
-    if p[PARAMS.shaping] == 0.0:
+    if shaping == 0.0:
         return -1.0
     pos, vel, _, _, radii, _ = views
     best = math.inf  # (the least squared distance: see scoring.aim_squared)
@@ -108,12 +107,12 @@ def _straight_aim(b, views, diag, state, params, seq, cluster):  # pragma: no co
             vx,
             vy,
             radii[b, i],
-            p[PARAMS.xmin],
-            p[PARAMS.ymin],
-            p[PARAMS.xmax],
-            p[PARAMS.ymax],
+            box.xmin,
+            box.ymin,
+            box.xmax,
+            box.ymax,
         )
-        best = min(best, aim_squared(cx, cy, b, state, seq, params))
+        best = min(best, aim_squared(cx, cy, b, state, seq, box))
     return -min(1.0, math.sqrt(best) / diag)
 
 
@@ -154,12 +153,15 @@ def settle(flags, engine, state, params):  # pragma: no cover - numba
     straight = params.switches[SWITCHES.aim_predicted] == 0
     scene_f, scene_i = state.scene_f, state.scene_i
     views = ball_views(engine.balls)
+    # (read once per call: see scoring.Box)
+    box = play_area(params.params)
     diag = play_area_diagonal(params.params)
+    shaping = params.params[PARAMS.shaping]
     for b in range(flags.shape[0]):
         f = flags[b]
         if f == ROW_SKIP:
             continue
-        phi_new = _straight_aim(b, views, diag, state, params, seq, cluster) if straight else -1.0
+        phi_new = _straight_aim(b, views, box, diag, shaping, state, params, seq, cluster) if straight else -1.0
         if f == ROW_STEPPED:
             _reward(b, phi_new, state, params, straight)
         else:

@@ -22,7 +22,7 @@ from .layout import (
 )
 from .nudge import clip1
 from .observe import centre_and_half_size
-from .scoring import aim_squared, next_wall_impact, target_hit
+from .scoring import aim_squared, next_wall_impact, play_area, target_hit
 
 
 @njit(label="the environments' predicted observation")
@@ -47,6 +47,7 @@ def predict_kernel(h, flags, imp, obs):  # pragma: no cover - numba
     engine, state, params = unpack(h)
     p, switches, shown, body = params.params, params.switches, params.shown, state.ahead_body
     xc, yc, xh, yh = centre_and_half_size(p)
+    box = play_area(p)
     diag = 2.0 * math.sqrt(xh * xh + yh * yh)
     tlimit = p[PARAMS.time_limit]
     seq = switches[SWITCHES.sequential] != 0
@@ -89,7 +90,7 @@ def predict_kernel(h, flags, imp, obs):  # pragma: no cover - numba
             x = imp[j]["x"]
             y = imp[j]["y"]
             if aim and scores:
-                best[b] = min(best[b], aim_squared(x, y, b, state, seq, params))
+                best[b] = min(best[b], aim_squared(x, y, b, state, seq, box))
             if observe and shown[i]:
                 hits = scores and target_hit(j, imp, state, seq) >= 0
                 if first or hits:

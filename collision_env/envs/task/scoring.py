@@ -11,6 +11,7 @@ does), so that a wall impact scores only if its ball was part of a cluster at th
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 from collision_env.engine.compiled import njit
 from collision_env.engine.scene import WALL_BOTTOM, WALL_LEFT, WALL_RIGHT
@@ -30,9 +31,28 @@ from .layout import (
 )
 
 
-@njit(refcount=False, forceinline=True)
+class Box(NamedTuple):
+    """The play area's bounds (m), read from the parameters once per call of a kernel: a parameter
+    read again in each scene's loop, after the scene's writes to the task state (which the compiler
+    cannot tell apart from the parameters), costs as much as the scene's aim."""
+
+    xmin: float
+    ymin: float
+    xmax: float
+    ymax: float
+
+
+@njit(inline="always")
+def play_area(p):  # pragma: no cover - numba
+    """The play area's :class:`Box`, from the parameters ``p``."""
+    return Box(p[PARAMS.xmin], p[PARAMS.ymin], p[PARAMS.xmax], p[PARAMS.ymax])
+
+
+@njit(inline="always")
 def on_side_wall(wall):  # pragma: no cover - numba
-    """Left and right walls run along y; bottom and top along x."""
+    """Left and right walls run along y; bottom and top along x. (Inlined by numba: a kernel of its
+    own, even one LLVM may inline, keeps the aim's loops over balls and targets from being compiled
+    as one, which costs a fifth of the task kernel.)"""
     return wall == WALL_LEFT or wall == WALL_RIGHT
 
 
@@ -143,13 +163,14 @@ def _squared_distance_to_target(cx, cy, wall, centre, hw, xmin, ymin, xmax, ymax
 
 
 @njit(refcount=False, forceinline=True)
-def aim_squared(cx, cy, b, state, seq, params):  # pragma: no cover - numba
+def aim_squared(cx, cy, b, state, seq, box):  # pragma: no cover - numba
     """Squared distance from a wall point (cx, cy) to the nearest visible pending target of scene b
-    (inf if none). The distance is its square root, taken once for the nearest: a square root (and
-    a division by a positive scale) keeps the order of its arguments, so the root of the least
-    square is the least root, bit for bit, for one root instead of one per target."""
+    (inf if none; ``box``: the play area's :class:`Box`). The distance is its square root, taken
+    once for the nearest: a square root (and a division by a positive scale) keeps the order of its
+    arguments, so the root of the least square is the least root, bit for bit, for one root instead
+    of one per target."""
     best = math.inf
-    targets, geo, p = state.targets, state.target_geo, params.params
+    targets, geo = state.targets, state.target_geo
     k0, k1 = visible_targets(state.scene_i[b, SCENE_INTS.current], targets.shape[1], seq)
     for k in range(k0, k1):
         if targets[b, k, TARGET_INTS.status] == TARGET_PENDING:
@@ -159,10 +180,10 @@ def aim_squared(cx, cy, b, state, seq, params):  # pragma: no cover - numba
                 targets[b, k, TARGET_INTS.wall],
                 geo[b, k, TARGET_GEOMETRY.centre],
                 geo[b, k, TARGET_GEOMETRY.half_width],
-                p[PARAMS.xmin],
-                p[PARAMS.ymin],
-                p[PARAMS.xmax],
-                p[PARAMS.ymax],
+                box.xmin,
+                box.ymin,
+                box.xmax,
+                box.ymax,
             )
             best = min(best, d)
     return best
