@@ -18,6 +18,7 @@ from numpy.typing import DTypeLike
 
 from collision_env.engine import MAX_SUBSTEPS
 from collision_env.engine.compiled import compile_for
+from collision_env.engine.impacts import copy_records
 from collision_env.engine.keywords import close_matches
 from collision_env.engine.modes import MODES
 from collision_env.engine.scene import WALL_NAMES
@@ -421,7 +422,9 @@ class TaskCore:
         if bad >= 0:
             where = f"sub-env {bad}: " if self.num_scenes > 1 else ""
             raise ValueError(f"{where}action contains NaN: {actions[bad].tolist()}")
-        imp = self.batch.step(dt).array
+        # (a copy: the engine's records are a view of its impact buffer, which an info kept for long,
+        # an episode's last say, would keep alive whole)
+        imp = copy_records(self.batch.step(dt).array)
         imp.flags.writeable = False  # (the kernels take the records read-only: one compiled version)
         return imp
 
