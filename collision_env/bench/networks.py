@@ -77,8 +77,8 @@ ROW_MS, PILE_MS, PILE_MB = 50.0, 20.0, 50.0
 #: cluster), 1e-4 s, about 1/300 of their time scale under gravity ``sqrt(r / g)`` (32 ms) and 1/20
 #: of the time the cluster's first gaps take to close (2 ms); for the cooling gas, 1e-3 s, about a
 #: tenth of a disk's initial mean time between collisions (Enskog's rate at area fraction 0.5 and
-#: unit mean square speed: about 88 per second), as Luding & McNamara (1998) ask: much shorter
-#: than the time between a ball's collisions where the gas is not collapsing.
+#: unit mean square speed: about 88 per second): much shorter than the time between a ball's
+#: collisions where the flow is not collapsing, so that the model changes only where it is.
 TC_PILE, TC_GAS = 1e-4, 1e-3
 
 

@@ -52,9 +52,9 @@ previous collision happened less than ``t_c`` before it (a ball-wall collision: 
 has the scene's ``e`` otherwise (:func:`restitution`). Dissipation then stops where collisions come
 faster than one per ``t_c`` per ball, as it does in a soft-sphere contact lasting ``t_c``, so dense
 regions stay a dense elastic gas instead of collapsing; a dilute gas, whose balls collide far less
-often, is not changed. Luding & McNamara take ``t_c`` much shorter than the mean time between a
-ball's collisions in the flow being studied (the physical contact duration of the grains, where
-known), and found their results insensitive to it there.
+often, is not changed so long as ``t_c`` is much shorter than the time between a ball's
+collisions there: choose ``t_c`` so (the grains' contact duration, where it is known, is the
+model's own reading of it).
 
 Each ball's last collision instant (s on the clock; ``-inf``: none yet) is kept in exact mode's
 calendar, carried by ``copy``/``load`` and, under the model, by ``get_state``/``set_state``
