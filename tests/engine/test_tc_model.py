@@ -167,3 +167,15 @@ def test_set_balls_starts_the_memory_afresh():
     sim = two_collisions(2.0)
     sim.set_balls(velocities=[[1.0, 0.0], [0.0, 0.0]])
     np.testing.assert_array_equal(sim.get_state().last_impact, [-math.inf, -math.inf])
+
+
+def test_batch_scenes_keep_their_own_collision_instants():
+    # scene 0 as above; in scene 1 ball 1 starts 0.1 m further from the wall, so every instant is 0.1 s later
+    pos = [TWO[0], [[0.0, 0.0], [0.5, 0.0]]]
+    batch = BatchSimulator(BOX, pos, [TWO[1]] * 2, TWO[2], TWO[3], contact_duration=2.0)
+    batch.step(2.0)
+    np.testing.assert_allclose(batch.get_state().last_impact, [[1.7, 1.7], [1.8, 1.8]], rtol=1e-12)
+    np.testing.assert_allclose(batch.velocities[:, :, 0], [[-0.5, 0.0], [-0.5, 0.0]], atol=1e-15)
+    other = BatchSimulator(BOX, pos, [TWO[1]] * 2, TWO[2], TWO[3], contact_duration=2.0)
+    other.load(batch)
+    assert other.get_state() == batch.get_state() and batch.contact_duration == 2.0
