@@ -63,12 +63,15 @@ def new_stepper(
     max_events: Any,
     collapse_ratio: Any,
     collapse_floor: Any,
+    contact_duration: Any = 0.0,
 ) -> Stepper:
     """A :class:`Stepper` of ``(B, N, 2)`` positions and velocities (``single``: a batch of one that
     its simulator shows without the batch axis), every argument checked (ValueError naming it)."""
     if not isinstance(scene, Scene):
         raise ValueError(f"scene: expected a collision_env.engine.Scene, got {type(scene).__name__}")
-    settings = checked_settings(mode, substeps, max_events, collapse_ratio, collapse_floor, MODE_REGISTRY)
+    settings = checked_settings(
+        mode, substeps, max_events, collapse_ratio, collapse_floor, MODE_REGISTRY, contact_duration, scene.sticky
+    )
     try:
         shape = np.shape(cast(ArrayLike, positions))  # (numpy's ArrayLike leaves out lists of arrays)
     except ValueError:  # numpy refuses ragged nesting
@@ -182,6 +185,11 @@ class BatchSimulator:
         ``s`` being the fastest speed among the balls of the impact (exact mode; the cheap modes use
         the scene's slowest moving ball), see :mod:`collision_env.engine.physics.response`. The default
         floor, 0, keeps energy from growing beyond round-off at e < 1.
+    contact_duration:
+        The TC model (Luding & McNamara 1998), off at 0 (the default): a collision is elastic when
+        either ball's previous collision was less than ``contact_duration`` seconds before it, which
+        bounds the collisions of dense inelastic flows (exact mode, slip scenes; forward steps only).
+        See :mod:`collision_env.engine.physics.response`.
 
     Inputs are real numbers (numpy scalar types included; booleans, strings and complex numbers
     are refused) with finite, representable values: positions and speeds up to 1e150, masses
@@ -209,6 +217,7 @@ class BatchSimulator:
         max_events: int | None = None,
         collapse_ratio: float = 1e-9,
         collapse_floor: float = 0.0,
+        contact_duration: float = 0.0,
     ) -> None:
         self._stepper = new_stepper(
             scene,
@@ -222,6 +231,7 @@ class BatchSimulator:
             max_events=max_events,
             collapse_ratio=collapse_ratio,
             collapse_floor=collapse_floor,
+            contact_duration=contact_duration,
         )
 
     @classmethod
@@ -361,6 +371,11 @@ class BatchSimulator:
     def collapse_ratio(self) -> float:
         """Collapse regulariser: u_min / fastest speed."""
         return self._stepper.settings.collapse_ratio
+
+    @property
+    def contact_duration(self) -> float:
+        """The TC model's contact duration (s; 0: off), as given to the constructor."""
+        return self._stepper.settings.contact_duration
 
     @property
     def collapse_floor(self) -> float:
@@ -513,6 +528,7 @@ class BatchSimulator:
             images=checked.images,
             clusters=checked.clusters,
             omega=checked.omega,
+            last_impact=checked.last_impact,
         )
 
     def copy(self) -> BatchSimulator:

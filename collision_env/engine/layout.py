@@ -71,10 +71,13 @@ HEAP = ("time", "ball")
 H_TIME, H_BALL = range(2)
 
 #: Scene floats: the border (m; zeros when there is none), the restitution used this step (1/e
-#: when running backwards), the collapse regulariser's ratio and floor (m/s), and the direction
-#: of time (+1 or -1).
-SCENE_F = ("xmin", "ymin", "xmax", "ymax", "elasticity", "collapse_ratio", "sign", "collapse_floor")
-S_XMIN, S_YMIN, S_XMAX, S_YMAX, S_ELASTICITY, S_COLLAPSE_RATIO, S_SIGN, S_COLLAPSE_FLOOR = range(8)
+#: when running backwards), the collapse regulariser's ratio and floor (m/s), the direction
+#: of time (+1 or -1), and the TC model's contact duration (s; 0: off, see
+#: :mod:`collision_env.engine.physics.response`).
+SCENE_F = ("xmin", "ymin", "xmax", "ymax", "elasticity", "collapse_ratio", "sign", "collapse_floor", "contact_duration")
+(
+    S_XMIN, S_YMIN, S_XMAX, S_YMAX, S_ELASTICITY, S_COLLAPSE_RATIO, S_SIGN, S_COLLAPSE_FLOOR, S_CONTACT_DURATION,
+) = range(9)  # fmt: skip
 
 #: Scene ints: a border exists; ball pairs are modelled; the dimension (1 or 2); stick clusters
 #: are formed; the cap on events per step (exact mode); sub-steps per step (the cheap modes).

@@ -20,7 +20,7 @@ from .keywords import check_keywords
 from .scene import Scene
 from .snapshot import SimulatorState
 from .stepper import Stepper
-from .validation import checked_balls, periodic_slack, real_number, state_record
+from .validation import checked_balls, left_out, periodic_slack, real_number, state_record
 
 
 class Simulator:
@@ -28,8 +28,9 @@ class Simulator:
 
     ``Simulator(scene, positions (N, 2), velocities (N, 2), masses (N,), radii=None, mode="exact",
     substeps=1)``; :meth:`step` returns the step's :class:`Impacts` in time order. The other keyword
-    arguments (``max_events``, ``collapse_ratio``, ``collapse_floor``) and every check are those of
-    :class:`BatchSimulator`, whose parameters they are; shapes in errors are this simulator's own.
+    arguments (``max_events``, ``collapse_ratio``, ``collapse_floor``, ``contact_duration``) and every
+    check are those of :class:`BatchSimulator`, whose parameters they are; shapes in errors are this
+    simulator's own.
     """
 
     _stepper: Stepper
@@ -51,6 +52,7 @@ class Simulator:
         max_events: int | None = None,
         collapse_ratio: float = 1e-9,
         collapse_floor: float = 0.0,
+        contact_duration: float = 0.0,
     ) -> None:
         try:
             shape = np.shape(positions)
@@ -71,6 +73,7 @@ class Simulator:
             max_events=max_events,
             collapse_ratio=collapse_ratio,
             collapse_floor=collapse_floor,
+            contact_duration=contact_duration,
         )
 
     @property
@@ -206,7 +209,7 @@ class Simulator:
         """Restore a state from :meth:`get_state`, checked as :meth:`BatchSimulator.set_state` checks it
         (a dict of its fields is still taken, with a ``DeprecationWarning``)."""
         record = state_record(state, stacklevel=2)
-        self.batch._restore({key: np.asarray(value)[None] for key, value in record.items()})
+        self.batch._restore({key: np.asarray(value)[None] for key, value in record.items() if not left_out(value)})
 
     def copy(self) -> Simulator:
         """An independent copy (``copy.copy`` and ``copy.deepcopy`` give one too)."""

@@ -38,6 +38,9 @@ class SimulatorState(Mapping[str, Any]):
     time: Any  #: the clock, s
     time_compensation: Any  #: the clock's compensation (its round-off so far, below an ulp of ``time``)
     images: Any  #: ``(N, 2)`` int: periodic cell lengths each ball has crossed (zeros unless periodic)
+    #: ``(N,)`` each ball's last collision instant on the clock, s (``-inf``: none yet), which the TC
+    #: model reads (``contact_duration > 0``); None in the states of simulators without it
+    last_impact: Any = None
 
     def __getitem__(self, key: str) -> Any:
         if key not in FIELDS:
@@ -54,7 +57,7 @@ class SimulatorState(Mapping[str, Any]):
         """Equal when every field holds the same values (``np.array_equal``)."""
         if not isinstance(other, SimulatorState):
             return NotImplemented
-        return all(np.array_equal(getattr(self, key), getattr(other, key)) for key in FIELDS)
+        return all(_same(getattr(self, key), getattr(other, key)) for key in FIELDS)
 
     __hash__ = None  # type: ignore[assignment]  # (its arrays are mutable: not hashable, as a dict)
 
@@ -64,11 +67,20 @@ class SimulatorState(Mapping[str, Any]):
 
     def single(self) -> SimulatorState:
         """The first scene of a batch's state, without the batch axis."""
-        return SimulatorState(**{key: np.asarray(getattr(self, key))[0] for key in FIELDS})
+        return SimulatorState(
+            **{key: None if getattr(self, key) is None else np.asarray(getattr(self, key))[0] for key in FIELDS}
+        )
 
     def __repr__(self) -> str:
         shape = np.shape(self.positions)
         return f"SimulatorState({shape[-2] if len(shape) >= 2 else '?'} balls, time={self.time!r})"
+
+
+def _same(a: Any, b: Any) -> bool:
+    """Two fields hold the same values (both None, or ``np.array_equal``)."""
+    if a is None or b is None:
+        return a is None and b is None
+    return bool(np.array_equal(a, b))
 
 
 #: The fields of a :class:`SimulatorState`, in order.

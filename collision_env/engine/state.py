@@ -30,6 +30,7 @@ from .layout import (
     IMPACT_DTYPE,
     S_COLLAPSE_FLOOR,
     S_COLLAPSE_RATIO,
+    S_CONTACT_DURATION,
     S_DIM,
     S_ELASTICITY,
     S_HAS_WALLS,
@@ -74,6 +75,7 @@ class Calendar(NamedTuple):
     heap: np.ndarray  #: (B, rows, len(HEAP)) float64, the event queue's heap
     buckets: np.ndarray  #: (B, R + 1) int32, the event queue's bucket lists and far list
     inv_mass: np.ndarray  #: (B, N) float64, the inverse masses the calendar took
+    last_impact: np.ndarray  #: (B, N) float64, each ball's last collision instant (s; -inf: none), the TC model's
 
 
 class ExactScratch(NamedTuple):
@@ -138,6 +140,7 @@ class Physics(NamedTuple):
     dim: int
     sticky: bool  #: stick clusters are formed
     cascades: bool  #: forward inelastic: touching groups are resolved at one instant
+    contact_duration: float  #: the TC model's t_c, s (0: off)
 
 
 @njit(inline="always")
@@ -164,6 +167,7 @@ def physics(fparams, iparams):
         iparams[S_DIM],
         iparams[S_STICKY] != 0,
         e < 1.0,
+        fparams[S_CONTACT_DURATION],
     )
 
 
@@ -259,6 +263,7 @@ if HAVE_NUMBA:
             view(h, s + 3, np.float64, 3),
             view(h, s + 4, np.int32, 2),
             view(h, s + 5, np.float64, 2),
+            view(h, s + 6, np.float64, 2),
         )
 
     @njit(inline="always")

@@ -193,6 +193,7 @@ class Stepper:
             collapse_ratio=settings.collapse_ratio,
             sign=1.0,
             collapse_floor=settings.collapse_floor,
+            contact_duration=settings.contact_duration,
         )
         scene_i = dict(
             has_walls=scene.bounds is not None and not scene.periodic,
@@ -246,6 +247,7 @@ class Stepper:
         images: np.ndarray | None = None,
         clusters: np.ndarray | None = None,
         omega: np.ndarray | float = 0.0,
+        last_impact: np.ndarray | None = None,
     ) -> None:
         """Start ``scenes`` (indices) afresh from checked ``(K, N, ...)`` balls, at ``time`` (with
         its clock's ``compensation``). Periodic positions are wrapped into the cell, the periods
@@ -262,6 +264,8 @@ class Stepper:
         self.time[scenes] = time
         self.clock[scenes, 0] = time
         self.clock[scenes, 1] = compensation
+        if self.spec.persistent:  # (the TC model's memory: no collision yet, unless a state says)
+            self.mode_arrays[0].last_impact[scenes] = -np.inf if last_impact is None else last_impact
         self.invalidate(scenes)
 
     def changed(self) -> None:
@@ -388,6 +392,11 @@ class Stepper:
             check_reach(self.pos, self.vel, dt, label)
         longest = check_laps(self.scene, self.mass, self.vel, dt, label) if self._bounds_laps else 0.0
         e = self.scene.elasticity
+        if dt < 0.0 and self.settings.contact_duration > 0.0:
+            raise ValueError(
+                "dt: cannot step backwards under the TC model (contact_duration > 0): which collisions "
+                "it makes elastic depends on the collisions before them"
+            )
         if dt < 0.0 and e == 0.0:
             raise ValueError(
                 "dt: cannot step backwards with elasticity 0 (a perfectly inelastic collision has no inverse)"
@@ -621,6 +630,8 @@ class Stepper:
             time=self.time.copy(),
             time_compensation=self.clock[:, 1].copy(),
             images=self.images.copy(),
+            # (the TC model's memory, only where a simulator has the model: every other state stays as it was)
+            last_impact=self.mode_arrays[0].last_impact.copy() if self.settings.contact_duration > 0.0 else None,
         )
 
     # ------------------------------------------------------------------ copies

@@ -547,13 +547,22 @@ class Settings(NamedTuple):
     max_events: int | None  #: cap on events per scene and step (exact); None: the default for N balls
     collapse_ratio: float  #: collapse regulariser: u_min / fastest speed
     collapse_floor: float  #: collapse regulariser: smallest u_min, m/s
+    contact_duration: float = 0.0  #: the TC model's t_c, s (0: off)
 
 
 def checked_settings(
-    mode: Any, substeps: Any, max_events: Any, collapse_ratio: Any, collapse_floor: Any, modes: Mapping[str, Any]
+    mode: Any,
+    substeps: Any,
+    max_events: Any,
+    collapse_ratio: Any,
+    collapse_floor: Any,
+    modes: Mapping[str, Any],
+    contact_duration: Any = 0.0,
+    sticky: bool = False,
 ) -> Settings:
     """A simulator's settings, each checked (raises ValueError naming it); ``modes``: the mode
-    registry (``modes.MODES``), whose entry says whether the mode takes sub-steps."""
+    registry (``modes.MODES``), whose entry says whether the mode takes sub-steps; ``sticky``: the
+    scene forms stick clusters (which the TC model does not apply to)."""
     if not (isinstance(mode, str) and mode in modes):
         raise ValueError(f"mode: must be one of {tuple(modes)}, got {mode!r}")
     substeps = positive_integer(substeps, "substeps", MAX_SUBSTEPS)
@@ -565,11 +574,23 @@ def checked_settings(
         raise ValueError(f"collapse_ratio: must be a number in [0, 1), got {collapse_ratio!r}")
     if not (is_real(collapse_floor) and 0.0 <= float(collapse_floor) < MAX_MAGNITUDE):
         raise ValueError(f"collapse_floor: must be a finite speed >= 0 (m/s), got {collapse_floor!r}")
-    return Settings(mode, substeps, max_events, float(collapse_ratio), float(collapse_floor))
+    if not (is_real(contact_duration) and 0.0 <= float(contact_duration) < MAX_MAGNITUDE):
+        raise ValueError(f"contact_duration: must be a finite time >= 0 (s), got {contact_duration!r}")
+    if float(contact_duration) > 0.0 and mode != "exact":
+        raise ValueError(
+            f"contact_duration: the TC model is exact mode's (a {mode} step resolves each pair once per "
+            "sub-step, with no collision instants to compare); it must be 0 here"
+        )
+    if float(contact_duration) > 0.0 and sticky:
+        raise ValueError(
+            "contact_duration: a stick scene merges colliding balls (no restitution for the TC model to "
+            "set); it must be 0 here"
+        )
+    return Settings(mode, substeps, max_events, float(collapse_ratio), float(collapse_floor), float(contact_duration))
 
 
 #: The state fields a dict given to ``set_state`` may go without (a :class:`SimulatorState` has all).
-OPTIONAL_STATE_KEYS = ("images",)
+OPTIONAL_STATE_KEYS = ("images", "last_impact")
 
 
 def state_record(state: Any, stacklevel: int) -> SimulatorState | dict:
@@ -589,6 +610,14 @@ def state_record(state: Any, stacklevel: int) -> SimulatorState | dict:
     return dict(state)
 
 
+def left_out(value: Any) -> bool:
+    """An optional state field given as None (or a copy of it, ``np.array(None)``): left out."""
+    if value is None:
+        return True
+    a = np.asarray(value)
+    return a.shape == () and a.dtype == object and a.item() is None
+
+
 class CheckedState(NamedTuple):
     """A state as :func:`checked_state` returns it, ready for the stepper's ``put``."""
 
@@ -601,6 +630,7 @@ class CheckedState(NamedTuple):
     time: np.ndarray
     compensation: np.ndarray
     images: np.ndarray | None
+    last_impact: np.ndarray | None
 
 
 def checked_state(
@@ -622,6 +652,7 @@ def checked_state(
         "time": (n_scenes,),
         "time_compensation": (n_scenes,),
         "images": (n_scenes, n, 2),
+        "last_impact": (n_scenes, n),
     }
     required = [key for key in STATE_FIELDS if key not in OPTIONAL_STATE_KEYS]
     if not isinstance(state, Mapping):
@@ -636,14 +667,17 @@ def checked_state(
         raise ValueError(f"state: missing {missing} (a state has the keys {required}, as get_state gives)")
     arrays = {}
     for key in state:
+        if key in OPTIONAL_STATE_KEYS and left_out(state[key]):
+            continue
         a = np.asarray(state[key])
         if a.shape != shapes[key]:
             raise ValueError(f"state {key}: expected shape {label.shape(shapes[key])}, got {label.shape(a.shape)}")
         whole = key in ("clusters", "images")
         if a.dtype.kind not in ("iu" if whole else "iuf"):
             raise ValueError(f"state {key}: expected {'integers' if whole else 'real numbers'}, got dtype {a.dtype}")
-        if a.dtype.kind == "f" and not np.isfinite(a).all():  # (integers always are)
-            raise ValueError(f"state {key}: values must be finite")
+        # (integers always are finite; a ball with no collision yet has its last one at -inf)
+        if a.dtype.kind == "f" and not (np.isfinite(a) | (a == -np.inf if key == "last_impact" else False)).all():
+            raise ValueError(f"state {key}: values must be finite{' or -inf' if key == 'last_impact' else ''}")
         arrays[key] = a
     scenes = np.arange(n_scenes)
     # (positions a step left a round-off outside a periodic cell are taken as they are)
@@ -671,6 +705,15 @@ def checked_state(
                 f"state time_compensation: {label(sc)}must be within an ulp of the time "
                 f"({np.spacing(abs(time)):.3g} s at {time:g} s), got {compensation:g}"
             )
+    last_impact = arrays.get("last_impact")
+    if last_impact is not None:
+        clocks = arrays["time"]
+        refuse_first(
+            last_impact > clocks[:, None],
+            label,
+            lambda s, i: f"a last collision instant after the clock ({clocks[s]:g} s), got {last_impact[s, i]:g}",
+            field="state last_impact",
+        )
     images = None
     if "images" in arrays:
         wrapped: np.ndarray | int = 0
@@ -687,6 +730,7 @@ def checked_state(
         arrays["time"],
         arrays["time_compensation"],
         images,
+        None if last_impact is None else last_impact.astype(np.float64),
     )
 
 

@@ -18,6 +18,12 @@ def test_quick_run_writes_every_row_and_the_struck_rows_reach_every_step_end(tmp
             assert row["balls"] == 1001 and row["steps_reaching_their_end"] == row["steps"]
             assert abs(row["clock_s"] - row["steps"] * networks.FRAME) < 1e-9
     assert {"pile e=0", "pile e=0.5", "heap e=0", "heap e=0.5"} <= rows.keys()
+    # the same dense flows under the TC model: every one gets through every step, gaining no energy
+    tc_rows = [name for name in rows if name.endswith(" TC")]
+    assert len(tc_rows) == 10
+    for name in tc_rows:
+        assert rows[name]["contact_duration_s"] > 0.0 and rows[name[: -len(" TC")]]["contact_duration_s"] == 0.0
+        assert rows[name]["energy_gain"] <= 1e-12
     text = page.read_text()
     assert text.startswith("# Contact networks at e < 1\n")
     assert all(f"| {name} |" in text for name in rows)

@@ -26,6 +26,7 @@ class SceneCalendar(NamedTuple):
     heads: np.ndarray  #: (cells,) int32, the first ball of each grid cell
     q: EventQueue  #: the event queue
     inv_mass: np.ndarray  #: (N,) float64, each ball's inverse mass, taken with its radius
+    last_impact: np.ndarray  #: (N,) float64, each ball's last collision instant (the TC model's)
 
 
 class Work(NamedTuple):

@@ -17,6 +17,9 @@ group's size:
    within a few dozen sweeps. The sweeps of one group are bounded: :data:`MAX_SWEEPS`, and at most
    :data:`SWEEP_WORK` contact visits in all (so a group of many contacts gets fewer sweeps, at least
    :data:`MIN_SWEEPS`); sweeps that would take the step past its event budget give way to the limit.
+   Under the TC model (``contact_duration`` > 0) each contact's restitution is 1 when either of its
+   balls' previous collision instants, before the group's, is within ``t_c`` of it
+   (``response.restitution``); the group's instant is recorded once it is resolved.
 3. A cascade still running then is replaced by its **limit** (the settles below): the velocities
    closest to the current ones in the kinetic-energy metric at which every contact of the group
    separates at ``u_min`` or faster, a least-distance problem (Lawson & Hanson 1974, ch. 23):
@@ -63,7 +66,7 @@ from ..layout import C_CELL, EVENTS
 from ..physics.impacts import record
 from ..physics.ldp import least_distance
 from ..physics.periodic import cell_lengths, nearest
-from ..physics.response import ball_ball_along, ball_wall, group_threshold, normal_impulse
+from ..physics.response import ball_ball_along, ball_wall, group_threshold, normal_impulse, restitution
 from ..physics.tolerance import balls_touch, touching_at
 from ..physics.walls import is_low_wall, wall_axis, wall_contact, wall_count, wall_normal, wall_point
 from . import grid
@@ -286,10 +289,11 @@ def cascade_kernel(periodic: bool) -> Any:
             if start >= 0:
                 wk.in_group[start] = True
         # (the sweeps leave room in the budget for the limit's reports, should they not end)
-        outcome, work = _sweep(sc, t_abs, n_contacts, u_min, sweeps, budget - n_contacts - 2, b, ph, wk)
+        outcome, work = _sweep(sc, t_abs, n_contacts, u_min, sweeps, budget - n_contacts - 2, b, ph, cl.last_impact, wk)
         if outcome == OPEN:
             outcome, more = settle_group(sc, t_abs, size, n_contacts, u_min, plastic_row, budget - work, b, ph, wk)
             work += more
+        _record_instant(t_abs, i0, j0, n_contacts, cl.last_impact, wk)
         for q in range(size):
             wk.slot[wk.pending[q]] = -1
             wk.in_group[wk.pending[q]] = False
@@ -321,11 +325,27 @@ def _bring(k, now, b, cl, wk):
         take_in_place(k, now, cl.rec, b)
 
 
+@njit(python=False)
+def _record_instant(t_abs, i0, j0, n_contacts, last, wk):
+    """The TC model's record of a contact group's instant ``t_abs``, once the group is resolved: the
+    last collision instant (``last``) of the impact's balls and of every ball of a contact that took
+    an impulse (was reported)."""
+    for c in range(n_contacts):
+        if wk.c_hit[c]:
+            last[wk.c_a[c]] = t_abs
+            if wk.c_b[c] >= 0:
+                last[wk.c_b[c]] = t_abs
+    last[i0] = t_abs
+    if j0 >= 0:
+        last[j0] = t_abs
+
+
 @njit(inline="always")
-def _sweep(sc, t_abs, n_contacts, u_min, sweeps, budget, b, ph, wk):
+def _sweep(sc, t_abs, n_contacts, u_min, sweeps, budget, b, ph, last, wk):
     """Sweep the contacts, applying each one's impulse, until a sweep changes nothing (:data:`DONE`),
     or ``sweeps`` sweeps have or the work reaches ``budget`` (:data:`OPEN`: the limit is to end the
-    cascade); returns that and the work done (sweeps and impulses)."""
+    cascade); returns that and the work done (sweeps and impulses). Each contact's restitution is the
+    scene's, or 1 under the TC model (``last``: its balls' previous collision instants)."""
     work = 0
     for _ in range(sweeps):
         if work >= budget:
@@ -335,10 +355,11 @@ def _sweep(sc, t_abs, n_contacts, u_min, sweeps, budget, b, ph, wk):
         for c in range(n_contacts):
             a = wk.c_a[c]
             other = wk.c_b[c]
+            e = restitution(ph.e, ph.contact_duration, t_abs, last, a, other)
             if other >= 0:
-                speed = ball_ball_along(a, other, wk.c_f[c, F_DX], wk.c_f[c, F_DY], b.vel, b.inv_mass, ph.e, u_min)
+                speed = ball_ball_along(a, other, wk.c_f[c, F_DX], wk.c_f[c, F_DY], b.vel, b.inv_mass, e, u_min)
             else:
-                speed = ball_wall(a, -1 - other, b.vel, ph.e, u_min)
+                speed = ball_wall(a, -1 - other, b.vel, e, u_min)
             if speed > 0.0:
                 changed = True
                 wk.in_group[a] = True
@@ -347,7 +368,7 @@ def _sweep(sc, t_abs, n_contacts, u_min, sweeps, budget, b, ph, wk):
                 work += 1
                 wk.counters[EVENTS] += 1
                 w = _contact_inv_mass(c, wk.c_a, wk.c_b, b.inv_mass)
-                _record_contact(sc, t_abs, c, speed, normal_impulse(speed, ph.e, u_min, w), b, ph, wk)
+                _record_contact(sc, t_abs, c, speed, normal_impulse(speed, e, u_min, w), b, ph, wk)
                 if work >= budget:
                     return OPEN, work
         if not changed:

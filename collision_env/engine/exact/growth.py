@@ -74,6 +74,7 @@ def make_calendar(n: int, cells: int, inv_mass: np.ndarray) -> SceneCalendar:
         np.full(cells, -1, dtype=np.int32),
         queue,
         inv_mass,
+        np.full(n, -np.inf),
     )
 
 

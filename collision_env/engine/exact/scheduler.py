@@ -86,7 +86,7 @@ from ..layout import (
 from ..physics.impacts import record
 from ..physics.motion import ball_views, has_rotation
 from ..physics.periodic import cell_lengths, nearest, wrap_point
-from ..physics.response import ball_ball_along, ball_wall, impact_threshold, normal_impulse
+from ..physics.response import ball_ball_along, ball_wall, impact_threshold, normal_impulse, restitution
 from ..physics.toi import INF, toi_pair
 from ..physics.walls import snap_to_wall, wall_point
 from ..state import (
@@ -157,6 +157,7 @@ def calendar_arrays(kind: Kind, n_scenes: int, n: int) -> Calendar:
         aligned_zeros((n_scenes, cal.heap_rows(n), len(HEAP)), np.float64),
         np.full((n_scenes, (cal.bucket_count(n) if queues_in_buckets(kind, n) else 0) + 1), -1, dtype=np.int32),
         np.zeros((n_scenes, n)),
+        np.full((n_scenes, n), -np.inf),
     )
 
 
@@ -379,34 +380,36 @@ def prefetch_partner(bj, cl, geo):
 
 # ---------------------------------------------------------------------------- resolve
 @njit(refcount=False, forceinline=True)
-def resolve_wall(sc, t_abs, bi, li, wall, b, ph, wk):
+def resolve_wall(sc, t_abs, bi, li, wall, b, ph, last, wk):
     """Ball ``bi``, row ``li`` of ``b`` (the whole ball state, ``li = bi``, where contact groups
     may form; else the event's rows), meets ``wall``; it is listed in ``wk.pending``. Returns the
-    closing speed (0: no impulse)."""
+    closing speed (0: no impulse). ``last``: each ball's last collision instant (the TC model's)."""
     snap_to_wall(li, wall, b.pos, b.radius, ph.bounds)
     u_min = impact_threshold(li, -1, b.vel, ph.ratio, ph.floor)
-    speed = ball_wall(li, wall, b.vel, ph.e, u_min)
+    e = restitution(ph.e, ph.contact_duration, t_abs, last, bi, -1)
+    speed = ball_wall(li, wall, b.vel, e, u_min)
     if speed > 0.0:
         x, y = wall_point(li, wall, b.pos, ph.bounds)
-        impulse = normal_impulse(speed, ph.e, u_min, b.inv_mass[li])
+        impulse = normal_impulse(speed, e, u_min, b.inv_mass[li])
         record(wk.imp, wk.n_imp, sc, t_abs, bi, -1, wall, x, y, speed, impulse)
     wk.pending[0] = bi
     return speed
 
 
 @njit(refcount=False, forceinline=True)
-def resolve_pair(sc, t_abs, bi, bj, li, lj, dx, dy, b, ph, wk):
+def resolve_pair(sc, t_abs, bi, bj, li, lj, dx, dy, b, ph, last, wk):
     """Balls ``bi`` and ``bj``, rows ``li`` and ``lj`` of ``b`` (as in :func:`resolve_wall`), their
     centres ``(dx, dy)`` apart (in a periodic cell, through the nearest image), meet; they are
     listed in ``wk.pending``. Returns the closing speed (0: no impulse)."""
     pos, vel, radius = b.pos, b.vel, b.radius
     u_min = impact_threshold(li, lj, vel, ph.ratio, ph.floor)
-    speed = ball_ball_along(li, lj, dx, dy, vel, b.inv_mass, ph.e, u_min)
+    e = restitution(ph.e, ph.contact_duration, t_abs, last, bi, bj)
+    speed = ball_ball_along(li, lj, dx, dy, vel, b.inv_mass, e, u_min)
     if speed > 0.0:
         dist = math.sqrt(dx * dx + dy * dy)
         x = pos[li, 0] + radius[li] * dx / dist
         y = pos[li, 1] + radius[li] * dy / dist
-        impulse = normal_impulse(speed, ph.e, u_min, b.inv_mass[li] + b.inv_mass[lj])
+        impulse = normal_impulse(speed, e, u_min, b.inv_mass[li] + b.inv_mass[lj])
         record(wk.imp, wk.n_imp, sc, t_abs, bi, bj, -1, x, y, speed, impulse)
     wk.pending[0] = bi
     wk.pending[1] = bj
@@ -488,7 +491,9 @@ def close_scene(sc, t0, now, horizon_end, sign, dt_abs, state):
 def scene_calendar(calendar, state, sc):
     """Scene ``sc``'s :class:`~.bundles.SceneCalendar` (views of the batch's calendar)."""
     queue = cal.EventQueue(calendar.heap[sc], calendar.buckets[sc], state.work_f[sc], state.work_i[sc])
-    return SceneCalendar(calendar.rec[sc], calendar.ci[sc], calendar.heads[sc], queue, calendar.inv_mass[sc])
+    return SceneCalendar(
+        calendar.rec[sc], calendar.ci[sc], calendar.heads[sc], queue, calendar.inv_mass[sc], calendar.last_impact[sc]
+    )
 
 
 # ---------------------------------------------------------------------------- the scheduler
@@ -539,7 +544,7 @@ def _step(kind: Kind):
             return clusters.resolve_pair(sc, t_abs, bi, bj, b, wk), 0, False
         li = bi if in_place else 0
         if bj < 0:
-            speed = resolve_wall(sc, t_abs, bi, li, cal.EV_WALL - code, ev, ph, wk)
+            speed = resolve_wall(sc, t_abs, bi, li, cal.EV_WALL - code, ev, ph, cl.last_impact, wk)
             n_changed = 1
         else:
             lj = bj if in_place else 1
@@ -549,12 +554,16 @@ def _step(kind: Kind):
                 lx, ly = cell_lengths(ph.bounds, ph.dim)
                 dx = nearest(dx, lx)
                 dy = nearest(dy, ly)
-            speed = resolve_pair(sc, t_abs, bi, bj, li, lj, dx, dy, ev, ph, wk)
+            speed = resolve_pair(sc, t_abs, bi, bj, li, lj, dx, dy, ev, ph, cl.last_impact, wk)
             n_changed = 2
         if cascades:
             if in_place and speed > 0.0:
                 j0 = -1 - (cal.EV_WALL - code) if bj < 0 else bj
                 return cascade(sc, t_abs, now, bi, j0, budget, b, ph, cl, geo, wk)
+            if speed > 0.0:  # (the TC model's record of the instant; a contact group keeps its own)
+                cl.last_impact[bi] = t_abs
+                if bj >= 0:
+                    cl.last_impact[bj] = t_abs
         return n_changed, 0, False
 
     @njit(inline="always")

@@ -42,6 +42,35 @@ grows beyond round-off, and balls that take no part in the impact have no say in
 A positive ``collapse_floor`` (an absolute minimum separation speed, m/s) trades that bound for
 ``1/2 mu collapse_floor^2`` per collision. Elastic scenes are otherwise unaffected.
 
+**The TC model** (opt-in: ``contact_duration`` > 0 s, a Simulator/BatchSimulator setting beside
+the regulariser's; 0, the default, leaves every result as it was). The regulariser keeps
+collapse from stopping the clock, but a dense inelastic flow (a heap settling under gravity, a
+cluster collapsing, a cooling gas's clusters) still collides as often as exact hard-disk dynamics
+says, far more often than any step budget allows. Luding & McNamara (*Granular Matter* 1, 113,
+1998) bound that with a contact duration ``t_c``: a collision is elastic (e = 1) when either ball's
+previous collision happened less than ``t_c`` before it (a ball-wall collision: the ball's), and
+has the scene's ``e`` otherwise (:func:`restitution`). Dissipation then stops where collisions come
+faster than one per ``t_c`` per ball, as it does in a soft-sphere contact lasting ``t_c``, so dense
+regions stay a dense elastic gas instead of collapsing; a dilute gas, whose balls collide far less
+often, is not changed so long as ``t_c`` is much shorter than the time between a ball's
+collisions there: choose ``t_c`` so (the grains' contact duration, where it is known, is the
+model's own reading of it).
+
+Each ball's last collision instant (s on the clock; ``-inf``: none yet) is kept in exact mode's
+calendar, carried by ``copy``/``load`` and, under the model, by ``get_state``/``set_state``
+(``SimulatorState.last_impact``; None in other simulators' states, whose states stay as they
+were); a ball placed afresh (``set_balls``, ``set_scenes``, a reset) has none. Inside a contact
+group resolved at one instant (``exact.contacts``), every contact's restitution comes from its
+balls' collision instants *before* the group's, which is recorded once the group is resolved (for
+the impact's balls and those of every contact that took an impulse), so the impulses of one
+cascade do not make each other elastic; the sweeps apply each contact's own restitution, and a
+cascade that the sweeps do not end goes to its limit, which is the plastic one (separation at
+``u_min``) whatever the contacts' restitutions: energy never grows either way. Exact mode only
+(the cheap modes resolve each pair once per sub-step, with no collision instants: they refuse
+``contact_duration`` > 0), slip scenes only (a stick scene merges colliding balls: refused), and
+forward steps only (which collisions it makes elastic depends on those before: a backward step is
+refused).
+
 The cheap modes (naive, posteriori) resolve each pair once per sub-step, so no cascade runs at one
 instant there; they keep one threshold per scene and sub-step, :func:`elastic_threshold`, relative
 to the scene's slowest moving ball, which bounds the energy it adds the same way.
@@ -104,6 +133,18 @@ def group_threshold(group, size, vel, inv_mass, collapse_ratio, collapse_floor):
         heaviest_inv = min(heaviest_inv, inv_mass[i])
         fastest = max(fastest, speed2)
     return max(collapse_ratio * math.sqrt(energy2 * heaviest_inv), _ROUNDOFF_SPEED * math.sqrt(fastest), collapse_floor)
+
+
+@njit(inline="always")
+def restitution(e, contact_duration, t_abs, last, i, j):
+    """The TC model's restitution of a collision at instant ``t_abs`` of ball ``i`` with ball ``j``
+    (``j < 0``: a wall): 1 if either ball's last collision instant (``last``) was less than
+    ``contact_duration`` before, else the scene's ``e`` (always, with ``contact_duration`` 0: the
+    instants are still recorded, and a backward step may meet them ahead of its clock)."""
+    if contact_duration > 0.0:
+        if t_abs - last[i] < contact_duration or (j >= 0 and t_abs - last[j] < contact_duration):
+            return 1.0
+    return e
 
 
 @njit(inline="always")
