@@ -285,10 +285,12 @@ def bench_public(n: int = 10_000, frames: int = 60, rounds: int = 3) -> dict:
 
     def kernel():
         for _ in range(frames):
-            stepper._n_imp[0] = 0  # (the impact buffer's cursor: each frame's impacts are dropped)
+            stepper.rewind_impacts()  # (each call's impacts are dropped)
             if stepper._kernel(stepper._pack, FRAME, START_STEP) < 0:
                 while stepper._n_imp[2]:  # (a full impact buffer stopped the step: go on, as step does)
+                    stepper.rewind_impacts()
                     stepper._kernel(stepper._pack, FRAME, RESUME)
+        stepper.rewind_impacts()
 
     def step():
         for _ in range(frames):

@@ -48,10 +48,11 @@ class SimulatorState(Mapping[str, Any]):
         return getattr(self, key)
 
     def __iter__(self) -> Iterator[str]:
-        return iter(FIELDS)
+        # (a field a simulator does not keep, None, is left out: ``np.savez(**state)`` stays plain)
+        return (key for key in FIELDS if getattr(self, key) is not None)
 
     def __len__(self) -> int:
-        return len(FIELDS)
+        return sum(1 for _ in self)
 
     def __eq__(self, other: object) -> bool:
         """Equal when every field holds the same values (``np.array_equal``)."""

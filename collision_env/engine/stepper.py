@@ -539,7 +539,8 @@ class Stepper:
             if not n_imp[2]:  # no scene stalled
                 if len(chunks) > 1:  # the next steps like this one fit the buffer, up to MAX_IMPACT_ROWS
                     total = sum(len(chunk) for chunk in chunks)
-                    size = min(MAX_IMPACT_ROWS, 1 << (total - 1).bit_length())
+                    # (twice the step's rows: a step starts anywhere up to half way along)
+                    size = min(MAX_IMPACT_ROWS, 1 << (2 * total - 1).bit_length())
                     if size > len(self._imp):
                         self._fresh_buffer(size)
                 return chunks
@@ -581,6 +582,15 @@ class Stepper:
         if end > self._refill_at:
             self._fresh_buffer(len(self._imp))
         return rows
+
+    def rewind_impacts(self) -> None:
+        """Drop the impacts recorded since the last hand-over, for a caller that calls the kernel
+        itself and keeps none (a benchmark): the next call records from the first row of the buffer,
+        or of a new one if rows of this one were handed out (they stay as they are)."""
+        if self._cursor:
+            self._fresh_buffer(len(self._imp))
+        else:
+            self._n_imp[0] = 0
 
     def _fresh_buffer(self, rows: int) -> None:
         """Record impacts from the first row of a new buffer of ``rows`` rows (what was handed out of
@@ -639,6 +649,10 @@ class Stepper:
         """Take ``other``'s whole state in place (the caller checked that it fits)."""
         for mine, theirs in zip(self.stepped_arrays(), other.stepped_arrays(), strict=True):
             np.copyto(mine, theirs)
+        if self.spec.persistent and other.settings.contact_duration == 0.0:
+            # (instants a simulator without the TC model kept are no history for one with it: its
+            # backward steps may have taken the clock back past them)
+            self.mode_arrays[0].last_impact[:] = -np.inf
         for field in (S_ELASTICITY, S_SIGN):  # (the direction of time the state is kept for)
             self.fparams[field] = other.fparams[field]
         self._sign = other._sign

@@ -570,11 +570,12 @@ def checked_settings(
         raise ValueError(f"substeps: {mode} mode resolves every event at its exact time; substeps must be 1")
     if max_events is not None:
         max_events = positive_integer(max_events, "max_events", MAX_EVENT_CAP)
-    if not (is_real(collapse_ratio) and 0.0 <= float(collapse_ratio) < 1.0):
+    # (compared as given: a huge int has no float, and float() of it would raise OverflowError)
+    if not (is_real(collapse_ratio) and 0.0 <= collapse_ratio < 1.0):
         raise ValueError(f"collapse_ratio: must be a number in [0, 1), got {collapse_ratio!r}")
-    if not (is_real(collapse_floor) and 0.0 <= float(collapse_floor) < MAX_MAGNITUDE):
+    if not (is_real(collapse_floor) and 0.0 <= collapse_floor < MAX_MAGNITUDE):
         raise ValueError(f"collapse_floor: must be a finite speed >= 0 (m/s), got {collapse_floor!r}")
-    if not (is_real(contact_duration) and 0.0 <= float(contact_duration) < MAX_MAGNITUDE):
+    if not (is_real(contact_duration) and 0.0 <= contact_duration < MAX_MAGNITUDE):
         raise ValueError(f"contact_duration: must be a finite time >= 0 (s), got {contact_duration!r}")
     if float(contact_duration) > 0.0 and mode != "exact":
         raise ValueError(
@@ -709,7 +710,8 @@ def checked_state(
     if last_impact is not None:
         clocks = arrays["time"]
         refuse_first(
-            last_impact > clocks[:, None],
+            # (an instant at a step's very end may round an ulp above the compensated clock)
+            last_impact > np.nextafter(clocks, np.inf)[:, None],
             label,
             lambda s, i: f"a last collision instant after the clock ({clocks[s]:g} s), got {last_impact[s, i]:g}",
             field="state last_impact",

@@ -24,6 +24,7 @@ def test_quick_run_writes_every_row_and_the_struck_rows_reach_every_step_end(tmp
     for name in tc_rows:
         assert rows[name]["contact_duration_s"] > 0.0 and rows[name[: -len(" TC")]]["contact_duration_s"] == 0.0
         assert rows[name]["energy_gain"] <= 1e-12
+        assert rows[name]["steps_reaching_their_end"] == rows[name]["steps"]
     text = page.read_text()
     assert text.startswith("# Contact networks at e < 1\n")
     assert all(f"| {name} |" in text for name in rows)

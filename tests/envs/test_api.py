@@ -291,7 +291,7 @@ def test_info_is_fresh_and_impacts_match_the_engine():
             assert x in (-2.0, 2.0) or y in (-1.0, 1.0)  # contact points lie exactly on the walls
         # (the info's records are its own: a view of the engine's impact buffer would keep it
         # alive whole for as long as the info is kept)
-        assert not np.shares_memory(imp.array, env.core.batch._stepper._imp)
+        assert not isinstance(imp.array.base, np.ndarray)  # (a view of any impact buffer has one as its base)
         if term or trunc:
             break
     assert seen > 0

@@ -560,10 +560,6 @@ def _step(kind: Kind):
             if in_place and speed > 0.0:
                 j0 = -1 - (cal.EV_WALL - code) if bj < 0 else bj
                 return cascade(sc, t_abs, now, bi, j0, budget, b, ph, cl, geo, wk)
-            if speed > 0.0:  # (the TC model's record of the instant; a contact group keeps its own)
-                cl.last_impact[bi] = t_abs
-                if bj >= 0:
-                    cl.last_impact[bj] = t_abs
         return n_changed, 0, False
 
     @njit(inline="always")

@@ -139,8 +139,7 @@ def group_threshold(group, size, vel, inv_mass, collapse_ratio, collapse_floor):
 def restitution(e, contact_duration, t_abs, last, i, j):
     """The TC model's restitution of a collision at instant ``t_abs`` of ball ``i`` with ball ``j``
     (``j < 0``: a wall): 1 if either ball's last collision instant (``last``) was less than
-    ``contact_duration`` before, else the scene's ``e`` (always, with ``contact_duration`` 0: the
-    instants are still recorded, and a backward step may meet them ahead of its clock)."""
+    ``contact_duration`` before, else the scene's ``e`` (always, with ``contact_duration`` 0)."""
     if contact_duration > 0.0:
         if t_abs - last[i] < contact_duration or (j >= 0 and t_abs - last[j] < contact_duration):
             return 1.0
