@@ -8,10 +8,11 @@ Part **modes**: each preset of ``--envs`` (default: every preset) is trained wit
 hyperparameters under each engine mode of ``--modes`` (``mode:substeps``, default naive k=1,
 posteriori k=1, posteriori k=4 and exact), over several seeds; every policy is then evaluated
 deterministically in **exact** mode (and in its own training mode) on the same 100 episodes. The
-tables give success per seed, its mean and spread, the wall-clock training time and the engine's
-share of it, so the trade is read off directly: is a policy trained on a cheaper, less exact engine
-as good when the impacts are exact, and how much training time did the cheaper engine save? The
-trade table sums it up per preset, the Pareto figure (``pareto.png``) sets training time against
+tables give success per seed, its mean and spread, the training time (wall-clock, and the training
+process's CPU time, which a shared machine's load does not stretch) and the engine's share of it,
+so the trade is read off directly: is a policy trained on a cheaper, less exact engine as good
+when the impacts are exact, and how much training time did the cheaper engine save? The trade
+table sums it up per preset, the Pareto figure (``pareto.png``) sets training time against
 exact-evaluated success, and the rule says, from the same figures, where training cheap pays and
 where it costs points (``Pegs`` and ``Fence``, the presets built for it: small, fast balls, narrow
 targets, long control steps; in ``Fence`` the one shot commits the outcome before any impact is seen).
@@ -104,6 +105,7 @@ def train_and_evaluate(task: dict) -> dict:
         **task,
         "run": str(run_dir),
         "train_seconds": run["train_seconds"],
+        "train_cpu_seconds": run["train_cpu_seconds"],
         "timesteps_done": run["timesteps_done"],
         "time_split": run["time_split"],
         "observe": _observation(run["env_kwargs"]),
@@ -165,6 +167,12 @@ def _seconds(rows: list) -> float:
     return statistics.median(r["train_seconds"] for r in rows)
 
 
+def _cpu(rows: list) -> str:
+    """Median training CPU time over seeds, in seconds ("n/a" for runs recorded before it was measured)."""
+    times = [r["train_cpu_seconds"] for r in rows if r.get("train_cpu_seconds") is not None]
+    return f"{statistics.median(times):.0f}" if len(times) == len(rows) else "n/a"
+
+
 def _engine_share(rows: list) -> float | None:
     """Median over seeds of the engine's share of the training time (None where it was not timed)."""
     shares = [r["time_split"]["engine"] / r["train_seconds"] for r in rows if r["time_split"]["engine"] is not None]
@@ -198,8 +206,8 @@ def modes_table(rows: list) -> str:
             "time: median over seeds.",
             "",
             "| trained in | success, evaluated exact | per seed | success in its own mode | "
-            "training time (s) | ÷ exact's | engine's share of it |",
-            "|---|---:|---:|---:|---:|---:|---:|",
+            "training time (s) | ÷ exact's | CPU time (s) | engine's share of it |",
+            "|---|---:|---:|---:|---:|---:|---:|---:|",
         ]
         exact_rows = groups.get(("exact", 1))
         exact_time = _seconds(exact_rows) if exact_rows else None
@@ -210,7 +218,7 @@ def modes_table(rows: list) -> str:
             ratio = f"{secs / exact_time:.2f}" if exact_time else "n/a"
             lines.append(
                 f"| {_label(mode, k)} | {_spread(exact)} | {' / '.join(pct(x) for x in exact)} | "
-                f"{_spread(own)} | {secs:.0f} | {ratio} | {_share(_engine_share(rs))} |"
+                f"{_spread(own)} | {secs:.0f} | {ratio} | {_cpu(rs)} | {_share(_engine_share(rs))} |"
             )
         tables.append("\n".join(lines))
     return "\n\n".join(tables)
@@ -360,7 +368,8 @@ def presets_table(rows: list, base: list) -> str:
     lines = [
         f"Every preset, PPO in exact mode, beside the baselines on the same "
         f"{episodes} evaluation episodes (success rate; mean return in brackets). PPO: mean ± standard "
-        "deviation over seeds, then each seed; training time: median over seeds, with the engine's share of it. "
+        "deviation over seeds, then each seed; training time: median over seeds, wall-clock and the training "
+        "process's CPU time (n/a: not measured then), with the engine's share of the wall-clock. "
         "Setting: the observation and the control of the shipped hyperparameter entry (marked *shipped*), and "
         "beside it the plain observation where the entry changes it (`predicted`: the env's "
         '`observe="predicted"`, each ball\'s next wall impact as the engine predicts it; `predicted (scoring)`: '
@@ -375,8 +384,8 @@ def presets_table(rows: list, base: list) -> str:
         "under either control).",
         "",
         "| env | setting | steps | PPO success | per seed | PPO return | random | scripted (exact aim) | "
-        "training time (s) | engine's share |",
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "training time (s) | CPU time (s) | engine's share |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     fmt = lambda p: "n/a" if p is None else f"{pct(p['success_rate'])} ({p['mean_return']:.2f})"  # noqa: E731
     for (env_id, setting), rs in groups.items():
@@ -387,7 +396,7 @@ def presets_table(rows: list, base: list) -> str:
         lines.append(
             f"| `{env_id}` | {label} | {rs[0]['timesteps_done']:,} | {_spread(succ)} | "
             f"{' / '.join(pct(x) for x in succ)} | {ret:.2f} | {fmt(b.get('random'))} | "
-            f"{fmt(b.get('scripted'))} | {_seconds(rs):.0f} | {_share(_engine_share(rs))} |"
+            f"{fmt(b.get('scripted'))} | {_seconds(rs):.0f} | {_cpu(rs)} | {_share(_engine_share(rs))} |"
         )
     return "\n".join(lines)
 
@@ -407,8 +416,8 @@ def split_table(rows: list) -> str:
         "Where the training time goes (`agents.timing`: timers around the engine's step, the env's step, the "
         "policy's forward passes and PPO's update, in every training run above; median share over seeds):",
         "",
-        "| env | setting | trained in | training time (s) | " + " | ".join(PARTS) + " |",
-        "|---|---|---|---:|" + "---:|" * len(PARTS),
+        "| env | setting | trained in | training time (s) | CPU time (s) | " + " | ".join(PARTS) + " |",
+        "|---|---|---|---:|---:|" + "---:|" * len(PARTS),
     ]
     for (env_id, setting, mode, k), runs in groups.items():
         rs = list(runs.values())
@@ -416,7 +425,11 @@ def split_table(rows: list) -> str:
         for part in PARTS:
             shares = [r["time_split"][part] / r["train_seconds"] for r in rs if r["time_split"][part] is not None]
             cells.append(_share(statistics.median(shares) if shares else None))
-        lines.append(f"| `{env_id}` | {setting} | {_label(mode, k)} | {_seconds(rs):.0f} | " + " | ".join(cells) + " |")
+        lines.append(
+            f"| `{env_id}` | {setting} | {_label(mode, k)} | {_seconds(rs):.0f} | {_cpu(rs)} | "
+            + " | ".join(cells)
+            + " |"
+        )
     return "\n".join(lines)
 
 

@@ -1,4 +1,4 @@
-"""Where a PPO training run's wall-clock time goes.
+"""Where a PPO training run's wall-clock time goes, and the CPU time it took.
 
 :func:`time_split` is a callback that wraps, on one model's policy and env (instance attributes
 only, nothing global, removed when training ends), the calls that make up stable-baselines3's PPO
@@ -17,10 +17,15 @@ its ``on_rollout_end``, an update from there to the next rollout):
 
 The engine is timed only with the native vector env (SB3's dummy and subprocess vector envs build
 their own envs); then its part is ``None``. The timers cost a ``perf_counter`` pair per call.
+
+On a machine shared with other work the wall-clock time of a run grows with the load, while its CPU
+time (:func:`cpu_seconds`: user and system time, summed over the process's threads and its ended
+child processes) stays that of the work done: a run's ``config.yml`` records both.
 """
 
 from __future__ import annotations
 
+import sys
 import time
 from collections import defaultdict
 from typing import Any
@@ -36,6 +41,21 @@ PARTS = (
     "rollout bookkeeping",
     "other",
 )
+
+
+def cpu_seconds() -> float:
+    """CPU time (user + system, s) of this process so far, every thread of it, plus that of its
+    child processes that have ended and been waited for (``resource.getrusage``; on a platform
+    without it, this process's own, ``time.process_time``).
+
+    The workers of SB3's ``SubprocVecEnv`` count once the vector env is closed (which waits for
+    them); the native vector env and ``DummyVecEnv`` step in this process."""
+    if sys.platform == "win32":
+        return time.process_time()
+    import resource
+
+    own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
 
 
 def time_split(venv: Any) -> Any:

@@ -14,7 +14,7 @@ The run folder (``--output``/``--run-name``) holds:
 
 | file | what |
 |---|---|
-| ``config.yml`` | the resolved settings: env id and kwargs, hyperparameters, seed, versions, training time, its split |
+| ``config.yml`` | the resolved settings (env, hyperparameters, seed), versions, wall and CPU training time, its split |
 | ``model.zip`` | the final policy (``PPO.load``) |
 | ``vecnormalize.pkl`` | VecNormalize statistics (when the entry normalises) |
 | ``best_model.zip``, ``eval/evaluations.npz`` | EvalCallback's best policy and its evaluation log |
@@ -471,27 +471,35 @@ def train(
     callbacks = _callbacks(
         run_dir, eval_env, seed + EVAL_SEED_OFFSET, n_envs, eval_freq, eval_episodes, save_freq, norm is not None
     )
-    from agents.timing import time_split
+    from agents.timing import cpu_seconds, time_split
 
     timer = time_split(venv)
     callbacks.append(timer)
+    cpu = cpu_seconds()
     start = time.perf_counter()
     with log_tee(log, None if progress else run_dir / LOG_FILE) as log_line:
         if not progress:  # no bar: progress lines in the log instead (and in train.log)
             callbacks.append(_progress_log(timesteps, log_line))
         model.learn(total_timesteps=timesteps, callback=callbacks, progress_bar=progress, tb_log_name="ppo")
     seconds = time.perf_counter() - start
+    cpu = cpu_seconds() - cpu  # before saving: the training's own CPU time (subprocess workers: below)
     model.save(run_dir / MODEL_FILE)
     if norm is not None:
         venv.save(str(run_dir / VECNORMALIZE_FILE))  # type: ignore[attr-defined]
-    config["train_seconds"] = round(seconds, 2)
-    config["time_split"] = {k: None if v is None else round(v, 4) for k, v in timer.split(seconds).items()}
-    config["timesteps_done"] = int(model.num_timesteps)
-    write_yaml(run_dir / CONFIG_FILE, config)
+    children = cpu_seconds()
     venv.close()
     if eval_env is not None:
         eval_env.close()
-    log(f"trained {model.num_timesteps:,} steps in {seconds:.0f} s ({model.num_timesteps / seconds:,.0f} steps/s)")
+    cpu += cpu_seconds() - children  # subprocess workers count once closed (0 for the native env)
+    config["train_seconds"] = round(seconds, 2)
+    config["train_cpu_seconds"] = round(cpu, 2)
+    config["time_split"] = {k: None if v is None else round(v, 4) for k, v in timer.split(seconds).items()}
+    config["timesteps_done"] = int(model.num_timesteps)
+    write_yaml(run_dir / CONFIG_FILE, config)
+    log(
+        f"trained {model.num_timesteps:,} steps in {seconds:.0f} s wall-clock, {cpu:.0f} CPU s "
+        f"({model.num_timesteps / seconds:,.0f} steps/s)"
+    )
     try:
         plot_learning_curve(run_dir, title=f"PPO on {env_id} ({mode}, substeps {substeps}), seed {seed}")
     except MissingExtra as err:  # the run is complete without its picture: say so and go on

@@ -125,6 +125,7 @@ def test_train_save_reload_evaluate_and_record(tmp_path):
     assert list(split) == list(timing.PARTS) and all(v >= 0 for v in split.values())
     assert split["engine"] > 0 and split["policy forward, acting"] > 0 and split["backward and optimiser"] > 0
     assert sum(split.values()) == pytest.approx(cfg["train_seconds"], abs=0.05)
+    assert cfg["train_cpu_seconds"] > 0  # the process's CPU time, beside the wall-clock
 
     log = np.load(run / "eval" / "evaluations.npz")
     assert log["timesteps"].tolist() == [1024, 2048] and log["results"].shape == (2, 2)
@@ -249,6 +250,13 @@ def test_record_mp4(tmp_path):
     assert path.stat().st_size > 1000
 
 
+def test_cpu_seconds_counts_this_process_and_its_ended_children():
+    before = timing.cpu_seconds()
+    code = "import time; sum(i * i for i in range(2_000_000)); print(time.process_time())"
+    child = float(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout)
+    assert child > 0 and timing.cpu_seconds() - before >= child  # the child's CPU time, counted once it ended
+
+
 def test_training_on_sb3_dummy_vec_env_and_other_mode(tmp_path):
     run = train_ppo.train(
         "CollisionEnv/Line1D-v0",
@@ -362,7 +370,7 @@ def test_study_by_default_trains_every_mode_of_the_trade_and_draws_its_pareto_fi
     )
     for r in data["rows"]:  # every policy evaluated exact, and in its own mode
         assert 0.0 <= r["exact"]["success_rate"] <= 1.0 and 0.0 <= r["own"]["success_rate"] <= 1.0
-        assert r["train_seconds"] > 0 and r["time_split"]["engine"] is not None
+        assert r["train_seconds"] > 0 and r["train_cpu_seconds"] > 0 and r["time_split"]["engine"] is not None
     assert (docs / "pareto.png").stat().st_size > 0
     page = (docs / "modes.md").read_text()
     assert "| `CollisionEnv/Pegs-v0` |" in page and "| posteriori k=4 |" in page and "pareto.png" in page
