@@ -422,9 +422,12 @@ class TaskCore:
         if bad >= 0:
             where = f"sub-env {bad}: " if self.num_scenes > 1 else ""
             raise ValueError(f"{where}action contains NaN: {actions[bad].tolist()}")
+        imp = self.batch.step(dt).array
+        if not len(imp):  # (most steps: the engine's one shared, read-only empty array)
+            return imp
         # (a copy: the engine's records are a view of its impact buffer, which an info kept for long,
         # an episode's last say, would keep alive whole)
-        imp = copy_records(self.batch.step(dt).array)
+        imp = copy_records(imp)
         imp.flags.writeable = False  # (the kernels take the records read-only: one compiled version)
         return imp
 
