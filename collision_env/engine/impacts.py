@@ -70,8 +70,9 @@ class Impact(NamedTuple):
 def copy_records(rows: np.ndarray) -> np.ndarray:
     """A copy of impact records ``rows`` (C-contiguous), in memory of its own: for records kept
     long, so that they do not keep alive the impact buffer a step's records are a view of (numpy
-    copies structured arrays slowly: a byte copy is several times cheaper)."""
-    return np.frombuffer(bytearray(rows), dtype=rows.dtype)
+    copies structured arrays slowly, and a structured array's buffer describes its fields in a format
+    string each time: a byte copy of its bytes, 0.75 us for 50 records, is several times cheaper)."""
+    return np.ndarray(len(rows), rows.dtype, bytearray(rows.view(np.uint8)))
 
 
 def _impact(row: tuple) -> Impact:
