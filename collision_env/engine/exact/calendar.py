@@ -51,6 +51,7 @@ from ..layout import (
     W_QUEUE_BUCKET,
     W_QUEUE_FAR,
     W_QUEUE_HEAP,
+    W_QUEUE_NEXT,
     W_QUEUE_RELEASE,
     W_QUEUE_RING,
     W_QUEUE_WIDTH,
@@ -323,7 +324,9 @@ def _position(t, q):
     if x < bucket + 1:
         return -1
     if x < bucket + ring + 1:
-        return int(x) % ring
+        # (bucket int(x) % ring, counted on from the next bucket's place: no integer division)
+        p = q.qi[W_QUEUE_NEXT] + (int(x) - bucket - 1)
+        return p - ring if p >= ring else p
     return ring  # (also an event that never comes, t = inf)
 
 
@@ -441,6 +444,7 @@ def _open_next_bucket(rec, ci, q):
     q.qi[W_QUEUE_BUCKET] += 1
     bucket = q.qi[W_QUEUE_BUCKET]
     p = bucket % ring
+    q.qi[W_QUEUE_NEXT] = (bucket + 1) % ring
     ball = q.buckets[p]
     q.buckets[p] = -1
     while ball >= 0:
@@ -471,7 +475,7 @@ def walk_next_bucket(cursor, rec, ci, q):
     ring = _ring_size(q)
     if ring == 0:
         return -1
-    p = (q.qi[W_QUEUE_BUCKET] + 1) % ring
+    p = q.qi[W_QUEUE_NEXT]
     ball = q.buckets[p] if cursor < 0 or ci[cursor, C_QUEUE_SLOT] != -1 - p else ci[cursor, C_QUEUE_NEXT]
     if ball >= 0:
         prefetch_int_row(ball, ci)
@@ -557,6 +561,7 @@ def reset_queue(n, now, width, rec, ci, q):
     q.qi[W_QUEUE_RING] = 0
     q.qi[W_QUEUE_FAR] = 0
     q.qi[W_QUEUE_BUCKET] = 0
+    q.qi[W_QUEUE_NEXT] = 1 % max(ring, 1)
     q.qi[W_QUEUE_RELEASE] = ring
     q.qf[W_QUEUE_BASE] = now
     q.qf[W_QUEUE_WIDTH] = width
