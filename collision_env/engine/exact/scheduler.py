@@ -87,7 +87,7 @@ from ..physics.impacts import record
 from ..physics.motion import ball_views, has_rotation
 from ..physics.periodic import cell_lengths, nearest, wrap_point
 from ..physics.response import ball_ball_along, ball_wall, impact_threshold, normal_impulse, restitution
-from ..physics.toi import INF, toi_pair
+from ..physics.toi import INF, not_before, toi_pair
 from ..physics.walls import snap_to_wall, wall_point
 from ..state import (
     EXACT_FRAMES_SLOT,
@@ -106,7 +106,7 @@ from . import calendar as cal
 from . import clusters, contacts, grid
 from . import periodic as cyclic
 from .bundles import SceneCalendar, work
-from .trajectories import load, not_before, pair_gap, pair_time, store, take, take_in_place, wall_time
+from .trajectories import load, pair_gap, pair_time, store, take, take_in_place, wall_time
 
 
 class Kind(NamedTuple):
