@@ -65,6 +65,25 @@ def load(k, t, rec, pos, vel, row):
     r["ref_time"] = t
 
 
+@njit(inline="always")
+def settle(k, t, rec, pos, vel):
+    """End a step at step time ``t`` for ball ``k``: its record moved there and its times made
+    relative to it (its reference time 0, its event's time less ``t``), its position and velocity
+    into its row of the ball state (events resolved on their own rows left it behind)."""
+    r = rec[k]
+    dt = t - r["ref_time"]
+    x = r["x"] + r["vx"] * dt
+    y = r["y"] + r["vy"] * dt
+    r["x"] = x
+    r["y"] = y
+    r["ref_time"] = 0.0
+    r["event_time"] -= t
+    pos[k, 0] = x
+    pos[k, 1] = y
+    vel[k, 0] = r["vx"]
+    vel[k, 1] = r["vy"]
+
+
 @njit(refcount=False, forceinline=True)
 def take(k, row, t, cl, ev):
     """Ball ``k``, moved in its record to step time ``t``, into row ``row`` of an event's balls."""
