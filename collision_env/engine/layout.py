@@ -103,16 +103,16 @@ WORK_F = (
 #: stopped because the impact buffer was full; sub-steps done (cheap modes); the calendar holds
 #: valid predictions (0 after anything that changes a scene wholesale: a reset, ``set_state``);
 #: the grid's cells along x and y; the event queue: the bucket last moved into its heap, the bucket
-#: at which its far list is next sorted into buckets, and how many events its heap, its buckets
-#: and its far list hold.
+#: at which its far list is next sorted into buckets, how many events its heap, its buckets
+#: and its far list hold, and the place in the ring of the bucket after the last one moved.
 WORK_I = (
     "events", "active", "stalled", "substeps_done", "calendar_valid", "grid_nx", "grid_ny", "queue_bucket",
-    "queue_release", "queue_heap", "queue_ring", "queue_far",
+    "queue_release", "queue_heap", "queue_ring", "queue_far", "queue_next",
 )  # fmt: skip
 (
     W_EVENTS, W_ACTIVE, W_STALLED, W_SUBSTEPS_DONE, W_CALENDAR_VALID, W_GRID_NX, W_GRID_NY, W_QUEUE_BUCKET,
-    W_QUEUE_RELEASE, W_QUEUE_HEAP, W_QUEUE_RING, W_QUEUE_FAR,
-) = range(12)  # fmt: skip
+    W_QUEUE_RELEASE, W_QUEUE_HEAP, W_QUEUE_RING, W_QUEUE_FAR, W_QUEUE_NEXT,
+) = range(13)  # fmt: skip
 
 #: One row per impact, as ``BatchSimulator.step`` returns them (the kernels write them).
 IMPACT_DTYPE = np.dtype(

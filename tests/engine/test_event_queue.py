@@ -124,10 +124,8 @@ def run_queue(width, rec, ci, hp, buckets, qf, qi, kinds, balls, times):
         if not walk_in_next_bucket(walk, walked, ci, q):
             return firsts, k
         walk = walked
-        if kinds[k] == REBASE:
-            for i in range(n):
-                rec[i]["event_time"] -= times[k]
-            cal.rebase_queue(n, times[k], rec, ci, q)
+        if kinds[k] == REBASE:  # (a step's end: the balls, at rest, keep their places)
+            cal.finish_queue(n, times[k], rec, ci, q, np.zeros((n, 2)), np.zeros((n, 2)))
         elif kinds[k] == MOVE or first >= 0:
             ball = balls[k] if kinds[k] == MOVE else first
             rec[ball]["event_time"] = times[k] + (rec[ball]["event_time"] if kinds[k] == POP else 0.0)

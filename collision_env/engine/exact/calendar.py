@@ -51,10 +51,12 @@ from ..layout import (
     W_QUEUE_BUCKET,
     W_QUEUE_FAR,
     W_QUEUE_HEAP,
+    W_QUEUE_NEXT,
     W_QUEUE_RELEASE,
     W_QUEUE_RING,
     W_QUEUE_WIDTH,
 )
+from .trajectories import settle
 
 INF = np.inf
 
@@ -323,7 +325,9 @@ def _position(t, q):
     if x < bucket + 1:
         return -1
     if x < bucket + ring + 1:
-        return int(x) % ring
+        # (bucket int(x) % ring, counted on from the next bucket's place: no integer division)
+        p = q.qi[W_QUEUE_NEXT] + (int(x) - bucket - 1)
+        return p - ring if p >= ring else p
     return ring  # (also an event that never comes, t = inf)
 
 
@@ -441,6 +445,7 @@ def _open_next_bucket(rec, ci, q):
     q.qi[W_QUEUE_BUCKET] += 1
     bucket = q.qi[W_QUEUE_BUCKET]
     p = bucket % ring
+    q.qi[W_QUEUE_NEXT] = (bucket + 1) % ring
     ball = q.buckets[p]
     q.buckets[p] = -1
     while ball >= 0:
@@ -471,7 +476,7 @@ def walk_next_bucket(cursor, rec, ci, q):
     ring = _ring_size(q)
     if ring == 0:
         return -1
-    p = (q.qi[W_QUEUE_BUCKET] + 1) % ring
+    p = q.qi[W_QUEUE_NEXT]
     ball = q.buckets[p] if cursor < 0 or ci[cursor, C_QUEUE_SLOT] != -1 - p else ci[cursor, C_QUEUE_NEXT]
     if ball >= 0:
         prefetch_int_row(ball, ci)
@@ -557,6 +562,7 @@ def reset_queue(n, now, width, rec, ci, q):
     q.qi[W_QUEUE_RING] = 0
     q.qi[W_QUEUE_FAR] = 0
     q.qi[W_QUEUE_BUCKET] = 0
+    q.qi[W_QUEUE_NEXT] = 1 % max(ring, 1)
     q.qi[W_QUEUE_RELEASE] = ring
     q.qf[W_QUEUE_BASE] = now
     q.qf[W_QUEUE_WIDTH] = width
@@ -573,30 +579,41 @@ def reset_queue(n, now, width, rec, ci, q):
     _heapify(size, ci, q.hp)
 
 
+@njit(inline="always")
+def _refile_ball(i, size, moved, rec, ci, q):
+    """After a rebase: move ball ``i``'s event if its rebased time fell into another bucket, or into
+    or out of the heap (of ``size`` events, left out of order: ``moved`` becomes True if it
+    changed). Returns the heap's new size and ``moved``."""
+    p = _position(rec[i]["event_time"], q)
+    slot = ci[i, C_QUEUE_SLOT]
+    if slot >= 0 and p >= 0:
+        size = _vacate(slot, size, ci, q.hp)
+        _link(i, p, ci, q)
+        moved = True
+    elif slot < 0 and p != -1 - slot:
+        _unlink(i, ci, q)
+        if p < 0:
+            _place(size, i, rec[i]["event_time"], ci, q.hp)
+            size += 1
+            moved = True
+        else:
+            _link(i, p, ci, q)
+    return size, moved
+
+
 # Called once per step in scenes with buckets: a call of its own, so that small scenes do not
 # carry its code.
 @njit(refcount=False, python=False)
-def _refile(n, rec, ci, q):
-    """After a rebase: move every event whose rebased time fell into another bucket, or into or
-    out of the heap (the heap is left out of order: returns True if it changed)."""
+def _settle_and_refile(n, t, rec, ci, q, pos, vel):
+    """Bring every ball to step time ``t`` (:func:`~.trajectories.settle`) and move every event
+    whose rebased time fell into another bucket, or into or out of the heap (the heap is left out
+    of order: returns True if it changed), in one pass over the balls: each ball's record is read
+    once at a step's end."""
     size = q.qi[W_QUEUE_HEAP]
-    hp = q.hp
     moved = False
     for i in range(n):
-        p = _position(rec[i]["event_time"], q)
-        slot = ci[i, C_QUEUE_SLOT]
-        if slot >= 0 and p >= 0:
-            size = _vacate(slot, size, ci, hp)
-            _link(i, p, ci, q)
-            moved = True
-        elif slot < 0 and p != -1 - slot:
-            _unlink(i, ci, q)
-            if p < 0:
-                _place(size, i, rec[i]["event_time"], ci, hp)
-                size += 1
-                moved = True
-            else:
-                _link(i, p, ci, q)
+        settle(i, t, rec, pos, vel)
+        size, moved = _refile_ball(i, size, moved, rec, ci, q)
     q.qi[W_QUEUE_HEAP] = size
     return moved
 
@@ -604,7 +621,7 @@ def _refile(n, rec, ci, q):
 @njit(refcount=False, forceinline=True)
 def _rebase_heap(size, t, hp):
     """Subtract ``t`` from the heap's times; True if round-off made a node and its parent tie (see
-    :func:`rebase_queue`)."""
+    :func:`finish_queue`)."""
     disorder = False
     for slot in range(size):
         row = slot + HEAP_OFFSET
@@ -617,23 +634,28 @@ def _rebase_heap(size, t, hp):
 
 @njit(refcount=False, forceinline=True)
 def heap_rebase(n, t, rec, ci, q):
-    """:func:`rebase_queue` in a queue without buckets."""
+    """Make a heap of every ball's times relative to step time ``t``, after every ball's event time
+    was (the caller's): as :func:`finish_queue` does."""
     if _rebase_heap(n, t, q.hp):
         _heapify(n, ci, q.hp)
 
 
 @njit(refcount=False, forceinline=True)
-def rebase_queue(n, t, rec, ci, q):
-    """Make the queue's times relative to step time ``t``, after every ball's event time was (the
-    caller's): the heap's times and the buckets' base are rebased the same way. Round-off can move
-    a time across a bucket boundary, or round a heap node's and its parent's times into a tie
-    (which the tie rule, :func:`order_key`, may order the other way): such events are moved and
-    the heap is re-ordered, which is rare. Subtracting the same number keeps every other pair in
-    order."""
+def finish_queue(n, t, rec, ci, q, pos, vel):
+    """End a step at step time ``t``: every ball brought there (:func:`~.trajectories.settle`: its
+    record, with its times made relative to ``t``, and its row of the ball state ``pos``, ``vel``),
+    and the queue's times made relative to it the same way: the heap's times and the buckets' base.
+    Round-off can move a time across a bucket boundary, or round a heap node's and its parent's
+    times into a tie (which the tie rule, :func:`order_key`, may order the other way): such events
+    are moved and the heap is re-ordered, which is rare. Subtracting the same number keeps every
+    other pair in order."""
     disorder = _rebase_heap(_heap_size(rec, q), t, q.hp)
     if _ring_size(q) > 0:
         q.qf[W_QUEUE_BASE] -= t
-        disorder = _refile(n, rec, ci, q) or disorder
+        disorder = _settle_and_refile(n, t, rec, ci, q, pos, vel) or disorder
+    else:
+        for i in range(n):
+            settle(i, t, rec, pos, vel)
     if disorder:
         _heapify(_heap_size(rec, q), ci, q.hp)
 
@@ -656,17 +678,17 @@ def is_stale(ball, rec, ci):
 
 class QueueOps(NamedTuple):
     """The event queue's operations as the scheduler calls them, for one kind of queue: build it
-    afresh, move an event after its time changed, the ball whose event comes first, rebase its
-    times at a step's end, and a step of the walk ahead of the next bucket."""
+    afresh, move an event after its time changed, the ball whose event comes first, and a step of
+    the walk ahead of the next bucket. (A step's end is :func:`finish_queue` for either, or
+    :func:`heap_rebase` where the balls are there already.)"""
 
     build: Callable[..., Any]
     schedule: Callable[..., Any]
     first: Callable[..., Any]
-    rebase: Callable[..., Any]
     walk: Callable[..., Any]
 
 
 #: A heap of every ball (scenes of fewer than :data:`QUEUE_MIN_BALLS` balls), and Paul's two-level
 #: queue of a heap and time buckets.
-HEAP_QUEUE = QueueOps(heap_build, heap_schedule, heap_first, heap_rebase, no_walk)
-BUCKET_QUEUE = QueueOps(build_queue, schedule, next_ball, rebase_queue, walk_next_bucket)
+HEAP_QUEUE = QueueOps(heap_build, heap_schedule, heap_first, no_walk)
+BUCKET_QUEUE = QueueOps(build_queue, schedule, next_ball, walk_next_bucket)

@@ -32,10 +32,10 @@ from __future__ import annotations
 from .._jit import njit
 from ..layout import C_CELL, C_EVENT_OTHER, CELL_CROSSINGS, PAIR_TESTS, STALE_EVENTS
 from ..physics.periodic import cell_lengths, nearest, toi_images, wrap_point
-from ..physics.toi import INF, toi_pair
+from ..physics.toi import INF, not_before, toi_pair
 from . import calendar as cal
 from . import grid
-from .trajectories import not_before, pair_gap
+from .trajectories import pair_gap
 
 #: What :func:`screen` makes of a popped event (as the scheduler's ``screen``).
 RUN, PREDICT, RESCHEDULE = range(3)

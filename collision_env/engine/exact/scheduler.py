@@ -15,7 +15,7 @@ The scheduler of the event-driven loop (Alder & Wainwright 1959; Rapaport 1980; 
   (:func:`next_event`), *pop* the earliest event and *screen* it (:func:`screen`: stale, a cell
   crossing, or re-verified), *advance* the balls it involves, *resolve* it (:func:`resolve_wall`,
   :func:`resolve_pair`, and a contact group's :func:`~.contacts.cascade`) and *invalidate*
-  (:func:`invalidate`), and finally *finish* (:func:`finish`: bring every ball to the end of the
+  (:func:`invalidate`), and finally *finish* (:func:`~.calendar.finish_queue`: bring every ball to the end of the
   step and rebase the calendar's times). The phases take a scene's arrays in named bundles
   (:mod:`~collision_env.engine.exact.bundles`).
 
@@ -87,7 +87,7 @@ from ..physics.impacts import record
 from ..physics.motion import ball_views, has_rotation
 from ..physics.periodic import cell_lengths, nearest, wrap_point
 from ..physics.response import ball_ball_along, ball_wall, impact_threshold, normal_impulse, restitution
-from ..physics.toi import INF, toi_pair
+from ..physics.toi import INF, not_before, toi_pair
 from ..physics.walls import snap_to_wall, wall_point
 from ..state import (
     EXACT_FRAMES_SLOT,
@@ -106,7 +106,7 @@ from . import calendar as cal
 from . import clusters, contacts, grid
 from . import periodic as cyclic
 from .bundles import SceneCalendar, work
-from .trajectories import load, not_before, pair_gap, pair_time, store, take, take_in_place, wall_time
+from .trajectories import load, pair_gap, pair_time, take, take_in_place, wall_time
 
 
 class Kind(NamedTuple):
@@ -430,23 +430,9 @@ def invalidate(n_changed, now, ev, in_place, cl, wk):
 
 # ---------------------------------------------------------------------------- finish
 @njit(refcount=False, forceinline=True)
-def finish(t_end, b, rec):
-    """End the step at step time ``t_end``: every ball there, in its record and in the ball state
-    (events resolved on their own rows left the state behind), and the records' times made
-    relative to it (the caller rebases the queue the same way)."""
-    for i in range(b.pos.shape[0]):
-        r = rec[i]
-        dt = t_end - r["ref_time"]
-        r["x"] += r["vx"] * dt
-        r["y"] += r["vy"] * dt
-        store(i, rec, b.pos, b.vel, i)
-        r["ref_time"] = 0.0
-        r["event_time"] -= t_end
-
-
-@njit(refcount=False, forceinline=True)
 def finish_synced(t_end, rec):
-    """:func:`finish` for a scene whose balls are all at ``t_end`` already (stick scenes)."""
+    """Make the records' times relative to step time ``t_end`` in a scene whose balls are all there
+    already (stick scenes; :func:`~.calendar.finish_queue` brings the others there)."""
     for i in range(rec.shape[0]):
         rec[i]["ref_time"] = 0.0
         rec[i]["event_time"] -= t_end
@@ -517,7 +503,7 @@ def _step(kind: Kind):
     """
     sticky, cascades, periodic = kind.sticky, kind.cascades, kind.periodic
     # (the two-level queue works as a heap of every ball when a scene has no buckets; stick scenes never do)
-    build, schedule, first, rebase, walk_ahead = cal.HEAP_QUEUE if kind.sticky else cal.BUCKET_QUEUE
+    build, schedule, first, walk_ahead = cal.HEAP_QUEUE if kind.sticky else cal.BUCKET_QUEUE
     cascade = contacts.cascade_kernel(periodic)  # (compiled only where called: scenes with cascades)
 
     @njit(inline="always")
@@ -689,12 +675,13 @@ def _step(kind: Kind):
             t_end = close_scene(sc, t0, now, horizon_end, ph.sign, dt_abs, state)
             if t_end < 0.0:
                 continue
+            # finish: every ball at the step's end, and the calendar's times made relative to it
             if sticky:
                 clusters.sync_all(t_end, b, rot, cl.rec)
                 finish_synced(t_end, cl.rec)
+                cal.heap_rebase(b.pos.shape[0], t_end, cl.rec, cl.ci, cl.q)  # (the same times, rebased alike)
             else:
-                finish(t_end, b, cl.rec)
-            rebase(b.pos.shape[0], t_end, cl.rec, cl.ci, cl.q)  # (the same times, rebased the same way)
+                cal.finish_queue(b.pos.shape[0], t_end, cl.rec, cl.ci, cl.q, b.pos, b.vel)
         n_imp = state.n_imp
         return n_imp[0] if n_imp[1] == 0 and n_imp[2] == 0 else -1
 

@@ -65,6 +65,25 @@ def load(k, t, rec, pos, vel, row):
     r["ref_time"] = t
 
 
+@njit(inline="always")
+def settle(k, t, rec, pos, vel):
+    """End a step at step time ``t`` for ball ``k``: its record moved there and its times made
+    relative to it (its reference time 0, its event's time less ``t``), its position and velocity
+    into its row of the ball state (events resolved on their own rows left it behind)."""
+    r = rec[k]
+    dt = t - r["ref_time"]
+    x = r["x"] + r["vx"] * dt
+    y = r["y"] + r["vy"] * dt
+    r["x"] = x
+    r["y"] = y
+    r["ref_time"] = 0.0
+    r["event_time"] -= t
+    pos[k, 0] = x
+    pos[k, 1] = y
+    vel[k, 0] = r["vx"]
+    vel[k, 1] = r["vy"]
+
+
 @njit(refcount=False, forceinline=True)
 def take(k, row, t, cl, ev):
     """Ball ``k``, moved in its record to step time ``t``, into row ``row`` of an event's balls."""
@@ -100,18 +119,6 @@ def pair_time(i, k, rec):
     from their records at the later of their reference times."""
     tc, dx, dy, dvx, dvy, sigma = pair_gap(i, k, rec)
     return tc + toi_pair(dx, dy, dvx, dvy, sigma)
-
-
-@njit(inline="always")
-def not_before(dx, dy, dvx, dvy, sigma, span):
-    """Two balls apart by ``(dx, dy)``, closing at ``(dvx, dvy)``, cannot touch within ``span``
-    seconds: their time of impact is at least ``c / (-2 b)`` (``b = dr . dv < 0``, ``c = |dr|^2 -
-    sigma^2``: the quadratic's ``t^2`` term is never negative), with a margin far above the round-off
-    of the time of impact itself. A cheap test that spares the square root and the division of
-    most pairs a prediction looks at (Smallenburg 2022)."""
-    b = dx * dvx + dy * dvy
-    c = dx * dx + dy * dy - sigma * sigma
-    return b >= 0.0 or c * (1.0 - 1e-9) > -2.0 * b * span
 
 
 @njit(refcount=False, forceinline=True)

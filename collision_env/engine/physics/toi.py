@@ -59,6 +59,18 @@ def toi_pair(dx, dy, dvx, dvy, sigma):
 
 
 @njit(inline="always")
+def not_before(dx, dy, dvx, dvy, sigma, span):
+    """Two balls apart by ``(dx, dy)``, closing at ``(dvx, dvy)``, cannot touch within ``span``
+    seconds: their time of impact is at least ``c / (-2 b)`` (``b = dr . dv < 0``, ``c = |dr|^2 -
+    sigma^2``: the quadratic's ``t^2`` term is never negative), with a margin far above the round-off
+    of the time of impact itself. A cheap test that spares the square root and the division of
+    most pairs a prediction looks at (Smallenburg 2022)."""
+    b = dx * dvx + dy * dvy
+    c = dx * dx + dy * dy - sigma * sigma
+    return b >= 0.0 or c * (1.0 - 1e-9) > -2.0 * b * span
+
+
+@njit(inline="always")
 def toi_wall_axis(x, v, r, lo, hi):
     """Time until a ball moving along one axis touches the wall it heads for, and that wall.
 
