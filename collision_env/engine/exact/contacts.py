@@ -207,45 +207,36 @@ def cascade_kernel(periodic: bool) -> Any:
     @njit(inline="always")
     def gather(i0, j0, now, b, ph, cl, geo, wk):
         """Every ball connected to the impact's balls through contacts, into ``wk.pending``, breadth
-        first (a ball's new neighbours in index order), each with its place in ``wk.slot``; returns
-        how many."""
-        group, slot = wk.pending, wk.slot
+        first (a ball's new neighbours in index order), each with its place in ``wk.slot``, and the
+        group's contacts, each once, in a fixed order (``wk.c_a``, ``wk.c_b``; ``wk.c_hit`` marks
+        the impact's own): each ball's partners of later place in the group in the order of their
+        places, then its walls, each with its separation (``wk.c_f[:, :2]``, from ``c_a`` to
+        ``c_b``) and normal. A ball's partners are all in the group once its neighbours have
+        joined, so one look at the balls around it gives both. Returns how many balls and
+        contacts."""
+        group, slot, near = wk.pending, wk.slot, wk.near
         size = 0
         for start in (i0, j0):  # j0 < 0: a wall
             if start >= 0 and slot[start] < 0:
                 group[size] = start
                 slot[start] = size
                 size += 1
-        q = 0
-        while q < size and ph.pairs:
-            a = group[q]
-            q += 1
-            m = touching(a, now, b, ph, cl, geo, wk)
-            _sort_by(wk.near, m, slot, False)
-            for t in range(m):
-                k = wk.near[t]
-                if slot[k] < 0:
-                    group[size] = k
-                    slot[k] = size
-                    size += 1
-        return size
-
-    @njit(inline="always")
-    def list_contacts(i0, j0, size, now, b, ph, cl, geo, wk):
-        """The group's contacts, each once, in a fixed order (``wk.c_a``, ``wk.c_b``; ``wk.c_hit``
-        marks the impact's own), each ball's partners of later place in the group in the order of
-        their places, then its walls; each with its separation (``wk.c_f[:, :2]``, from ``c_a`` to
-        ``c_b``). Returns how many."""
-        group, slot, near = wk.pending, wk.slot, wk.near
         n_contacts = 0
-        for qa in range(size):
-            a = group[qa]
+        q = 0
+        while q < size:
+            a = group[q]
             if ph.pairs:
                 m = touching(a, now, b, ph, cl, geo, wk)
+                _sort_by(near, m, slot, False)
                 later = 0
                 for t in range(m):
-                    if slot[near[t]] > qa:
-                        near[later] = near[t]
+                    k = near[t]
+                    if slot[k] < 0:
+                        group[size] = k
+                        slot[k] = size
+                        size += 1
+                    if slot[k] > q:
+                        near[later] = k
                         later += 1
                 _sort_by(near, later, slot, True)
                 for t in range(later):
@@ -272,12 +263,12 @@ def cascade_kernel(periodic: bool) -> Any:
                         wk.c_f[n_contacts, F_DY] = 0.0
                         wk.c_f[n_contacts, F_NX], wk.c_f[n_contacts, F_NY] = wall_normal(wall)
                         n_contacts += 1
-        return n_contacts
+            q += 1
+        return size, n_contacts
 
     @njit(refcount=False, python=False)
     def cascade(sc, t_abs, now, i0, j0, budget, b, ph, cl, geo, wk):
-        size = gather(i0, j0, now, b, ph, cl, geo, wk)
-        n_contacts = list_contacts(i0, j0, size, now, b, ph, cl, geo, wk)
+        size, n_contacts = gather(i0, j0, now, b, ph, cl, geo, wk)
         u_min = group_threshold(wk.pending, size, b.vel, b.inv_mass, ph.ratio, ph.floor)
         small = size <= DENSE_BALLS
         # (a plastic row's sweeps end only after about its length squared: it goes to its limit at once)
