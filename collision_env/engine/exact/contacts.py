@@ -316,7 +316,7 @@ def _bring(k, now, b, cl, wk):
         take_in_place(k, now, cl.rec, b)
 
 
-@njit(python=False)
+@njit(refcount=False, python=False)
 def _record_instant(t_abs, i0, j0, n_contacts, last, wk):
     """The TC model's record of a contact group's instant ``t_abs``, once the group is resolved: the
     last collision instant (``last``) of the impact's balls and of every ball of a contact that took
@@ -435,7 +435,7 @@ def settle_group(sc, t_abs, size, n_contacts, u_min, row, budget, b, ph, wk):
     return outcome, work
 
 
-@njit(python=False)
+@njit(refcount=False, python=False)
 def _settle_large(size, n_contacts, u_min, fastest, budget, b, wk):
     """The limit of the first ``size`` balls of a large group over its first ``n_contacts``
     contacts: in one pass for a row, else accelerated. Returns the outcome and the work."""
@@ -446,7 +446,7 @@ def _settle_large(size, n_contacts, u_min, fastest, budget, b, wk):
     return _settle_accelerated(size, n_contacts, u_min, accuracy, iterations, budget, b, wk)
 
 
-@njit(python=False)
+@njit(refcount=False, python=False)
 def _moved_first(size, n_contacts, wk):
     """Reorder a group: the balls the cascade moved (marked in ``wk.in_group``) first, in group
     order, and the contacts among them (and their walls) first. Returns how many of each."""
@@ -540,7 +540,7 @@ def settle(size, n_contacts, u_min, b, wk):
         vel[i, 1] += x[2 * q + 1] * root_w[q]
 
 
-@njit(python=False)
+@njit(refcount=False, python=False)
 def _row_axis(size, n_contacts, wk):
     """The axis (0: x, 1: y) along which the group is a row, with each place's neighbours along it
     in ``wk.g_i`` (low side, high side; -1: none, ``_WALL``: a wall), or -1 if it is not one: a
@@ -595,7 +595,7 @@ def _row_gap(k, u, axis, order, vel, wk):
     return u * (wk.g_f[q, _TILT + 1] - 1.0) - (vel[order[k + 1], across] - vel[order[k], across]) * tilt
 
 
-@njit(python=False)
+@njit(refcount=False, python=False)
 def _settle_row(size, n_contacts, u_min, b, wk):
     """The limit of a row's cascade in one pass, if the group is a row (else False, nothing changed):
     with ``z_k = v_k - U_k`` along the row, ``U_k`` the separation speeds its contacts before place
@@ -663,7 +663,7 @@ def _settle_row(size, n_contacts, u_min, b, wk):
     return True
 
 
-@njit(python=False)
+@njit(refcount=False, python=False)
 def _lipschitz(size, n_contacts, inv_mass, wk):
     """A bound on the largest eigenvalue of the group's Delassus matrix ``A = G M^-1 G^T`` (row sums,
     Gershgorin): each contact's ``w_a deg_a + w_b deg_b`` at most, ``deg`` a ball's contacts."""
@@ -685,7 +685,7 @@ def _lipschitz(size, n_contacts, inv_mass, wk):
     return bound
 
 
-@njit(python=False)
+@njit(refcount=False, python=False)
 def _settle_accelerated(size, n_contacts, u_min, accuracy, iterations, budget, b, wk):
     """The limit of any group's cascade by an accelerated projected gradient on the least-distance
     dual ``min f(l) = 1/2 l^T A l - h^T l`` over contact impulses ``l >= 0`` (``A = G M^-1 G^T``, ``h``
