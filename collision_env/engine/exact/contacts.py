@@ -700,8 +700,10 @@ def _settle_accelerated(size, n_contacts, u_min, accuracy, iterations, budget, b
     ``f + u_min sum l``, so with ``f <= 0`` no more than the regulariser's allowance.
 
     Velocities are affine in the impulses, so each iteration's are formed from the last ones
-    (``wk.g_f``: per group place, the velocities before, at the last iterate and at the extrapolated
-    point), and an iteration is three passes over the contacts."""
+    (``wk.g_f``: per group place, the velocities before and at the last iterate; ``b.vel``: at the
+    extrapolated point), and an iteration is three passes over the contacts and two over the balls:
+    a contact's next extrapolated impulse is formed where its gradient step reads it, and a ball's
+    next extrapolated velocity where its share of the objective is summed."""
     c_f, vel, group, inv_mass = wk.c_f, b.vel, wk.pending, b.inv_mass
     g_f = wk.g_f
     for q in range(size):
@@ -711,19 +713,26 @@ def _settle_accelerated(size, n_contacts, u_min, accuracy, iterations, budget, b
             g_f[q, _V_LAM + axis] = vel[i, axis]
     for c in range(n_contacts):
         c_f[c, F_LAM] = 0.0
-        c_f[c, F_Y] = 0.0
+        c_f[c, F_Z] = 0.0
         # (h from this pass's own start: a second pass starts where the first left the velocities)
         c_f[c, F_SHORTFALL] = u_min - _separation(c, vel, wk)
     step = 1.0 / _lipschitz(size, n_contacts, inv_mass, wk)
     t = 1.0
+    momentum = 0.0  # (of the last iteration: its extrapolated impulses are formed in the next one's first pass)
     work = 0
+    outcome = OPEN
     for _ in range(iterations):
         if work >= budget:
             break
         work += 1
-        # (vel holds the extrapolated point's velocities) the projected gradient step
+        # (vel holds the extrapolated point's velocities) the extrapolated impulses and the
+        # projected gradient step
         for c in range(n_contacts):
-            c_f[c, F_Z] = max(0.0, c_f[c, F_Y] - step * (_separation(c, vel, wk) - u_min))
+            z = c_f[c, F_Z]
+            y = z + momentum * (z - c_f[c, F_LAM])
+            c_f[c, F_Y] = y
+            c_f[c, F_LAM] = z
+            c_f[c, F_Z] = max(0.0, y - step * (_separation(c, vel, wk) - u_min))
         # the candidate's velocities, its objective and its worst contact
         for q in range(size):
             vel[group[q], 0] = g_f[q, _V0]
@@ -743,30 +752,29 @@ def _settle_accelerated(size, n_contacts, u_min, accuracy, iterations, budget, b
             worst = max(worst, short)
             if c_f[c, F_Z] > 0.0:
                 excess = max(excess, -short)
-        for q in range(size):
-            i = group[q]
-            dvx = vel[i, 0] - g_f[q, _V0]
-            dvy = vel[i, 1] - g_f[q, _V0 + 1]
-            f_z += 0.5 * (dvx * dvx + dvy * dvy) / inv_mass[i]
-        if worst <= 0.5 * u_min and excess <= accuracy and f_z <= 0.0:
-            return DONE, work
         # the next extrapolated point (none where the step turned against the momentum: a restart)
         t_next = 0.5 * (1.0 + math.sqrt(1.0 + 4.0 * t * t))
         momentum = (t - 1.0) / t_next if turn <= 0.0 else 0.0
         t = t_next if turn <= 0.0 else 1.0
-        for c in range(n_contacts):
-            z = c_f[c, F_Z]
-            c_f[c, F_Y] = z + momentum * (z - c_f[c, F_LAM])
-            c_f[c, F_LAM] = z
         for q in range(size):
             i = group[q]
-            for axis in range(2):
-                v_z = vel[i, axis]
-                vel[i, axis] = v_z + momentum * (v_z - g_f[q, _V_LAM + axis])
-                g_f[q, _V_LAM + axis] = v_z
-    for q in range(size):  # (the last iterate)
+            vx = vel[i, 0]
+            vy = vel[i, 1]
+            dvx = vx - g_f[q, _V0]
+            dvy = vy - g_f[q, _V0 + 1]
+            f_z += 0.5 * (dvx * dvx + dvy * dvy) / inv_mass[i]
+            vel[i, 0] = vx + momentum * (vx - g_f[q, _V_LAM])
+            vel[i, 1] = vy + momentum * (vy - g_f[q, _V_LAM + 1])
+            g_f[q, _V_LAM] = vx
+            g_f[q, _V_LAM + 1] = vy
+        outcome = DONE if worst <= 0.5 * u_min and excess <= accuracy and f_z <= 0.0 else OPEN
+        if outcome == DONE:
+            break
+    for q in range(size):  # (the last iterate, or the candidate that is the limit)
         vel[group[q], 0] = g_f[q, _V_LAM]
         vel[group[q], 1] = g_f[q, _V_LAM + 1]
+    if outcome == DONE:
+        return DONE, work
     return (CAPPED if work >= budget else OPEN), work
 
 
