@@ -207,45 +207,36 @@ def cascade_kernel(periodic: bool) -> Any:
     @njit(inline="always")
     def gather(i0, j0, now, b, ph, cl, geo, wk):
         """Every ball connected to the impact's balls through contacts, into ``wk.pending``, breadth
-        first (a ball's new neighbours in index order), each with its place in ``wk.slot``; returns
-        how many."""
-        group, slot = wk.pending, wk.slot
+        first (a ball's new neighbours in index order), each with its place in ``wk.slot``, and the
+        group's contacts, each once, in a fixed order (``wk.c_a``, ``wk.c_b``; ``wk.c_hit`` marks
+        the impact's own): each ball's partners of later place in the group in the order of their
+        places, then its walls, each with its separation (``wk.c_f[:, :2]``, from ``c_a`` to
+        ``c_b``) and normal. A ball's partners are all in the group once its neighbours have
+        joined, so one look at the balls around it gives both. Returns how many balls and
+        contacts."""
+        group, slot, near = wk.pending, wk.slot, wk.near
         size = 0
         for start in (i0, j0):  # j0 < 0: a wall
             if start >= 0 and slot[start] < 0:
                 group[size] = start
                 slot[start] = size
                 size += 1
-        q = 0
-        while q < size and ph.pairs:
-            a = group[q]
-            q += 1
-            m = touching(a, now, b, ph, cl, geo, wk)
-            _sort_by(wk.near, m, slot, False)
-            for t in range(m):
-                k = wk.near[t]
-                if slot[k] < 0:
-                    group[size] = k
-                    slot[k] = size
-                    size += 1
-        return size
-
-    @njit(inline="always")
-    def list_contacts(i0, j0, size, now, b, ph, cl, geo, wk):
-        """The group's contacts, each once, in a fixed order (``wk.c_a``, ``wk.c_b``; ``wk.c_hit``
-        marks the impact's own), each ball's partners of later place in the group in the order of
-        their places, then its walls; each with its separation (``wk.c_f[:, :2]``, from ``c_a`` to
-        ``c_b``). Returns how many."""
-        group, slot, near = wk.pending, wk.slot, wk.near
         n_contacts = 0
-        for qa in range(size):
-            a = group[qa]
+        q = 0
+        while q < size:
+            a = group[q]
             if ph.pairs:
                 m = touching(a, now, b, ph, cl, geo, wk)
+                _sort_by(near, m, slot, False)
                 later = 0
                 for t in range(m):
-                    if slot[near[t]] > qa:
-                        near[later] = near[t]
+                    k = near[t]
+                    if slot[k] < 0:
+                        group[size] = k
+                        slot[k] = size
+                        size += 1
+                    if slot[k] > q:
+                        near[later] = k
                         later += 1
                 _sort_by(near, later, slot, True)
                 for t in range(later):
@@ -272,12 +263,12 @@ def cascade_kernel(periodic: bool) -> Any:
                         wk.c_f[n_contacts, F_DY] = 0.0
                         wk.c_f[n_contacts, F_NX], wk.c_f[n_contacts, F_NY] = wall_normal(wall)
                         n_contacts += 1
-        return n_contacts
+            q += 1
+        return size, n_contacts
 
     @njit(refcount=False, python=False)
     def cascade(sc, t_abs, now, i0, j0, budget, b, ph, cl, geo, wk):
-        size = gather(i0, j0, now, b, ph, cl, geo, wk)
-        n_contacts = list_contacts(i0, j0, size, now, b, ph, cl, geo, wk)
+        size, n_contacts = gather(i0, j0, now, b, ph, cl, geo, wk)
         u_min = group_threshold(wk.pending, size, b.vel, b.inv_mass, ph.ratio, ph.floor)
         small = size <= DENSE_BALLS
         # (a plastic row's sweeps end only after about its length squared: it goes to its limit at once)
@@ -325,7 +316,7 @@ def _bring(k, now, b, cl, wk):
         take_in_place(k, now, cl.rec, b)
 
 
-@njit(python=False)
+@njit(refcount=False, python=False)
 def _record_instant(t_abs, i0, j0, n_contacts, last, wk):
     """The TC model's record of a contact group's instant ``t_abs``, once the group is resolved: the
     last collision instant (``last``) of the impact's balls and of every ball of a contact that took
@@ -444,7 +435,7 @@ def settle_group(sc, t_abs, size, n_contacts, u_min, row, budget, b, ph, wk):
     return outcome, work
 
 
-@njit(python=False)
+@njit(refcount=False, python=False)
 def _settle_large(size, n_contacts, u_min, fastest, budget, b, wk):
     """The limit of the first ``size`` balls of a large group over its first ``n_contacts``
     contacts: in one pass for a row, else accelerated. Returns the outcome and the work."""
@@ -455,7 +446,7 @@ def _settle_large(size, n_contacts, u_min, fastest, budget, b, wk):
     return _settle_accelerated(size, n_contacts, u_min, accuracy, iterations, budget, b, wk)
 
 
-@njit(python=False)
+@njit(refcount=False, python=False)
 def _moved_first(size, n_contacts, wk):
     """Reorder a group: the balls the cascade moved (marked in ``wk.in_group``) first, in group
     order, and the contacts among them (and their walls) first. Returns how many of each."""
@@ -549,7 +540,7 @@ def settle(size, n_contacts, u_min, b, wk):
         vel[i, 1] += x[2 * q + 1] * root_w[q]
 
 
-@njit(python=False)
+@njit(refcount=False, python=False)
 def _row_axis(size, n_contacts, wk):
     """The axis (0: x, 1: y) along which the group is a row, with each place's neighbours along it
     in ``wk.g_i`` (low side, high side; -1: none, ``_WALL``: a wall), or -1 if it is not one: a
@@ -604,7 +595,7 @@ def _row_gap(k, u, axis, order, vel, wk):
     return u * (wk.g_f[q, _TILT + 1] - 1.0) - (vel[order[k + 1], across] - vel[order[k], across]) * tilt
 
 
-@njit(python=False)
+@njit(refcount=False, python=False)
 def _settle_row(size, n_contacts, u_min, b, wk):
     """The limit of a row's cascade in one pass, if the group is a row (else False, nothing changed):
     with ``z_k = v_k - U_k`` along the row, ``U_k`` the separation speeds its contacts before place
@@ -672,7 +663,7 @@ def _settle_row(size, n_contacts, u_min, b, wk):
     return True
 
 
-@njit(python=False)
+@njit(refcount=False, python=False)
 def _lipschitz(size, n_contacts, inv_mass, wk):
     """A bound on the largest eigenvalue of the group's Delassus matrix ``A = G M^-1 G^T`` (row sums,
     Gershgorin): each contact's ``w_a deg_a + w_b deg_b`` at most, ``deg`` a ball's contacts."""
@@ -694,7 +685,7 @@ def _lipschitz(size, n_contacts, inv_mass, wk):
     return bound
 
 
-@njit(python=False)
+@njit(refcount=False, python=False)
 def _settle_accelerated(size, n_contacts, u_min, accuracy, iterations, budget, b, wk):
     """The limit of any group's cascade by an accelerated projected gradient on the least-distance
     dual ``min f(l) = 1/2 l^T A l - h^T l`` over contact impulses ``l >= 0`` (``A = G M^-1 G^T``, ``h``
@@ -709,8 +700,10 @@ def _settle_accelerated(size, n_contacts, u_min, accuracy, iterations, budget, b
     ``f + u_min sum l``, so with ``f <= 0`` no more than the regulariser's allowance.
 
     Velocities are affine in the impulses, so each iteration's are formed from the last ones
-    (``wk.g_f``: per group place, the velocities before, at the last iterate and at the extrapolated
-    point), and an iteration is three passes over the contacts."""
+    (``wk.g_f``: per group place, the velocities before and at the last iterate; ``b.vel``: at the
+    extrapolated point), and an iteration is three passes over the contacts and two over the balls:
+    a contact's next extrapolated impulse is formed where its gradient step reads it, and a ball's
+    next extrapolated velocity where its share of the objective is summed."""
     c_f, vel, group, inv_mass = wk.c_f, b.vel, wk.pending, b.inv_mass
     g_f = wk.g_f
     for q in range(size):
@@ -720,19 +713,26 @@ def _settle_accelerated(size, n_contacts, u_min, accuracy, iterations, budget, b
             g_f[q, _V_LAM + axis] = vel[i, axis]
     for c in range(n_contacts):
         c_f[c, F_LAM] = 0.0
-        c_f[c, F_Y] = 0.0
+        c_f[c, F_Z] = 0.0
         # (h from this pass's own start: a second pass starts where the first left the velocities)
         c_f[c, F_SHORTFALL] = u_min - _separation(c, vel, wk)
     step = 1.0 / _lipschitz(size, n_contacts, inv_mass, wk)
     t = 1.0
+    momentum = 0.0  # (of the last iteration: its extrapolated impulses are formed in the next one's first pass)
     work = 0
+    outcome = OPEN
     for _ in range(iterations):
         if work >= budget:
             break
         work += 1
-        # (vel holds the extrapolated point's velocities) the projected gradient step
+        # (vel holds the extrapolated point's velocities) the extrapolated impulses and the
+        # projected gradient step
         for c in range(n_contacts):
-            c_f[c, F_Z] = max(0.0, c_f[c, F_Y] - step * (_separation(c, vel, wk) - u_min))
+            z = c_f[c, F_Z]
+            y = z + momentum * (z - c_f[c, F_LAM])
+            c_f[c, F_Y] = y
+            c_f[c, F_LAM] = z
+            c_f[c, F_Z] = max(0.0, y - step * (_separation(c, vel, wk) - u_min))
         # the candidate's velocities, its objective and its worst contact
         for q in range(size):
             vel[group[q], 0] = g_f[q, _V0]
@@ -752,30 +752,29 @@ def _settle_accelerated(size, n_contacts, u_min, accuracy, iterations, budget, b
             worst = max(worst, short)
             if c_f[c, F_Z] > 0.0:
                 excess = max(excess, -short)
-        for q in range(size):
-            i = group[q]
-            dvx = vel[i, 0] - g_f[q, _V0]
-            dvy = vel[i, 1] - g_f[q, _V0 + 1]
-            f_z += 0.5 * (dvx * dvx + dvy * dvy) / inv_mass[i]
-        if worst <= 0.5 * u_min and excess <= accuracy and f_z <= 0.0:
-            return DONE, work
         # the next extrapolated point (none where the step turned against the momentum: a restart)
         t_next = 0.5 * (1.0 + math.sqrt(1.0 + 4.0 * t * t))
         momentum = (t - 1.0) / t_next if turn <= 0.0 else 0.0
         t = t_next if turn <= 0.0 else 1.0
-        for c in range(n_contacts):
-            z = c_f[c, F_Z]
-            c_f[c, F_Y] = z + momentum * (z - c_f[c, F_LAM])
-            c_f[c, F_LAM] = z
         for q in range(size):
             i = group[q]
-            for axis in range(2):
-                v_z = vel[i, axis]
-                vel[i, axis] = v_z + momentum * (v_z - g_f[q, _V_LAM + axis])
-                g_f[q, _V_LAM + axis] = v_z
-    for q in range(size):  # (the last iterate)
+            vx = vel[i, 0]
+            vy = vel[i, 1]
+            dvx = vx - g_f[q, _V0]
+            dvy = vy - g_f[q, _V0 + 1]
+            f_z += 0.5 * (dvx * dvx + dvy * dvy) / inv_mass[i]
+            vel[i, 0] = vx + momentum * (vx - g_f[q, _V_LAM])
+            vel[i, 1] = vy + momentum * (vy - g_f[q, _V_LAM + 1])
+            g_f[q, _V_LAM] = vx
+            g_f[q, _V_LAM + 1] = vy
+        outcome = DONE if worst <= 0.5 * u_min and excess <= accuracy and f_z <= 0.0 else OPEN
+        if outcome == DONE:
+            break
+    for q in range(size):  # (the last iterate, or the candidate that is the limit)
         vel[group[q], 0] = g_f[q, _V_LAM]
         vel[group[q], 1] = g_f[q, _V_LAM + 1]
+    if outcome == DONE:
+        return DONE, work
     return (CAPPED if work >= budget else OPEN), work
 
 
