@@ -177,3 +177,29 @@ class Impacts(Sequence):
 
     def __repr__(self) -> str:
         return f"Impacts({len(self.array)} impacts)"
+
+
+class BufferRows(Impacts):
+    """:class:`Impacts` of rows ``first`` to ``end`` of an impact buffer (a simulator's step, see
+    ``Stepper.step``), whose view of them, its :attr:`~Impacts.array`, is made at the first look:
+    a loop of steps that never looks at their impacts (a loop of frames from Python) does not pay
+    for the view. The rows are the buffer's for good (its kernel never writes them again), so a
+    late look sees what an early one would have. A copy or a pickle is an :class:`Impacts` of the
+    rows alone, without the buffer."""
+
+    __slots__ = ("_buffer", "_first", "_end")
+
+    def __init__(self, buffer: np.ndarray, first: int, end: int) -> None:
+        self._buffer = buffer
+        self._first = first
+        self._end = end
+
+    def __getattr__(self, name: str) -> np.ndarray:
+        if name != "array":  # (only the records are made late: anything else is missing)
+            raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+        rows = self._buffer[self._first : self._end]
+        self.array = rows
+        return rows
+
+    def __reduce__(self) -> tuple:
+        return Impacts, (self.array,)

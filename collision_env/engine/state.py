@@ -339,7 +339,7 @@ else:
         return h[-1]
 
 
-@njit(refcount=False, label="restarting scenes")
+@njit(refcount=False)
 def restart_scenes(h, last_impact, scenes, pos, vel, mass, radius, t, compensation, omega, x0, y0):
     """Start ``scenes`` (indices) of the state in pack ``h`` afresh from checked ``(K, N, ...)``
     positions, velocities, masses and radii, at clock ``t`` (its compensation ``compensation``),
