@@ -27,12 +27,6 @@ from numpy.typing import DTypeLike
 from ._jit import HAVE_NUMBA, njit
 from .argpack import pack_arrays, set_slots
 from .layout import (
-    B_INV_MASS,
-    B_MASS,
-    B_OMEGA,
-    B_RADIUS,
-    B_VX,
-    B_X,
     IMPACT_DTYPE,
     S_COLLAPSE_FLOOR,
     S_COLLAPSE_RATIO,
@@ -45,13 +39,6 @@ from .layout import (
     S_STICKY,
     S_XMIN,
     S_YMAX,
-    W_CALENDAR_VALID,
-    W_GRID_HX,
-    W_GRID_HY,
-    W_GRID_NX,
-    W_GRID_NY,
-    W_GRID_X0,
-    W_GRID_Y0,
 )
 
 #: How a call of a stepping kernel starts: it resumes the scenes a full impact buffer stopped,
@@ -337,45 +324,3 @@ else:
     def unpack_frames(h: tuple, s: int) -> FramesOut:
         """The :class:`FramesOut` of ``h`` (its last bundle)."""
         return h[-1]
-
-
-@njit(refcount=False)
-def restart_scenes(h, last_impact, scenes, pos, vel, mass, radius, t, compensation, omega, x0, y0):
-    """Start ``scenes`` (indices) of the state in pack ``h`` afresh from checked ``(K, N, ...)``
-    positions, velocities, masses and radii, at clock ``t`` (its compensation ``compensation``),
-    spin ``omega``, every ball its own cluster and none of a periodic cell's images; each such scene's
-    grid one cell from ``(x0, y0)`` on, its calendar to be made afresh. ``last_impact`` (the TC
-    model's memory, exact mode's; no rows in the others) becomes -inf: no collision yet.
-
-    ``Stepper.put`` in one call, for the scenes it takes this way (with a border, neither periodic
-    nor on a grid: every small scene an env resets), where a dozen numpy writes of a few rows each
-    cost more than a small scene's step."""
-    state = unpack_state(h)
-    balls, work_f, work_i = state.balls, state.work_f, state.work_i
-    tc = last_impact.shape[0] > 0
-    for k in range(scenes.shape[0]):
-        sc = scenes[k]
-        for i in range(balls.shape[1]):
-            balls[sc, i, B_X] = pos[k, i, 0]
-            balls[sc, i, B_X + 1] = pos[k, i, 1]
-            balls[sc, i, B_VX] = vel[k, i, 0]
-            balls[sc, i, B_VX + 1] = vel[k, i, 1]
-            balls[sc, i, B_MASS] = mass[k, i]
-            balls[sc, i, B_INV_MASS] = 1.0 / mass[k, i]
-            balls[sc, i, B_RADIUS] = radius[k, i]
-            balls[sc, i, B_OMEGA] = omega
-            state.body[sc, i] = i
-            state.images[sc, i, 0] = 0
-            state.images[sc, i, 1] = 0
-            if tc:
-                last_impact[sc, i] = -np.inf
-        state.time[sc] = t
-        state.clock[sc, 0] = t
-        state.clock[sc, 1] = compensation
-        work_f[sc, W_GRID_X0] = x0
-        work_f[sc, W_GRID_Y0] = y0
-        work_f[sc, W_GRID_HX] = np.inf
-        work_f[sc, W_GRID_HY] = np.inf
-        work_i[sc, W_GRID_NX] = 1
-        work_i[sc, W_GRID_NY] = 1
-        work_i[sc, W_CALENDAR_VALID] = 0

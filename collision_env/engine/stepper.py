@@ -16,7 +16,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ._jit import BACKEND, HAVE_NUMBA, compile_for
+from ._jit import BACKEND, compile_for
 from .broadphase import GRID_MIN_BALLS, PERIODIC_GRID_MIN_BALLS, grid_geometry
 from .frames import copy_impacts, record_frame
 from .impacts import BufferRows, Impacts
@@ -61,7 +61,6 @@ from .state import (
     aligned_copy,
     aligned_zeros,
     pack,
-    restart_scenes,
     with_frames,
     with_impacts,
 )
@@ -252,16 +251,7 @@ class Stepper:
     ) -> None:
         """Start ``scenes`` (indices) afresh from checked ``(K, N, ...)`` balls, at ``time`` (with
         its clock's ``compensation``). Periodic positions are wrapped into the cell, the periods
-        counted in their ``images`` (zeros if None); ``clusters`` default to every ball its own.
-        Balls alone, at a float time, go in one kernel call where a scene takes them so
-        (:meth:`_restart`)."""
-        if (
-            images is None
-            and clusters is None
-            and last_impact is None
-            and self._restart(scenes, pos, vel, mass, radius, time, compensation, omega)
-        ):
-            return
+        counted in their ``images`` (zeros if None); ``clusters`` default to every ball its own."""
         pos, wrapped = self.wrapped(pos)
         self.pos[scenes] = pos
         self.images[scenes] = wrapped if images is None else wrapped + images
@@ -277,34 +267,6 @@ class Stepper:
         if self.spec.persistent:  # (the TC model's memory: no collision yet, unless a state says)
             self.mode_arrays[0].last_impact[scenes] = -np.inf if last_impact is None else last_impact
         self.invalidate(scenes)
-
-    def _restart(
-        self,
-        scenes: np.ndarray,
-        pos: np.ndarray,
-        vel: np.ndarray,
-        mass: np.ndarray,
-        radius: np.ndarray,
-        time: Any,
-        compensation: Any,
-        omega: Any,
-    ) -> bool:
-        """:meth:`put` of balls alone at a float ``time`` (``compensation`` and ``omega`` floats too)
-        in one call of ``state.restart_scenes``, if this scene takes it (a border, no periodic cell,
-        no grid) and the arrays are of the types the kernel is compiled for (its compiled version is
-        called directly: see ``_jit.compile_for``); False, with nothing done, otherwise."""
-        if self._restart_call is None or not all(type(x) is float for x in (time, compensation, omega)):
-            return False
-        arrays = (pos, vel, mass, radius)
-        if scenes.dtype != np.int64 or not all(a.dtype == np.float64 and a.flags.c_contiguous for a in arrays):
-            return False
-        k = (len(scenes), self.n)
-        if scenes.ndim != 1 or pos.shape != (*k, 2) or vel.shape != (*k, 2) or mass.shape != k or radius.shape != k:
-            return False
-        x0, y0 = self._restart_origin
-        self._restart_call(self._pack, self._last_impact, scenes, *arrays, time, compensation, omega, x0, y0)
-        self.changed()
-        return True
 
     def changed(self) -> None:
         """The balls were changed outside a step (a nudge): the next step compares every ball with
@@ -375,30 +337,12 @@ class Stepper:
             self.images,
         )
         self._pack = pack(state, *self.mode_arrays, frames=True)
-        self._bind_restart()
         self._sign = float(self.fparams[S_SIGN])  # the direction fparams are set for (see step)
         self._shared = getattr(self, "_shared", False)  # (live_arrays handed out: see live_arrays)
         self._reset_fast_path()
         self.live = LiveArrays(
             self.balls, self.pos, self.vel, self.mass, self.radius, self.time, self.body, self.capped
         )
-
-    def _bind_restart(self) -> None:
-        """What :meth:`_restart` hands ``state.restart_scenes``: exact mode's TC memory (no rows in
-        the cheap modes), the one cell's origin, and the kernel's compiled version (None where the
-        scene is not restarted so, or without numba, where numpy's writes are the faster)."""
-        scene = self.scene
-        self._last_impact = self.mode_arrays[0].last_impact if self.spec.persistent else np.empty((0, self.n))
-        self._restart_call = None
-        if not HAVE_NUMBA or scene.bounds is None or scene.periodic or self.uses_grid():
-            return
-        self._restart_origin = (float(scene.bounds[0]), float(scene.bounds[1]))
-        if restart_scenes not in _DIRECT:
-            k = np.zeros(1, dtype=np.int64)
-            rows = np.zeros((1, self.n))
-            example = (self._pack, self._last_impact, k, np.zeros((1, self.n, 2)), np.zeros((1, self.n, 2)), rows, rows)
-            _DIRECT[restart_scenes] = compile_for(restart_scenes, *example, 0.0, 0.0, 0.0, 0.0, 0.0)
-        self._restart_call = _DIRECT[restart_scenes]
 
     # ------------------------------------------------------------------ stepping
     def step(self, dt: float, stacklevel: int = 4) -> Impacts:
@@ -733,8 +677,7 @@ class Stepper:
     #: What a copy or a pickle rebuilds rather than carries: work space, and what is bound to it.
     _REBUILT = (
         "_imp", "_views", "_cursor", "_refill_at", "_n_imp", "_kernel", "_call", "_pack", "_sign", "_fast_dt",
-        "_shared", "live", "_last_impact", "_restart_call", "_restart_origin", "pos", "vel", "mass", "inv_mass",
-        "radius", "omega", "spec", "start", "_after_step",
+        "_shared", "live", "pos", "vel", "mass", "inv_mass", "radius", "omega", "spec", "start", "_after_step",
     )  # fmt: skip
 
     def __getstate__(self) -> dict[str, Any]:
