@@ -177,3 +177,36 @@ class Impacts(Sequence):
 
     def __repr__(self) -> str:
         return f"Impacts({len(self.array)} impacts)"
+
+
+class BufferRows(Impacts):
+    """:class:`Impacts` of rows ``first`` to ``end`` of an impact buffer (a simulator's step, see
+    ``Stepper.step``), whose view of them, its :attr:`array`, is made at the first look: a loop of
+    steps that never looks at their impacts (a loop of frames from Python) does not pay for the
+    view. The rows are the buffer's for good (its kernel never writes them again), so a late look
+    sees what an early one would have. A copy or a pickle is an :class:`Impacts` of the rows alone,
+    without the buffer."""
+
+    __slots__ = ("_buffer", "_first", "_end", "_rows")
+
+    def __init__(self, buffer: np.ndarray, first: int, end: int) -> None:
+        self._buffer: np.ndarray | None = buffer
+        self._first = first
+        self._end = end
+
+    @property
+    def array(self) -> np.ndarray:
+        """The records, a structured array of ``IMPACT_DTYPE`` (a view of the buffer's rows)."""
+        buffer = self._buffer
+        if buffer is not None:  # (the first look: the view, which holds the buffer from then on)
+            self._rows = buffer[self._first : self._end]
+            self._buffer = None
+        return self._rows
+
+    @array.setter
+    def array(self, rows: np.ndarray) -> None:
+        self._rows = rows
+        self._buffer = None
+
+    def __reduce__(self) -> tuple:
+        return Impacts, (self.array,)

@@ -19,7 +19,7 @@ import numpy as np
 from ._jit import BACKEND, compile_for
 from .broadphase import GRID_MIN_BALLS, PERIODIC_GRID_MIN_BALLS, grid_geometry
 from .frames import copy_impacts, record_frame
-from .impacts import Impacts
+from .impacts import BufferRows, Impacts
 from .layout import (
     B_INV_MASS,
     B_MASS,
@@ -369,13 +369,13 @@ class Stepper:
                 first = self._cursor
                 if end == first:
                     return NO_IMPACTS
-                if self._views:  # (_take_impacts, inlined for the common case)
-                    rows = self._imp[first:end]
-                    self._cursor = end
+                if self._views:  # (_take_impacts, inlined for the common case, its view made late)
+                    impacts = _new(BufferRows)  # (BufferRows(...) without the call of its __init__)
+                    impacts._buffer = self._imp
+                    impacts._first = first
+                    impacts._end = self._cursor = end
                     if end > self._refill_at:
                         self._fresh_buffer(len(self._imp))
-                    impacts = _new(Impacts)  # (Impacts(rows) without the call of its __init__)
-                    impacts.array = rows
                     return impacts
                 return Impacts(self._take_impacts(first, end))
             self.start = START_STEP

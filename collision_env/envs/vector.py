@@ -111,6 +111,10 @@ class CollisionTargetVectorEnv(VectorEnv):
         self._rng_seeds: list = [None] * self.num_envs
         self._autoreset = np.zeros(self.num_envs, dtype=bool)
         self._all = np.ones(self.num_envs, dtype=bool)
+        # the task kernel's row flags (which it only reads): every row stepped, and a buffer for a
+        # step with resets
+        self._stepped_rows = np.full(self.num_envs, ROW_STEPPED, dtype=np.int8)
+        self._rows = np.empty(self.num_envs, dtype=np.int8)
         self._trails = bool(trails)
         self._renderers = None
 
@@ -135,8 +139,8 @@ class CollisionTargetVectorEnv(VectorEnv):
             self._np_random, self._np_random_seed = seeding.np_random(int(seed))
 
     def _info(self, energy, event_cap, nudge, success, n_hit, imp) -> dict:
-        n = self.num_envs
-        info = {"impacts": Impacts(imp), "_impacts": np.ones(n, dtype=bool)}
+        every = np.ones(self.num_envs, dtype=bool)  # (each key's mask a copy: cheaper than a new array)
+        info = {"impacts": Impacts(imp), "_impacts": every}
         for key, value in (
             ("event_cap", event_cap),
             ("nudge", nudge),
@@ -146,7 +150,7 @@ class CollisionTargetVectorEnv(VectorEnv):
             ("is_success", success),
         ):
             info[key] = value
-            info["_" + key] = np.ones(n, dtype=bool)
+            info["_" + key] = every.copy()
         return info
 
     def reset(
@@ -211,13 +215,16 @@ class CollisionTargetVectorEnv(VectorEnv):
             imp = core.advance(a, active, self.config.dt)
             event_cap = core.batch.cap_reached
             if any_reset:
-                idx = np.flatnonzero(resetting)
+                idx = resetting.nonzero()[0]
                 core.reset_scenes(idx, [self._rngs[i] for i in idx])
-                flags = np.where(active, ROW_STEPPED, ROW_RESET).astype(np.int8)
-                imp = imp[active[imp["scene"]]]
+                flags = self._rows
+                flags.fill(ROW_STEPPED)
+                flags[idx] = ROW_RESET
+                if len(imp):
+                    imp = imp[active[imp["scene"]]]
                 event_cap = event_cap & active
             else:
-                flags = np.full(B, ROW_STEPPED, dtype=np.int8)
+                flags = self._stepped_rows
             obs = core.finish(flags, imp, self._fresh_obs())
             reward, term, trunc, success, n_hit, energy, nudge = core.outputs()
             if cap_limit is not None:
@@ -231,7 +238,7 @@ class CollisionTargetVectorEnv(VectorEnv):
         # SAME_STEP: step everything, then reset the sub-envs that ended and report their last step
         imp = core.advance(a, self._all, self.config.dt)
         event_cap = core.batch.cap_reached
-        obs = core.finish(np.full(B, ROW_STEPPED, dtype=np.int8), imp, self._fresh_obs())
+        obs = core.finish(self._stepped_rows, imp, self._fresh_obs())
         reward, term, trunc, success, n_hit, energy, nudge = core.outputs()
         if cap_limit is not None:
             trunc |= core.steps >= cap_limit

@@ -249,3 +249,25 @@ def test_a_cascade_stops_at_the_default_cap_with_the_warning(make):
     p, r = sim.positions, sim.radii
     d = np.linalg.norm(p[:, None] - p[None], axis=-1) + np.eye(len(r)) * 1e9
     assert np.all(d >= (r[:, None] + r[None]) * (1 - 1e-9)) and math.isfinite(sim.kinetic_energy())
+
+
+def test_a_steps_impacts_looked_at_late_are_those_an_early_look_saw():
+    # exact mode's step records are viewed at the first look, which may come after the kernel has
+    # moved on to new buffers (4,096 rows each): what it sees is what a look at once saw, and a
+    # pickle or copy is a plain Impacts of the rows
+    import copy
+    import pickle
+
+    gas = _box_gas(seed=7)
+    sim, twin = (Simulator(gas.scene, gas.positions, 40 * gas.velocities, gas.masses, gas.radii) for _ in range(2))
+    late, early = [], []
+    for _ in range(200):
+        late.append(sim.step(0.6))
+        early.append(twin.step(0.6).array.copy())
+    assert sum(len(c) for c in early) > 10_000
+    for imp, rows in zip(late, early, strict=True):
+        np.testing.assert_array_equal(imp.array, rows)
+    for clone in (pickle.loads(pickle.dumps(late[-1])), copy.copy(late[-1]), copy.deepcopy(late[-2])):
+        assert type(clone) is Impacts
+    np.testing.assert_array_equal(pickle.loads(pickle.dumps(late[-1])).array, early[-1])
+    np.testing.assert_array_equal(copy.deepcopy(late[-2]).array, early[-2])
