@@ -93,7 +93,7 @@ class ExactScratch(NamedTuple):
     near: np.ndarray  #: (N,) int64: the balls touching one ball of a contact group (or its new order)
     g_i: np.ndarray  #: (N, 2) int64: per group place, its neighbours along a row, pooled blocks or degree
     g_f: np.ndarray  #: (N, 4) float64: per group place, pooled blocks or velocities (``contacts``)
-    c_f: np.ndarray  #: (C, 8) float64: per contact, its geometry and impulses (``contacts.F_*``)
+    c_f: np.ndarray  #: (C, 9) float64: per contact, its geometry and impulses (``contacts.F_*``)
 
 
 class SubstepScratch(NamedTuple):

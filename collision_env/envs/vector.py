@@ -145,7 +145,7 @@ class CollisionTargetVectorEnv(VectorEnv):
             ("event_cap", event_cap),
             ("nudge", nudge),
             ("energy", energy),
-            ("time", self._core.time),
+            ("time", self._core.time.copy()),  # (the clock itself moves on: a kept info keeps its time)
             ("targets_hit", n_hit),
             ("is_success", success),
         ):

@@ -187,3 +187,24 @@ def test_sb3_ppo_trains_on_the_native_vector_env():
     model.learn(total_timesteps=512)
     assert model.num_timesteps >= 512
     assert len(model.ep_info_buffer) > 0 and len(model.ep_success_buffer) > 0
+
+
+@pytest.mark.parametrize("mode", [AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP])
+def test_an_info_kept_from_one_step_stays_as_it_was_through_the_next(mode):
+    # replay buffers and episode logs keep infos: none of an info's arrays may be the engine's own
+    import copy
+
+    env = CollisionTargetVectorEnv(num_envs=4, autoreset_mode=mode, max_episode_steps=3)
+    env.reset(seed=0)
+    kept = []
+    for _ in range(7):
+        _, _, _, _, info = env.step(env.action_space.sample())
+        kept.append((info, copy.deepcopy(info)))
+    for info, then in kept:
+        assert info.keys() == then.keys()
+        for key, value in then.items():
+            if isinstance(value, Impacts):
+                np.testing.assert_array_equal(info[key].array, value.array, err_msg=key)
+            else:  # (arrays, SAME_STEP's final observations and infos as object arrays)
+                assert data_equivalence(info[key], value), key
+    assert kept[0][0]["time"][0] != kept[1][0]["time"][0]  # (the clock did move on)

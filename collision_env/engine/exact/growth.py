@@ -112,7 +112,7 @@ def _around(c, ox, oy, geo, g):
 def _not_before(dx, dy, dvx, dvy, sigma, sigma_dot, span):
     """Two growing disks (as :func:`~collision_env.engine.physics.growth.toi_growing_pair` takes them)
     cannot touch within ``span``: where the quadratic's ``t^2`` term is not negative, the time of
-    impact is at least ``c / (-2 b)`` (``trajectories.not_before``, for growing disks). A cheap test
+    impact is at least ``c / (-2 b)`` (``physics.toi.not_before``, for growing disks). A cheap test
     that spares most pairs the square root and the division."""
     a = dvx * dvx + dvy * dvy - sigma_dot * sigma_dot
     b = dx * dvx + dy * dvy - sigma * sigma_dot
