@@ -167,6 +167,22 @@ def _seconds(rows: list) -> float:
     return statistics.median(r["train_seconds"] for r in rows)
 
 
+_CLOCK_NAME = {"cpu": "CPU time", "wall": "wall-clock (some runs predate the CPU time's record)"}
+
+
+def _clock(groups: dict) -> str:
+    """The training time a preset's modes are compared by: ``"cpu"`` when every run of every mode
+    recorded its CPU time (wall-clock on a shared machine varies with the other jobs, CPU time with the
+    work), else ``"wall"``."""
+    rows = [r for rs in groups.values() for r in rs]
+    return "cpu" if all(r.get("train_cpu_seconds") is not None for r in rows) else "wall"
+
+
+def _time(rows: list, clock: str) -> float:
+    """Median training time over seeds on ``clock`` (see :func:`_clock`)."""
+    return statistics.median(r["train_cpu_seconds" if clock == "cpu" else "train_seconds"] for r in rows)
+
+
 def _cpu(rows: list) -> str:
     """Median training CPU time over seeds, in seconds ("n/a" for runs recorded before it was measured)."""
     times = [r["train_cpu_seconds"] for r in rows if r.get("train_cpu_seconds") is not None]
@@ -198,27 +214,27 @@ def _by_env_and_mode(rows: list) -> dict:
 def modes_table(rows: list) -> str:
     tables = []
     for env_id, groups in _by_env_and_mode(rows).items():
-        first = next(iter(groups.values()))[0]
+        first, clock = next(iter(groups.values()))[0], _clock(groups)
         lines = [
             f"**`{env_id}`**: PPO with the shipped hyperparameters ({first['timesteps_done']:,} steps), "
             f"trained under each engine mode, evaluated deterministically on the same {first['episodes']} "
             "episodes. Success: mean ± standard deviation over seeds, then each seed's figure; training "
-            "time: median over seeds.",
+            f"time: median over seeds; ÷ exact's: of the {_CLOCK_NAME[clock]}.",
             "",
             "| trained in | success, evaluated exact | per seed | success in its own mode | "
-            "training time (s) | ÷ exact's | CPU time (s) | engine's share of it |",
+            "training time (s) | CPU time (s) | ÷ exact's | engine's share of it |",
             "|---|---:|---:|---:|---:|---:|---:|---:|",
         ]
         exact_rows = groups.get(("exact", 1))
-        exact_time = _seconds(exact_rows) if exact_rows else None
+        exact_time = _time(exact_rows, clock) if exact_rows else None
         for (mode, k), rs in groups.items():
             exact = [r["exact"]["success_rate"] for r in rs]
             own = [r["own"]["success_rate"] for r in rs]
             secs = _seconds(rs)
-            ratio = f"{secs / exact_time:.2f}" if exact_time else "n/a"
+            ratio = f"{_time(rs, clock) / exact_time:.2f}" if exact_time else "n/a"
             lines.append(
                 f"| {_label(mode, k)} | {_spread(exact)} | {' / '.join(pct(x) for x in exact)} | "
-                f"{_spread(own)} | {secs:.0f} | {ratio} | {_cpu(rs)} | {_share(_engine_share(rs))} |"
+                f"{_spread(own)} | {secs:.0f} | {_cpu(rs)} | {ratio} | {_share(_engine_share(rs))} |"
             )
         tables.append("\n".join(lines))
     return "\n\n".join(tables)
@@ -233,27 +249,36 @@ def comparisons(rows: list) -> list[dict]:
     mean exact-evaluated success ``ref``, the largest standard deviation over seeds of any of its
     modes ``spread``, the engine's share of exact training ``f``, and per cheaper mode (``cheap``,
     in run order) its exact-evaluated success, its loss against ``ref``, how many times as fast it
-    trained, and the verdict: ``"costs"`` (a loss beyond the spread), ``"pays"`` (faster, no such
-    loss) or ``"no gain"``."""
+    trained (on the preset's ``clock``, :func:`_clock`), and the verdict: ``"costs"`` (a loss beyond
+    the spread), ``"pays"`` (faster, no such loss) or ``"no gain"``."""
     out = []
     for env_id, groups in _by_env_and_mode(rows).items():
         exact_rows = groups.get(("exact", 1))
         cheap = {key: rs for key, rs in groups.items() if key != ("exact", 1)}
         if not exact_rows or not cheap:
             continue
-        ref = _mean_exact(exact_rows)
+        ref, clock = _mean_exact(exact_rows), _clock(groups)
         spread = max(
             statistics.stdev([r["exact"]["success_rate"] for r in rs]) if len(rs) > 1 else 0.0 for rs in groups.values()
         )
         modes = []
         for (mode, k), rs in cheap.items():
             success = _mean_exact(rs)
-            loss, speed = ref - success, _seconds(exact_rows) / _seconds(rs)
+            loss, speed = ref - success, _time(exact_rows, clock) / _time(rs, clock)
             verdict = "costs" if loss > spread and loss >= 0.01 else "pays" if speed > 1.0 else "no gain"
             modes.append(
                 {"mode": mode, "substeps": k, "success": success, "loss": loss, "speed": speed, "verdict": verdict}
             )
-        out.append({"env_id": env_id, "ref": ref, "spread": spread, "f": _engine_share(exact_rows), "cheap": modes})
+        out.append(
+            {
+                "env_id": env_id,
+                "ref": ref,
+                "spread": spread,
+                "f": _engine_share(exact_rows),
+                "clock": clock,
+                "cheap": modes,
+            }
+        )
     return out
 
 
@@ -276,7 +301,7 @@ def modes_reading(rows: list) -> str:
             f"- `{c['env_id']}`: policies trained in the cheaper modes succeed in exact mode "
             f"{pct(ref + min(diffs))}–{pct(ref + max(diffs))} against exact-trained {pct(ref)}, "
             f"{verdict} (largest standard deviation over seeds {100 * spread:.0f} points), after "
-            f"{min(ratios):.2f}–{max(ratios):.2f}× exact mode's training time."
+            f"{min(ratios):.2f}–{max(ratios):.2f}× exact mode's training {_CLOCK_NAME[c['clock']].split(' (')[0]}."
         )
     return "\n".join(out)
 
@@ -290,21 +315,23 @@ def trade_table(rows: list) -> str:
     modes = sorted(keys, key=lambda key: (key == ("exact", 1), key))  # cheaper modes by name, exact last
     lines = [
         "The trade, per preset: success of the policies trained in each mode, evaluated exact (mean over seeds; "
-        "in brackets: evaluated in the mode they trained in), and their median training time; the engine's share "
-        "is that of exact training.",
+        "in brackets: evaluated in the mode they trained in), and their median training time: CPU seconds, or "
+        'wall-clock seconds ("wall") where some run of the preset predates the CPU time\'s record; the '
+        "engine's share is that of exact training.",
         "",
         "| env | engine's share | " + " | ".join(_label(m, k) for m, k in modes) + " |",
         "|---|---:|" + "---:|" * len(modes),
     ]
     for env_id, groups in envs.items():
-        cells = []
+        cells, clock = [], _clock(groups)
+        unit = "s CPU" if clock == "cpu" else "s wall"
         for key in modes:
             rs = groups.get(key)
             if not rs:
                 cells.append("")
                 continue
             own = statistics.fmean(r["own"]["success_rate"] for r in rs)
-            cells.append(f"{pct(_mean_exact(rs))} ({pct(own)}), {_seconds(rs):.0f} s")
+            cells.append(f"{pct(_mean_exact(rs))} ({pct(own)}), {_time(rs, clock):.0f} {unit}")
         exact_rows = groups.get(("exact", 1))
         share = _share(_engine_share(exact_rows)) if exact_rows else "n/a"
         lines.append(f"| `{env_id}` | {share} | " + " | ".join(cells) + " |")
@@ -509,7 +536,8 @@ def _verdict_text(found: list) -> str:
 
 
 def pareto_plot(rows: list, path: Path) -> Path | None:
-    """Training time (median over seeds) against exact-evaluated success (mean, with the seeds' standard
+    """Training time (median over seeds; CPU time, or wall-clock for a preset with runs that predate its
+    record) against exact-evaluated success (mean, with the seeds' standard
     deviation), one point per preset and training mode, each preset's modes joined in order of time and
     its Pareto front (no other mode of the preset both faster and better) drawn solid."""
     envs = _by_env_and_mode(rows)
@@ -524,12 +552,12 @@ def pareto_plot(rows: list, path: Path) -> Path | None:
     markers = dict(zip(("naive", "posteriori", "substep", "cells", "exact"), "v^sDo", strict=False))
     fig, ax = plt.subplots(figsize=(8, 5))
     for i, (env_id, groups) in enumerate(envs.items()):
-        color = f"C{i % 10}"
+        color, clock = f"C{i % 10}", _clock(groups)
         points = []
         for (mode, k), rs in groups.items():
             exact = [100 * r["exact"]["success_rate"] for r in rs]
             sd = statistics.stdev(exact) if len(exact) > 1 else 0.0
-            points.append((_seconds(rs), statistics.fmean(exact), sd, mode, k))
+            points.append((_time(rs, clock), statistics.fmean(exact), sd, mode, k))
         points.sort()
         front, best = [], -1.0
         for t, y, *_ in points:
@@ -537,7 +565,8 @@ def pareto_plot(rows: list, path: Path) -> Path | None:
                 front.append((t, y))
                 best = y
         ax.plot([p[0] for p in points], [p[1] for p in points], color=color, alpha=0.3, lw=1)
-        ax.plot(*zip(*front, strict=True), color=color, lw=1.5, label=env_id.split("/")[-1])
+        label = env_id.split("/")[-1] + ("" if clock == "cpu" else " (wall-clock)")
+        ax.plot(*zip(*front, strict=True), color=color, lw=1.5, label=label)
         for t, y, sd, mode, k in points:
             ax.errorbar(t, y, yerr=sd, color=color, marker=markers.get(mode, "o"), ms=7, capsize=2)
             ax.annotate(_label(mode, k), (t, y), textcoords="offset points", xytext=(5, 4), fontsize=7, color=color)
@@ -545,7 +574,7 @@ def pareto_plot(rows: list, path: Path) -> Path | None:
     seconds = FuncFormatter(lambda x, _: f"{x:g}")  # 50, 100, 200 rather than 5 x 10^1
     ax.xaxis.set_major_formatter(seconds)
     ax.xaxis.set_minor_formatter(seconds)
-    ax.set_xlabel("training time per seed (s, median; log scale)")
+    ax.set_xlabel("training CPU time per seed (s, median; log scale)")
     ax.set_ylabel("success evaluated exact (%, mean ± sd over seeds)")
     ax.set_ylim(-3, 105)
     ax.grid(alpha=0.3)

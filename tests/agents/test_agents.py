@@ -377,7 +377,7 @@ def test_study_by_default_trains_every_mode_of_the_trade_and_draws_its_pareto_fi
     assert "**Rule**" in page
 
 
-def _mode_row(env_id, mode, k, seed, success, seconds):
+def _mode_row(env_id, mode, k, seed, success, seconds, cpu_seconds=None):
     return {
         "part": "modes",
         "env_id": env_id,
@@ -387,6 +387,7 @@ def _mode_row(env_id, mode, k, seed, success, seconds):
         "episodes": 100,
         "run": f"runs/{env_id}-{mode}{k}-{seed}",
         "train_seconds": seconds,
+        "train_cpu_seconds": cpu_seconds,
         "timesteps_done": 1000,
         "time_split": {part: (0.5 * seconds if part == "engine" else 0.0) for part in timing.PARTS},
         "observe": "plain",
@@ -416,8 +417,9 @@ def test_study_rule_names_where_training_cheap_pays_and_where_it_costs(tmp_path)
     assert "`CollisionEnv/Pegs-v0` (posteriori k=4 -2 points at 1.25×)" in paid
     assert "`CollisionEnv/Pegs-v0` (naive k=1 -72 points at 2.00×)" in cost
     table = study.trade_table(rows)
-    assert "| `CollisionEnv/Pegs-v0` | 50 % | 10 % (100 %), 50 s | 80 % (100 %), 80 s | 82 % (100 %), 100 s |" in table
-    assert "| `CollisionEnv/Crowd-v0` | 50 % | 95 % (100 %), 60 s |  | 96 % (100 %), 90 s |" in table  # (none trained)
+    cells = ["10 % (100 %), 50 s wall", "80 % (100 %), 80 s wall", "82 % (100 %), 100 s wall"]
+    assert "| `CollisionEnv/Pegs-v0` | 50 % | " + " | ".join(cells) + " |" in table
+    assert "| `CollisionEnv/Crowd-v0` | 50 % | 95 % (100 %), 60 s wall |  | 96 % (100 %), 90 s wall |" in table
     assert study.pareto_plot(rows, tmp_path / "pareto.png").stat().st_size > 0
     # no cheap mode beyond the spread: the rule says so rather than naming one
     slow = rows + [_mode_row("CollisionEnv/Pegs-v0", "posteriori", 1, seed, 0.82, 400.0) for seed in range(3)]
@@ -562,3 +564,22 @@ def test_a_folder_that_is_not_a_run_is_rejected(tmp_path):
         (tmp_path / "x").mkdir()
         (tmp_path / "x" / "f").write_text("")
         train_ppo.train("CollisionEnv/OneBallTarget-v0", timesteps=10, output=tmp_path, run_name="x")
+
+
+def test_study_compares_modes_by_cpu_time_where_every_run_recorded_it():
+    # Wall-clock says naive trained 1.5x as fast; the CPU time says it did the same work: no gain.
+    rows = []
+    for seed in range(3):
+        rows += [
+            _mode_row("CollisionEnv/Crowd-v0", "naive", 1, seed, 0.95, 60.0, cpu_seconds=57.0),
+            _mode_row("CollisionEnv/Crowd-v0", "exact", 1, seed, 0.95, 90.0, cpu_seconds=57.0),
+        ]
+    (crowd,) = study.comparisons(rows)
+    assert crowd["clock"] == "cpu" and crowd["cheap"][0]["speed"] == pytest.approx(1.0)
+    assert crowd["cheap"][0]["verdict"] == "no gain"
+    assert "95 % (100 %), 57 s CPU" in study.trade_table(rows)
+    assert "| 60 | 57 | 1.00 |" in study.modes_table(rows)
+    # one run without its CPU time: the preset falls back to wall-clock throughout
+    rows[0] = {**rows[0], "train_cpu_seconds": None}
+    (crowd,) = study.comparisons(rows)
+    assert crowd["clock"] == "wall" and crowd["cheap"][0]["speed"] == pytest.approx(1.5)
