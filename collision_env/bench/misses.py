@@ -20,7 +20,7 @@ model with what events use, and one frame of 1/60 s is counted. The report gives
 ball and ball-wall collisions) and per array the kernel takes (named as the fields of its bundles,
 :class:`~collision_env.engine.state.State`, :class:`~collision_env.engine.state.Calendar` and
 :class:`~collision_env.engine.state.ExactScratch`), the lines that missed; with ``--sites``, also
-per line of the kernel source that indexed the array (``trajectories.pair_gap:95``).
+per line of the kernel source that indexed the array (``scheduler._partner_event:255``).
 What the counts leave out:
 
 - the frame's passes over every ball (the step's start and end) are counted with the events, as

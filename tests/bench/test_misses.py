@@ -70,4 +70,4 @@ def test_a_small_gas_misses_nothing_in_a_large_cache_and_its_records_in_a_tiny_o
             for site in row["sites"]:
                 by_array[site["array"]] = by_array.get(site["array"], 0.0) + site["per_event"]
             assert by_array == pytest.approx(row["misses_per_event"])
-            assert any(s["array"] == "rec" and s["site"].startswith("trajectories.pair_gap:") for s in row["sites"])
+            assert any(s["array"] == "rec" and s["site"].startswith("scheduler._partner_event:") for s in row["sites"])
