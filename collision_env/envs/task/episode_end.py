@@ -78,9 +78,9 @@ def border_contact(x, y, vx, vy, r, xmin, ymin, xmax, ymax):  # pragma: no cover
 
 
 @njit(inline="always")
-def play_area_diagonal(p):  # pragma: no cover - numba
-    """The length of the play area's diagonal (the aiming potential's unit), from the parameters."""
-    return math.sqrt((p[PARAMS.xmax] - p[PARAMS.xmin]) ** 2 + (p[PARAMS.ymax] - p[PARAMS.ymin]) ** 2)
+def play_area_diagonal(box):  # pragma: no cover - numba
+    """The length of the play area's diagonal (the aiming potential's unit), from its ``scoring.Box``."""
+    return math.sqrt((box.xmax - box.xmin) ** 2 + (box.ymax - box.ymin) ** 2)
 
 
 @njit(refcount=False, forceinline=True)
@@ -155,7 +155,7 @@ def settle(flags, engine, state, params):  # pragma: no cover - numba
     views = ball_views(engine.balls)
     # (read once per call: see scoring.Box)
     box = play_area(params.params)
-    diag = play_area_diagonal(params.params)
+    diag = play_area_diagonal(box)
     shaping = params.params[PARAMS.shaping]
     for b in range(flags.shape[0]):
         f = flags[b]
