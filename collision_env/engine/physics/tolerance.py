@@ -21,6 +21,13 @@ CONTACT_RTOL = 1e-9
 ROUNDOFF_ULPS = 8.0
 #: float64 machine epsilon (the spacing of float64 numbers relative to their size).
 EPS = 2.0**-52
+#: :func:`touching_at` calls two balls apart, without a square root, when their squared distance
+#: exceeds ``(sigma + tol)^2`` by this factor: the round-off of the square, of the square root and of
+#: the gap (a few ``EPS``) is far below the margin, so the full test would say the same.
+SQUARED_MARGIN = 1.0 + 2.0**-20
+#: ... where ``sigma + tol`` exceeds this (m), so that its square is a normal float64, whose round-off
+#: is relative (a subnormal square's is not).
+SQUARED_FLOOR = 1e-150
 
 
 @njit
@@ -55,4 +62,10 @@ def touching_at(a, k, dx, dy, pos, radius):
     a periodic cell, through the nearest image)."""
     sigma = radius[a] + radius[k]
     tol = contact_tolerance(sigma, max(coordinate_size(a, pos), coordinate_size(k, pos)), CONTACT_RTOL)
-    return math.sqrt(dx * dx + dy * dy) - sigma <= tol
+    d2 = dx * dx + dy * dy
+    reach = sigma + tol
+    # (most balls looked at are clearly out of reach: their squared distance says so without the
+    # square root, and gives the same verdict, see SQUARED_MARGIN)
+    if reach > SQUARED_FLOOR and d2 > reach * reach * SQUARED_MARGIN:
+        return False
+    return math.sqrt(d2) - sigma <= tol
