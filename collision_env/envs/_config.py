@@ -25,11 +25,12 @@ from collision_env.engine.keywords import check_keywords
 from collision_env.engine.scene import MAX_MAGNITUDE, PLAY_AREA_1D, PLAY_AREA_2D, WALL_NAMES, radius_from_mass
 from collision_env.engine.validation import MAX_EVENT_CAP
 from collision_env.envs.task.episodes import FENCE_SPACING
+from collision_env.envs.task.images import IMAGE_FEATURES
 from collision_env.envs.task.layout import BALL_OBS, GLOBAL_OBS, PREDICTED_OBS, TARGET_OBS
 
 OBSERVATIONS = ("plain", "predicted")
 OBSERVED_BALLS = ("all", "controlled")
-AIMS = ("straight", "predicted")
+AIMS = ("straight", "predicted", "landing")  # (an index is the aim_predicted switch: task.layout.AIM_LANDING)
 #: Which predicted wall impact of a scoring ball the prediction reports (see TaskConfig).
 PREDICTED_IMPACTS = ("next", "scoring")
 #: What an action component means: a velocity change, or a velocity the ball is steered to (see TaskConfig).
@@ -37,6 +38,8 @@ CONTROLS = ("nudge", "velocity", "shot")  # (in the order of task.layout's CONTR
 SCORERS = ("any", "controlled", "others", "cluster")
 LAYOUTS = ("random", "rack", "fence")
 RADIUS_RULES = ("mass", "constant")
+#: The most reflections each way ``bank_images`` takes.
+MAX_BANK_IMAGES = 8
 
 #: Number of observation entries per ball, per target slot and global (the layouts in ``task.layout``).
 BALL_FEATURES = len(BALL_OBS)
@@ -175,8 +178,10 @@ class TaskConfig:
     next wall contact nearer the nearest pending target (the env's docstring, "Rewards", gives it)."""
     aim: str = "straight"
     """Where the aiming term takes each scoring ball's next wall contact from: ``"straight"`` (flying
-    straight on, a heuristic that ignores other balls) or ``"predicted"`` (the engine's prediction,
-    as for ``observe``)."""
+    straight on, a heuristic that ignores other balls), ``"predicted"`` (the engine's prediction,
+    as for ``observe``) or ``"landing"`` (the engine's prediction of each scoring ball's first impact
+    on the wall of a visible pending target, the impact that decides a shot, past any bounces off
+    the other walls and balls)."""
     # ---- observation
     observed_balls: str = "all"
     """``"all"``: a block per ball in the observation; ``"controlled"``: the controlled balls' blocks
@@ -186,8 +191,14 @@ class TaskConfig:
     per observed ball, its next wall impact as the engine predicts it with no further nudge (contact
     point, time, and whether it hits a target), found by running a copy of the engine ``lookahead`` s
     ahead at every step."""
+    bank_images: int = 0
+    """With ``n > 0``, the observation ends (before the predicted blocks) with the current target's
+    bank-shot aims from the first controlled ball: for the target and its ``2 n`` mirror images in
+    the two walls along its wall (``n`` reflections each way), the unit direction from the ball to
+    the image and whether that straight unfolded path passes every other ball (``task.images``).
+    2D, one target at a time."""
     lookahead: float = 5.0
-    """How far ahead (s) the prediction of ``observe="predicted"`` and ``aim="predicted"`` runs."""
+    """How far ahead (s) the prediction of ``observe="predicted"`` and ``aim="predicted"`` or ``"landing"`` runs."""
     predicted_impact: str = "next"
     """Which impact of a scoring ball the prediction reports: ``"next"``, its next wall impact;
     ``"scoring"``, the first of its wall impacts within the look-ahead that lands on a visible pending
@@ -303,6 +314,12 @@ class TaskConfig:
             raise ValueError(f"aim: expected one of {AIMS}, got {self.aim!r}")
         if self.observe not in OBSERVATIONS:
             raise ValueError(f"observe: expected one of {OBSERVATIONS}, got {self.observe!r}")
+        s("bank_images", _number("bank_images", self.bank_images, low=0, high=MAX_BANK_IMAGES, integer=True))
+        if self.bank_images and (self.dimension != 2 or (self.n_targets > 1 and not self.sequential)):
+            raise ValueError(
+                f"bank_images: needs dimension=2 and one target at a time, got dimension={self.dimension}, "
+                f"n_targets={self.n_targets}, sequential={self.sequential}"
+            )
         s("lookahead", _number("lookahead", self.lookahead, low=0.0, strict_low=True))
         if self.predicted_impact not in PREDICTED_IMPACTS:
             raise ValueError(f"predicted_impact: expected one of {PREDICTED_IMPACTS}, got {self.predicted_impact!r}")
@@ -374,8 +391,13 @@ class TaskConfig:
     def obs_dim(self) -> int:
         """Length of the observation vector (the layout is tabled in each env's docstring)."""
         shown = self.n_observed
-        plain = shown * BALL_FEATURES + self.target_slots * TARGET_FEATURES + GLOBAL_FEATURES
-        return plain + (shown * PREDICTED_FEATURES if self.observe == "predicted" else 0)
+        images = (2 * self.bank_images + 1) * IMAGE_FEATURES if self.bank_images else 0
+        return self.images_at + images + (shown * PREDICTED_FEATURES if self.observe == "predicted" else 0)
+
+    @property
+    def images_at(self) -> int:
+        """Where the bank-shot aims (``bank_images``) start in the observation: after the globals."""
+        return self.n_observed * BALL_FEATURES + self.target_slots * TARGET_FEATURES + GLOBAL_FEATURES
 
     @property
     def shown_mask(self) -> np.ndarray:

@@ -22,11 +22,12 @@ from collision_env.engine.impacts import copy_records
 from collision_env.engine.keywords import close_matches
 from collision_env.engine.modes import MODES
 from collision_env.engine.scene import WALL_NAMES
-from collision_env.envs._config import CONTROLS, TaskConfig
+from collision_env.envs._config import AIMS, CONTROLS, TaskConfig
 from collision_env.envs.task.arrays import Engine, TaskParams, TaskState, pack
 from collision_env.envs.task.checks import check_cluster_mirror, checked_task_state
 from collision_env.envs.task.episodes import block_size, build_episodes
 from collision_env.envs.task.finish import task_kernel
+from collision_env.envs.task.images import observe_images
 from collision_env.envs.task.layout import (
     EPISODE_FLOATS,
     EPISODE_INTS,
@@ -274,7 +275,7 @@ class TaskCore:
             n_steps=cfg.n_steps,
             sticky=int(self.scene.sticky),
             observe_predicted=int(cfg.observe == "predicted"),
-            aim_predicted=int(cfg.aim == "predicted" and cfg.shaping != 0.0),
+            aim_predicted=AIMS.index(cfg.aim) if cfg.aim != "straight" and cfg.shaping != 0.0 else 0,
             control=CONTROLS.index(cfg.control),
             predict_scoring=int(cfg.predicted_impact == "scoring"),
         )
@@ -445,6 +446,8 @@ class TaskCore:
         ``step`` and ``reset`` are the checked way in.
         """
         self._task(self._pack, flags, imp, obs)
+        if self.cfg.bank_images:
+            observe_images(self, flags, obs, self.cfg.images_at)
         if self.ahead is not None:
             self._predict(self.ahead, flags, obs)
         return obs

@@ -85,6 +85,14 @@ class CollisionTargetEnv(gym.Env):
     | 6N + 10S + 2 + 4i + 2    | time until it / time_limit (1, and point 0, 0: none within the lookahead)  |
     | 6N + 10S + 2 + 4i + 3    | 1 if it lands on a visible pending target inside its window, else 0        |
 
+    With `bank_images=n` (2D, one target at a time), `3 (2 n + 1)` entries follow the globals (the
+    predicted blocks, if any, come after them): for m = -n .. n, the unit direction from the first
+    controlled ball to image m of the current target, and 1 if that straight unfolded path passes
+    every other ball (else 0). Image m is the point where the ball's centre meets the target's wall
+    at its centre, mirrored |m| times in the two walls along that wall (first in the lower or left
+    one for m < 0): a ball sent at it bounces |m| times before it lands if nothing is in its way
+    (`task.images`; the plane geometry of the scripted bank shots, the other balls taken at rest).
+
     With sequential targets the single slot shows the current target. Targets without a window
     read -1 and 1 in the window entries. The predicted entries (`observe="predicted"`) come from a
     copy of the engine, in the env's own mode, loaded with the current state and run `lookahead`
@@ -104,6 +112,10 @@ class CollisionTargetEnv(gym.Env):
     step, `shaping * (phi(s') - phi(s))` where `-phi` is the distance (over the play-area diagonal)
     from the nearest point where a scoring ball would touch the border if it flew straight on to the
     nearest visible pending target (a potential-based aiming heuristic that ignores other balls).
+    With `aim="predicted"` that point is the engine's predicted next wall impact instead (see
+    `observe="predicted"`); with `aim="landing"`, the predicted first impact on the wall of a
+    visible pending target (past any bounces off other walls and balls: the impact that decides a
+    shot), measured to that target.
 
     ## Starting State
 

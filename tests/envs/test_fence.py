@@ -17,8 +17,10 @@ from gymnasium.vector import AutoresetMode
 
 import collision_env  # noqa: F401
 from collision_env.envs import TaskConfig, make_config
+from collision_env.envs._config import AIMS
 from collision_env.envs.scripted import BankShotPolicy, scripted_policy
-from collision_env.envs.task.layout import TARGET_FAILED, TARGET_GEOMETRY, TARGET_HIT, TARGET_PENDING
+from collision_env.envs.task.images import unfolded
+from collision_env.envs.task.layout import AIM_LANDING, TARGET_FAILED, TARGET_GEOMETRY, TARGET_HIT, TARGET_PENDING
 
 from .test_vector import run_pair
 
@@ -192,3 +194,148 @@ def test_checkers():
 def test_the_native_vector_env_equals_the_single_env(mode, substeps):
     for autoreset in (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP):
         assert run_pair(ID, autoreset, steps=40, seed=5, mode=mode, substeps=substeps) >= 4
+
+
+LANDING = {"aim": "landing", "shaping": 1.0, "lookahead": 1.5}
+DIAGONAL = (4.0**2 + 2.0**2) ** 0.5  # the play area's diagonal, the aiming potential's unit (m)
+
+
+def reset_env(**kwargs):
+    """A bare Fence env after ``reset``: the ball at rest, nothing predicted, the potential at -1."""
+    env = gym.make(ID, **kwargs).unwrapped
+    env.reset(seed=0)
+    return env
+
+
+def test_the_landing_aim_pays_for_the_shot_landing_near_the_target():
+    # right of the fence at (1, 0.5), shot along (1, 0) at a target centred at 0.2: the contact
+    # point is (2, 0.5), 0.15 m from the target's upper end, after 0.95 / 5 = 0.19 s; the ball at
+    # rest gave -1
+    env = placed(reset_env(**LANDING), ball=(1.0, 0.5), target=0.2)
+    _, reward, term, _, _ = env.step(np.array([1.0, 0.0], np.float32))
+    assert not term and reward == pytest.approx(1.0 - 0.15 / DIAGONAL, abs=1e-12)
+    _, reward, term, _, info = env.step(np.array([1.0, 0.0], np.float32))  # flying on: nothing changes
+    assert term and not info["is_success"]
+    # the miss fails the target: nothing is left to aim at (-1), so the term gives back what it paid
+    assert reward == pytest.approx(-(1.0 - 0.15 / DIAGONAL), abs=1e-12)
+    # on the target (centred at 0.4): the potential's most, 0, then the hit's reward alone
+    env = placed(reset_env(**LANDING), ball=(1.0, 0.5), target=0.4)
+    _, reward, *_ = env.step(np.array([1.0, 0.0], np.float32))
+    assert reward == 1.0
+    _, reward, term, _, info = env.step(np.array([1.0, 0.0], np.float32))
+    assert term and info["is_success"] and reward == 1.0
+
+
+def test_the_landing_aim_looks_past_a_bounce_to_the_impact_on_the_target_wall():
+    # the same start shot steeply down: it bounces off the bottom wall first, then lands on the right
+    # wall; "landing" measures from that second impact, "predicted" (predicted_impact="next") from
+    # the first (the bounce)
+    shot = np.array([0.3, -0.954], np.float32)
+    rewards = {}
+    for aim in ("landing", "predicted"):
+        env = placed(reset_env(**{**LANDING, "aim": aim}), ball=(1.0, 0.5), target=0.0)
+        _, rewards[aim], *_ = env.step(shot)
+        walls = []
+        while True:
+            _, _, term, trunc, info = env.step(shot)
+            walls += [r for r in info["impacts"].array if r["wall"] >= 0]
+            if term or trunc:
+                break
+        assert [int(r["wall"]) for r in walls] == [2, 1]  # bottom, then right
+    land = walls[-1]["y"]
+    assert land == pytest.approx(0.621, abs=1e-3)  # 0.456 m on to the bottom wall, 0.494 m back up: a miss
+    assert rewards["landing"] == pytest.approx(1.0 - (land - 0.15) / DIAGONAL, abs=1e-12)
+    bounce = walls[0]
+    segment = np.hypot(2.0 - bounce["x"], -1.0 + 0.15)  # from the bounce to the target's lower end
+    assert rewards["predicted"] == pytest.approx(1.0 - segment / DIAGONAL, abs=1e-12)
+
+
+def test_the_landing_aim_changes_the_reward_only():
+    # same seeds, same actions: observations, end flags and is_success as without the term; the same
+    # again on a second run (deterministic)
+    runs = []
+    for kwargs in ({}, LANDING, LANDING):
+        env = gym.make(ID, observe="predicted", **kwargs)
+        rng = np.random.default_rng(3)
+        out = []
+        for seed in range(20):
+            env.reset(seed=seed)
+            while True:
+                obs, reward, term, trunc, info = env.step(rng.uniform(-1.3, 1.3, 2).astype(np.float32))
+                out.append((obs.tobytes(), term, trunc, info["is_success"], reward))
+                if term or trunc:
+                    break
+        runs.append(out)
+    plain, landing, again = runs
+    assert [o[:4] for o in plain] == [o[:4] for o in landing]
+    assert landing == again
+    assert any(o[4] != p[4] for o, p in zip(landing, plain, strict=True))
+
+
+def test_checkers_and_vector_equality_with_the_landing_aim():
+    pytest.importorskip("stable_baselines3")
+    from stable_baselines3.common.env_checker import check_env as sb3_check_env
+
+    kwargs = {"observe": "predicted", **LANDING}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(gym.make(ID, **kwargs).unwrapped, skip_render_check=True)
+        sb3_check_env(gym.make(ID, **kwargs).unwrapped, warn=True)
+    for mode, substeps in MODES[::3]:
+        for autoreset in (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP):
+            assert run_pair(ID, autoreset, steps=40, seed=5, mode=mode, substeps=substeps, **kwargs) >= 4
+
+
+def test_unfolded_images_alternate_reflections_in_the_two_mirrors():
+    # mirrors at -0.95 and 0.95 (period 3.8): 0.5 reflected in the lower one is -2.4, in the upper 1.4
+    m = np.arange(-3, 4)
+    got = unfolded(np.array(0.5), np.array(-0.95), np.array(3.8), m)
+    np.testing.assert_allclose(got, [-6.2, -3.3, -2.4, 0.5, 1.4, 4.3, 5.2], atol=1e-12)
+
+
+def test_bank_images_give_the_aims_and_whether_their_paths_clear_the_fence():
+    env = placed(reset_env(bank_images=2), ball=(-1.0, 0.0), target=0.5)
+    obs = env.core.finish(np.zeros(1, np.int8), env.core.empty_impacts(), env._obs())[0]
+    start = env.config.images_at
+    block = obs[start:].reshape(5, 3)  # images m = -2 .. 2
+    face = 2.0 - 0.05  # where the ball's centre meets the right wall
+    for m, y in zip(range(-2, 3), (-3.3, -2.4, 0.5, 1.4, 4.3), strict=True):
+        d = np.array([face + 1.0, y])
+        np.testing.assert_allclose(block[m + 2, :2], d / np.linalg.norm(d), atol=1e-6)
+    # straight at the target crosses the fence at y = 0.5 / 2.95 = 0.17, among the pegs; off the
+    # bottom wall it crosses at -0.81, in the opening
+    assert block[2, 2] == 0.0 and block[1, 2] == 1.0
+    for m, success in ((0, False), (-1, True)):  # the engine agrees
+        shot = placed(reset_env(), ball=(-1.0, 0.0), target=0.5)
+        while True:
+            _, _, term, trunc, info = shot.step(block[m + 2, :2])
+            if term or trunc:
+                break
+        assert info["is_success"] == success
+
+
+def test_bank_images_are_checked():
+    for bad in (-1, 1.5, 9):
+        with pytest.raises(ValueError, match="bank_images"):
+            gym.make(ID, bank_images=bad)
+    for env_id in ("CollisionEnv/Line1D-v0", "CollisionEnv/MultiBall-v0"):  # 1D; three targets at once
+        with pytest.raises(ValueError, match="bank_images"):
+            gym.make(env_id, bank_images=1)
+    with pytest.raises(ValueError, match="aim: expected one of .*'landing'"):
+        gym.make(ID, aim="land")
+    assert AIMS.index("landing") == AIM_LANDING  # (the kernel's switch code)
+    assert gym.make(ID, bank_images=3).observation_space.shape == (18 + 7 * 3,)
+    assert gym.make(ID, bank_images=0).observation_space.shape == (18,)  # (the default: none)
+
+
+def test_checkers_and_vector_equality_with_bank_images():
+    pytest.importorskip("stable_baselines3")
+    from stable_baselines3.common.env_checker import check_env as sb3_check_env
+
+    kwargs = {"observe": "predicted", "bank_images": 2}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(gym.make(ID, **kwargs).unwrapped, skip_render_check=True)
+        sb3_check_env(gym.make(ID, **kwargs).unwrapped, warn=True)
+    for autoreset in (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP):
+        assert run_pair(ID, autoreset, steps=40, seed=5, **kwargs) >= 4

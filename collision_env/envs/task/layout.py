@@ -66,7 +66,7 @@ SWITCHES = layout(
         ("n_steps", "control steps per episode"),
         ("sticky", "1: the engine merges colliding balls (the nudge moves whole clusters)"),
         ("observe_predicted", "1: the observation ends with the engine's predicted impacts"),
-        ("aim_predicted", "1: the aiming potential phi uses the engine's predicted impacts"),
+        ("aim_predicted", "phi from the engine's predicted impacts: 0 no, 1 the nearest, 2 the landing (AIM_LANDING)"),
         ("control", "what an action means: the index of TaskConfig.control in CONTROLS (0 nudge, 1 velocity, 2 shot)"),
         ("predict_scoring", "1: the prediction looks past a scoring ball's next wall impact for one on a target"),
     ),
@@ -140,6 +140,10 @@ EPISODE_INTS = layout(
 
 #: ``SWITCHES.control`` codes: the index of ``TaskConfig.control`` in ``CONTROLS``.
 CONTROL_NUDGE, CONTROL_VELOCITY, CONTROL_SHOT = 0, 1, 2
+
+#: The ``SWITCHES.aim_predicted`` code of ``aim="landing"``: the index of ``TaskConfig.aim`` in
+#: ``AIMS``, as for "predicted" (1; 0: straight flight, or no aiming term when ``shaping`` is 0).
+AIM_LANDING = 2
 
 #: Target status codes (``TARGET_INTS.status``).
 TARGET_PENDING, TARGET_HIT, TARGET_FAILED = 0, 1, 2

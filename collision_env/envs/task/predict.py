@@ -1,5 +1,6 @@
-"""What the engine knows ahead (``observe="predicted"`` and ``aim="predicted"``): each ball's next
-wall impact if the agent stops nudging, from a copy of the engine run ``lookahead`` seconds ahead."""
+"""What the engine knows ahead (``observe="predicted"``, ``aim="predicted"`` or ``"landing"``): each
+ball's next wall impact if the agent stops nudging, from a copy of the engine run ``lookahead``
+seconds ahead."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ from collision_env.engine.compiled import njit
 
 from .arrays import unpack
 from .layout import (
+    AIM_LANDING,
     PARAMS,
     PREDICTED_OBS,
     ROW_RESET,
@@ -22,7 +24,7 @@ from .layout import (
 )
 from .nudge import clip1
 from .observe import centre_and_half_size
-from .scoring import aim_squared, next_wall_impact, play_area, target_hit
+from .scoring import aim_squared, landing_squared, next_wall_impact, play_area, target_hit
 
 
 @njit(label="the environments' predicted observation")
@@ -42,7 +44,9 @@ def predict_kernel(h, flags, imp, obs):  # pragma: no cover - numba
     from the nearest of the scoring balls' predicted impact points (their first ones; all of them
     with ``predict_scoring``) to a visible pending target (-1 when none is predicted): the task
     kernel's shaping term, computed here with the engine's prediction instead of straight flight,
-    added to the reward of stepped scenes without a hit.
+    added to the reward of stepped scenes without a hit. With ``aim_predicted`` 2 (``aim="landing"``)
+    the distance is instead from each scoring ball's first predicted impact on the wall of a visible
+    pending target to that target (:func:`landing_squared`): the impact that decides a shot.
     """
     engine, state, params = unpack(h)
     p, switches, shown, body = params.params, params.switches, params.shown, state.ahead_body
@@ -53,6 +57,7 @@ def predict_kernel(h, flags, imp, obs):  # pragma: no cover - numba
     seq = switches[SWITCHES.sequential] != 0
     observe = switches[SWITCHES.observe_predicted] != 0
     aim = switches[SWITCHES.aim_predicted] != 0
+    landing = switches[SWITCHES.aim_predicted] == AIM_LANDING
     scan = switches[SWITCHES.predict_scoring] != 0
     n = body.shape[1]
     block = np.full(n, -1)  # the observation entry where each shown ball's block starts
@@ -67,6 +72,7 @@ def predict_kernel(h, flags, imp, obs):  # pragma: no cover - numba
             o += len(PREDICTED_OBS)
     seen = np.zeros(body.shape, dtype=np.bool_)
     found = np.zeros(body.shape, dtype=np.bool_)  # (a scoring impact is in the ball's block)
+    landed = np.zeros(body.shape, dtype=np.bool_)  # (the ball's landing is in best)
     best = np.full(body.shape[0], np.inf)  # (each scene's least squared aim distance)
     for b in range(flags.shape[0]):
         if flags[b] == ROW_SKIP:
@@ -84,12 +90,17 @@ def predict_kernel(h, flags, imp, obs):  # pragma: no cover - numba
     while j < imp.shape[0]:
         b = imp[j]["scene"]
         i = imp[j]["ball"]
+        if landing and scores and not landed[b, i]:
+            d2 = landing_squared(j, imp, state, seq)
+            if d2 < math.inf:
+                landed[b, i] = True
+                best[b] = min(best[b], d2)
         first = not seen[b, i]
         if first or (scan and scores and not found[b, i]):
             seen[b, i] = True
             x = imp[j]["x"]
             y = imp[j]["y"]
-            if aim and scores:
+            if aim and scores and not landing:
                 best[b] = min(best[b], aim_squared(x, y, b, state, seq, box))
             if observe and shown[i]:
                 hits = scores and target_hit(j, imp, state, seq) >= 0

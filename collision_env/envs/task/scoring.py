@@ -190,6 +190,23 @@ def aim_squared(cx, cy, b, state, seq, box):  # pragma: no cover - numba
 
 
 @njit(refcount=False, forceinline=True)
+def landing_squared(j, imp, state, seq):  # pragma: no cover - numba
+    """Squared distance along its wall from wall impact ``j`` to the nearest visible pending target
+    on that wall, 0 on it (inf if none: the impact does not land where a target waits)."""
+    b = imp[j]["scene"]
+    w = imp[j]["wall"]
+    along = imp[j]["y"] if on_side_wall(w) else imp[j]["x"]
+    best = math.inf
+    targets, geo = state.targets, state.target_geo
+    k0, k1 = visible_targets(state.scene_i[b, SCENE_INTS.current], targets.shape[1], seq)
+    for k in range(k0, k1):
+        if targets[b, k, TARGET_INTS.status] == TARGET_PENDING and targets[b, k, TARGET_INTS.wall] == w:
+            d = max(abs(along - geo[b, k, TARGET_GEOMETRY.centre]) - geo[b, k, TARGET_GEOMETRY.half_width], 0.0)
+            best = min(best, d * d)
+    return best
+
+
+@njit(refcount=False, forceinline=True)
 def _fail_on_wall(j, imp, state, seq):  # pragma: no cover - numba
     """Shot control: wall impact ``j`` missed every target, so the visible pending targets on its
     wall fail (the shot that was to hit them has struck their wall elsewhere)."""
