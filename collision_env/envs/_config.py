@@ -70,6 +70,8 @@ def _number(name, value, *, low=None, high=None, strict_low=False, integer=False
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise ValueError(f"{name}: expected a number, got {value!r}")
     if integer:
+        if not math.isfinite(value):
+            raise ValueError(f"{name}: must be finite, got {value!r}")
         if int(value) != value:
             raise ValueError(f"{name}: expected an integer, got {value!r}")
         value = int(value)

@@ -314,8 +314,18 @@ def test_bank_images_give_the_aims_and_whether_their_paths_clear_the_fence():
         assert info["is_success"] == success
 
 
+def test_a_ball_on_an_image_point_observes_no_direction_to_it():
+    env = placed(reset_env(bank_images=1), ball=(1.95, 0.3), target=0.3)  # on image 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # (no 0 / 0)
+        obs, *_ = env.step(np.zeros(2, np.float32))
+    block = obs[env.config.images_at :].reshape(3, 3)
+    assert np.isfinite(obs).all()
+    np.testing.assert_array_equal(block[1, :2], 0.0)
+
+
 def test_bank_images_are_checked():
-    for bad in (-1, 1.5, 9):
+    for bad in (-1, 1.5, 9, float("nan"), float("inf")):
         with pytest.raises(ValueError, match="bank_images"):
             gym.make(ID, bank_images=bad)
     for env_id in ("CollisionEnv/Line1D-v0", "CollisionEnv/MultiBall-v0"):  # 1D; three targets at once

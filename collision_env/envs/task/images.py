@@ -69,6 +69,8 @@ def observe_images(core, flags: np.ndarray, obs: np.ndarray, start: int) -> None
     dx = aim[:, :, 0] - ball[:, 0, None]  # (R, M)
     dy = aim[:, :, 1] - ball[:, 1, None]
     length2 = dx * dx + dy * dy
+    # a ball whose centre sits on an image point has no direction to it: (0, 0), not 0 / 0
+    length2 = np.where(length2 > 0.0, length2, np.inf)
     length = np.sqrt(length2)
     unit = np.stack([dx / length, dy / length], axis=2)
     # the other balls' images, out to one more reflection than the aims, relative to the ball
