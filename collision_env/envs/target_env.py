@@ -64,9 +64,8 @@ class CollisionTargetEnv(gym.Env):
 
     `Box(-1, 1, (D,), float32)` with a fixed layout, `D = 6 N + 10 S + 2` (N observed balls: every
     ball, or the controlled ones with `observed_balls="controlled"`; S target slots: 1 when targets
-    are sequential, else `n_targets`), plus `3 (2 n + 1)` with `bank_images=n` and `4 N` with
-    `observe="predicted"` (P below: where the predicted blocks start, `6 N + 10 S + 2 + 3 (2 n + 1)`,
-    `6 N + 10 S + 2` without images). Centre
+    are sequential, else `n_targets`), plus `4 N` with `observe="predicted"` and `3 (2 n + 1)` with
+    `bank_images=n` (which shift the predicted blocks' indices below by as many). Centre
     and half-size of the play area are (xc, yc), (xh, yh); `vs = 2 * max_speed`. Every entry is
     clipped to [-1, 1].
 
@@ -83,9 +82,9 @@ class CollisionTargetEnv(gym.Env):
     | 6N + 10s + 8, 9          | (window open - t) / time_limit, (window close - t) / time_limit            |
     | 6N + 10S + 0             | fraction of the episode's control steps left                               |
     | 6N + 10S + 1             | fraction of targets not yet hit                                            |
-    | P + 4i + 0, 1            | ball i's predicted wall impact (no more nudges), normalised like positions |
-    | P + 4i + 2               | time until it / time_limit (1, and point 0, 0: none within the lookahead)  |
-    | P + 4i + 3               | 1 if it lands on a visible pending target inside its window, else 0        |
+    | 6N + 10S + 2 + 4i + 0, 1 | ball i's predicted wall impact (no more nudges), normalised like positions |
+    | 6N + 10S + 2 + 4i + 2    | time until it / time_limit (1, and point 0, 0: none within the lookahead)  |
+    | 6N + 10S + 2 + 4i + 3    | 1 if it lands on a visible pending target inside its window, else 0        |
 
     With `bank_images=n` (2D, one target at a time), `3 (2 n + 1)` entries follow the globals (the
     predicted blocks, if any, come after them): for m = -n .. n, the unit direction from the first

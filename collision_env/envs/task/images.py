@@ -15,11 +15,16 @@ that a ball struck on the way moves.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from collision_env.engine.scene import WALL_BOTTOM, WALL_LEFT, WALL_RIGHT, WALL_TOP
 
 from .layout import ROW_SKIP, SCENE_INTS, TARGET_GEOMETRY, TARGET_INTS
+
+if TYPE_CHECKING:
+    from collision_env.envs._core import TaskCore
 
 #: Entries per image: the unit direction (x, y) from the ball to the image, and 1 if its path is clear.
 IMAGE_FEATURES = 3
@@ -34,7 +39,7 @@ def unfolded(s: np.ndarray, lo: np.ndarray, period: np.ndarray, m: np.ndarray) -
     return np.where(even, s + (m // 2) * period, 2.0 * lo - s + ((m + 1) // 2) * period)
 
 
-def observe_images(core, flags: np.ndarray, obs: np.ndarray, start: int) -> None:
+def observe_images(core: TaskCore, flags: np.ndarray, obs: np.ndarray, start: int) -> None:
     """Write the bank-shot aims of every scene not flagged ``ROW_SKIP`` into ``obs`` from entry
     ``start`` on: for images ``m = -n .. n`` of the current target (``n = bank_images``), the unit
     direction from the first controlled ball's centre to the image, and 1.0 if that unfolded path
