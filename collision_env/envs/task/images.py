@@ -50,6 +50,7 @@ def observe_images(core: TaskCore, flags: np.ndarray, obs: np.ndarray, start: in
         return
     n = cfg.bank_images
     i = cfg.controlled[0]
+    assert cfg.bounds is not None  # (None only as an argument of TaskConfig)
     xmin, ymin, xmax, ymax = cfg.bounds
     live = core.batch.live_arrays()
     pos, radii = live.positions[rows], live.radii[rows]  # (R, N, 2), (R, N)
