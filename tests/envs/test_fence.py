@@ -272,11 +272,12 @@ def test_the_landing_aim_changes_the_reward_only():
     assert any(o[4] != p[4] for o, p in zip(landing, plain, strict=True))
 
 
-def test_checkers_and_vector_equality_with_the_landing_aim():
+@pytest.mark.parametrize("extra", [LANDING, {"bank_images": 2}], ids=["landing", "bank_images"])
+def test_checkers_and_vector_equality_with_the_fence_options(extra):
     pytest.importorskip("stable_baselines3")
     from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
-    kwargs = {"observe": "predicted", **LANDING}
+    kwargs = {"observe": "predicted", **extra}
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         check_env(gym.make(ID, **kwargs).unwrapped, skip_render_check=True)
@@ -336,16 +337,3 @@ def test_bank_images_are_checked():
     assert AIMS.index("landing") == AIM_LANDING  # (the kernel's switch code)
     assert gym.make(ID, bank_images=3).observation_space.shape == (18 + 7 * 3,)
     assert gym.make(ID, bank_images=0).observation_space.shape == (18,)  # (the default: none)
-
-
-def test_checkers_and_vector_equality_with_bank_images():
-    pytest.importorskip("stable_baselines3")
-    from stable_baselines3.common.env_checker import check_env as sb3_check_env
-
-    kwargs = {"observe": "predicted", "bank_images": 2}
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        check_env(gym.make(ID, **kwargs).unwrapped, skip_render_check=True)
-        sb3_check_env(gym.make(ID, **kwargs).unwrapped, warn=True)
-    for autoreset in (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP):
-        assert run_pair(ID, autoreset, steps=40, seed=5, **kwargs) >= 4
